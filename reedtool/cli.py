@@ -1,0 +1,76 @@
+"""The click layer: parse options, call one api function, print, exit.
+
+Subcommands are imported lazily so that `reedtool --help` does not pay for numpy,
+trimesh or Pinocchio. Each entry in SUBCOMMANDS names the module that defines a click
+command called `command` and the one-line summary shown by --help.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import sys
+
+import click
+
+from . import __version__
+
+# name -> (module, one-line summary). Only subcommands that exist are listed here.
+SUBCOMMANDS: dict[str, tuple[str, str]] = {
+}
+
+
+class LazyGroup(click.Group):
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return sorted(SUBCOMMANDS)
+
+    def get_command(self, ctx: click.Context, name: str) -> click.Command | None:
+        if name not in SUBCOMMANDS:
+            return None
+        module_name, summary = SUBCOMMANDS[name]
+        command = importlib.import_module(module_name).command
+        command.short_help = summary
+        return command
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        # Summaries come from the table, so --help imports no subcommand module.
+        rows = [(name, SUBCOMMANDS[name][1]) for name in self.list_commands(ctx)]
+        if rows:
+            with formatter.section("Commands"):
+                formatter.write_dl(rows)
+
+
+@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="reedtool")
+def cli() -> None:
+    """Check, trim and package multirotor models for ROS/Gazebo, without ROS or Gazebo."""
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Console-script entry: user errors become one line and exit 2, never a traceback."""
+    from .errors import ReedtoolError
+
+    try:
+        # Commands return their exit code (0 ok, 1 findings/failed check); --help and
+        # --version return None through click's Exit.
+        exit_code = cli.main(args=argv, prog_name="reedtool", standalone_mode=False)
+    except click.exceptions.Abort:
+        click.echo("reedtool: aborted", err=True)
+        sys.exit(130)
+    except click.ClickException as exc:
+        exc.show()
+        sys.exit(2)
+    except ReedtoolError as exc:
+        click.echo(f"reedtool: error: {exc.one_line()}", err=True)
+        sys.exit(2)
+    except KeyboardInterrupt:
+        sys.exit(130)
+    except Exception as exc:  # noqa: BLE001 - the last line of defence against tracebacks
+        if os.environ.get("REEDTOOL_DEBUG"):
+            raise
+        detail = " ".join(str(exc).split()) or type(exc).__name__
+        click.echo(f"reedtool: internal error: {type(exc).__name__}: {detail} "
+                   "(this is a reedtool bug; rerun with REEDTOOL_DEBUG=1 for the traceback "
+                   "and report it)", err=True)
+        sys.exit(2)
+    sys.exit(exit_code if isinstance(exit_code, int) else 0)
