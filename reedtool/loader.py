@@ -1,0 +1,41 @@
+"""Path -> Robot: URDF read directly, everything else expanded with xacro first."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Mapping, Sequence
+
+from .errors import ReedtoolError
+from .model import ParseIssue, Robot, SourceLoc
+
+URDF_SUFFIXES = {".urdf"}
+
+
+def load_robot(path: Path | str, mappings: Mapping[str, str] | None = None,
+               package_paths: Sequence[Path] = ()) -> Robot:
+    """Load a model, with source locations pointing at the files the user edits.
+
+    Legacy xacro tags found during expansion are kept as ParseIssues ("legacy-xacro")
+    so that `validate` can report them with the rest.
+    """
+    from .packages import PackageResolver
+    from .urdf_io import load_urdf_file, parse_urdf
+
+    path = Path(path)
+    if not path.exists():
+        raise ReedtoolError("file not found", file=path, hint="check the model path")
+    if path.is_dir():
+        raise ReedtoolError("is a directory, expected a .urdf or .xacro file", file=path)
+    if path.suffix.lower() in URDF_SUFFIXES:
+        return load_urdf_file(path, resolver=PackageResolver(package_paths, model_path=path))
+
+    from .expand import expand_xacro
+
+    expansion = expand_xacro(path, dict(mappings or {}), package_paths)
+    robot = parse_urdf(expansion.urdf_xml, path, resolver=expansion.resolver,
+                       element_locs=expansion.element_locs)
+    for tag in expansion.legacy:
+        robot.parse_issues.append(ParseIssue(
+            kind="legacy-xacro", message=str(tag),
+            loc=SourceLoc(str(tag.file), tag.line), subject=getattr(tag, "tag", None)))
+    return robot

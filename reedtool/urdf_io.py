@@ -1,0 +1,257 @@
+"""URDF text -> Robot model, keeping the source location of every element.
+
+This is the only module that reads URDF XML. It never stops at the first problem in the
+model's content: unreadable numbers, missing attributes and the like are collected as
+ParseIssue entries for `validate` to report. Only input that is not a URDF at all
+(malformed XML, wrong root element) raises ReedtoolError.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Callable, Sequence
+
+import numpy as np
+from lxml import etree
+
+from .errors import ReedtoolError
+from .frames import make_T, rpy_to_matrix
+from .model import (Box, Collision, Cylinder, GazeboBlock, Inertial, Joint, JointLimit, Link,
+                    Mesh, ParseIssue, Plugin, Robot, SourceLoc, Sphere, Visual, XmlNode)
+
+Locator = Callable[[etree._Element], SourceLoc]
+
+
+def parse_urdf(xml_text: str, file: Path | str, *, resolver=None,
+               element_locs: Sequence[SourceLoc] | None = None) -> Robot:
+    """Parse URDF text read from (or expanded from) `file`.
+
+    `element_locs`, from an xacro expansion, gives the SourceLoc of each element in
+    document order; without it locations are lines of `file` itself. `resolver` resolves
+    mesh URIs (reedtool.packages.PackageResolver); by default one rooted at `file`.
+    """
+    file = Path(file)
+    try:
+        parser = etree.XMLParser(remove_blank_text=False, resolve_entities=False, huge_tree=True)
+        root = etree.fromstring(xml_text.encode("utf-8"), parser)
+    except etree.XMLSyntaxError as exc:
+        line = exc.lineno if element_locs is None else None
+        raise ReedtoolError(f"malformed XML: {exc.msg}", file=file, line=line,
+                            hint="fix the XML syntax at that position") from exc
+    if root.tag != "robot":
+        raise ReedtoolError(f"not a URDF: the root element is <{root.tag}>, expected <robot>",
+                            file=file, line=root.sourceline)
+    if resolver is None:
+        from .packages import PackageResolver
+        resolver = PackageResolver(model_path=file)
+    return _RobotReader(file, _make_locator(root, file, element_locs), resolver).read(root, xml_text)
+
+
+def load_urdf_file(path: Path | str, *, resolver=None) -> Robot:
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError as exc:
+        raise ReedtoolError("file not found", file=path, hint="check the path") from exc
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ReedtoolError(f"cannot read file: {exc}", file=path) from exc
+    return parse_urdf(text, path, resolver=resolver)
+
+
+def _make_locator(root: etree._Element, file: Path,
+                  element_locs: Sequence[SourceLoc] | None) -> Locator:
+    if element_locs is None:
+        return lambda el: SourceLoc(str(file), el.sourceline, urdf_line=el.sourceline)
+    elements = [el for el in root.iter() if isinstance(el.tag, str)]
+    if len(elements) != len(element_locs):
+        # A mapping that does not line up would point users at wrong lines; fall back to
+        # the expanded file's own lines rather than guess.
+        return lambda el: SourceLoc(str(file), None, urdf_line=el.sourceline)
+    by_element = {el: loc for el, loc in zip(elements, element_locs)}
+    return lambda el: by_element.get(el, SourceLoc(str(file), None, urdf_line=el.sourceline))
+
+
+class _RobotReader:
+    def __init__(self, file: Path, locate: Locator, resolver):
+        self.file = file
+        self.locate = locate
+        self.resolver = resolver
+        self.issues: list[ParseIssue] = []
+
+    # ---------------------------------------------------------------- helpers
+    def _issue(self, kind: str, message: str, el: etree._Element, subject: str | None) -> None:
+        self.issues.append(ParseIssue(kind, message, self.locate(el), subject))
+
+    def _floats(self, el: etree._Element | None, attr: str, count: int, default: Sequence[float],
+                subject: str | None) -> np.ndarray:
+        """Read `count` numbers from an attribute; problems become ParseIssues."""
+        if el is None or el.get(attr) is None:
+            return np.array(default, dtype=float)
+        raw = el.get(attr)
+        parts = raw.split()
+        try:
+            values = [float(p) for p in parts]
+        except ValueError:
+            self._issue("bad-number", f"<{el.tag} {attr}=\"{raw}\"> is not {count} number(s)",
+                        el, subject)
+            return np.array(default, dtype=float)
+        if len(values) != count:
+            self._issue("bad-number", f"<{el.tag} {attr}=\"{raw}\"> has {len(values)} "
+                        f"number(s), expected {count}", el, subject)
+            return np.array(default, dtype=float)
+        if not all(math.isfinite(v) for v in values):
+            self._issue("non-finite", f"<{el.tag} {attr}=\"{raw}\"> is not finite", el, subject)
+        return np.array(values, dtype=float)
+
+    def _float(self, el: etree._Element | None, attr: str, default: float | None,
+               subject: str | None, required: bool = False) -> float | None:
+        if el is None:
+            return default
+        if el.get(attr) is None:
+            if required:
+                self._issue("missing-attribute", f"<{el.tag}> has no {attr}= attribute",
+                            el, subject)
+            return default
+        fallback = [default] if default is not None else [math.nan]
+        return float(self._floats(el, attr, 1, fallback, subject)[0])
+
+    def _origin(self, el: etree._Element | None, subject: str | None) -> np.ndarray:
+        if el is None:
+            return np.eye(4)
+        xyz = self._floats(el, "xyz", 3, (0.0, 0.0, 0.0), subject)
+        rpy = self._floats(el, "rpy", 3, (0.0, 0.0, 0.0), subject)
+        return make_T(rpy_to_matrix(rpy), xyz)
+
+    def _node(self, el: etree._Element) -> XmlNode:
+        children = [self._node(c) for c in el if isinstance(c.tag, str)]
+        return XmlNode(tag=el.tag, attrib=dict(el.attrib), text=el.text, children=children,
+                       loc=self.locate(el))
+
+    # ---------------------------------------------------------------- elements
+    def read(self, root: etree._Element, xml_text: str) -> Robot:
+        robot = Robot(name=root.get("name", ""), loc=self.locate(root), source_file=self.file,
+                      urdf_xml=xml_text)
+        for el in root:
+            if not isinstance(el.tag, str):
+                continue
+            if el.tag == "link":
+                robot.links.append(self._link(el))
+            elif el.tag == "joint":
+                robot.joints.append(self._joint(el))
+            elif el.tag == "gazebo":
+                robot.gazebo.append(self._gazebo(el))
+        robot.parse_issues = self.issues
+        return robot
+
+    def _link(self, el: etree._Element) -> Link:
+        name = el.get("name")
+        if not name:
+            self._issue("missing-attribute", "<link> has no name= attribute", el, None)
+            name = ""
+        link = Link(name=name, loc=self.locate(el))
+        inertial = el.find("inertial")
+        if inertial is not None:
+            link.inertial = self._inertial(inertial, name)
+        for v in el.findall("visual"):
+            material = v.find("material")
+            link.visuals.append(Visual(geometry=self._geometry(v.find("geometry"), name),
+                                       T_link_geom=self._origin(v.find("origin"), name),
+                                       loc=self.locate(v), name=v.get("name"),
+                                       material=material.get("name") if material is not None else None))
+        for c in el.findall("collision"):
+            link.collisions.append(Collision(geometry=self._geometry(c.find("geometry"), name),
+                                             T_link_geom=self._origin(c.find("origin"), name),
+                                             loc=self.locate(c), name=c.get("name")))
+        return link
+
+    def _inertial(self, el: etree._Element, link: str) -> Inertial:
+        mass_el = el.find("mass")
+        if mass_el is None:
+            self._issue("missing-element", "<inertial> has no <mass>", el, link)
+        mass = self._float(mass_el, "value", 0.0, link, required=True)
+        inertia_el = el.find("inertia")
+        if inertia_el is None:
+            self._issue("missing-element", "<inertial> has no <inertia>", el, link)
+        values = {k: self._float(inertia_el, k, 0.0, link, required=inertia_el is not None)
+                  for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
+        tensor = np.array([[values["ixx"], values["ixy"], values["ixz"]],
+                           [values["ixy"], values["iyy"], values["iyz"]],
+                           [values["ixz"], values["iyz"], values["izz"]]], dtype=float)
+        return Inertial(mass_kg=float(mass), T_link_com=self._origin(el.find("origin"), link),
+                        inertia_kg_m2=tensor, loc=self.locate(el),
+                        mass_loc=self.locate(mass_el) if mass_el is not None else None,
+                        inertia_loc=self.locate(inertia_el) if inertia_el is not None else None)
+
+    def _geometry(self, el: etree._Element | None, link: str):
+        if el is None:
+            return None
+        shape = next((c for c in el if isinstance(c.tag, str)), None)
+        if shape is None:
+            self._issue("missing-element", "<geometry> is empty", el, link)
+            return None
+        if shape.tag == "box":
+            return Box(size_m=self._floats(shape, "size", 3, (math.nan,) * 3, link))
+        if shape.tag == "cylinder":
+            return Cylinder(radius_m=self._float(shape, "radius", math.nan, link, required=True),
+                            length_m=self._float(shape, "length", math.nan, link, required=True))
+        if shape.tag == "sphere":
+            return Sphere(radius_m=self._float(shape, "radius", math.nan, link, required=True))
+        if shape.tag == "mesh":
+            return self._mesh(shape, link)
+        self._issue("unknown-element", f"unknown geometry <{shape.tag}>", shape, link)
+        return None
+
+    def _mesh(self, el: etree._Element, link: str) -> Mesh:
+        uri = el.get("filename", "")
+        scale = self._floats(el, "scale", 3, (1.0, 1.0, 1.0), link)
+        if not uri:
+            self._issue("missing-attribute", "<mesh> has no filename= attribute", el, link)
+            return Mesh(uri="", path=None, scale=scale, resolve_error="no filename")
+        try:
+            # Relative mesh paths are relative to the file the user passed, as in xacro.
+            path = self.resolver.resolve_uri(uri, self.file.parent)
+        except ReedtoolError as exc:
+            return Mesh(uri=uri, path=None, scale=scale, resolve_error=exc.message)
+        return Mesh(uri=uri, path=Path(path), scale=scale)
+
+    def _joint(self, el: etree._Element) -> Joint:
+        name = el.get("name") or ""
+        if not name:
+            self._issue("missing-attribute", "<joint> has no name= attribute", el, None)
+        parent_el, child_el = el.find("parent"), el.find("child")
+        parent = parent_el.get("link") if parent_el is not None else None
+        child = child_el.get("link") if child_el is not None else None
+        if parent is None:
+            self._issue("missing-element", "<joint> has no <parent link=...>", el, name)
+        if child is None:
+            self._issue("missing-element", "<joint> has no <child link=...>", el, name)
+        axis_el = el.find("axis")
+        limit_el = el.find("limit")
+        limit = None
+        if limit_el is not None:
+            limit = JointLimit(lower=self._float(limit_el, "lower", None, name),
+                               upper=self._float(limit_el, "upper", None, name),
+                               effort=self._float(limit_el, "effort", None, name),
+                               velocity=self._float(limit_el, "velocity", None, name),
+                               loc=self.locate(limit_el))
+        origin_el = el.find("origin")
+        return Joint(name=name, type=el.get("type", ""), parent=parent, child=child,
+                     T_parent_joint=self._origin(origin_el, name),
+                     axis=self._floats(axis_el, "xyz", 3, (1.0, 0.0, 0.0), name),
+                     loc=self.locate(el), limit=limit,
+                     axis_loc=self.locate(axis_el) if axis_el is not None else None,
+                     origin_loc=self.locate(origin_el) if origin_el is not None else None)
+
+    def _gazebo(self, el: etree._Element) -> GazeboBlock:
+        block = GazeboBlock(reference=el.get("reference"), loc=self.locate(el))
+        for child in el:
+            if not isinstance(child.tag, str):
+                continue
+            node = self._node(child)
+            if child.tag == "plugin":
+                block.plugins.append(Plugin(name=child.get("name"), filename=child.get("filename"),
+                                            node=node, loc=node.loc))
+            else:
+                block.elements.append(node)
+        return block
