@@ -1,0 +1,71 @@
+"""`reedtool expand`: xacro -> URDF without ROS, resolving packages the way ROS would."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from ..errors import ReedtoolError
+
+
+def _fix_legacy(model: Path, mappings: dict[str, str], package_paths: list[Path]) -> None:
+    from ..expand import display_path, scan_legacy
+    from ..fileio import atomic_write_text
+    from ..packages import is_bundled
+
+    scan = scan_legacy(model, mappings, package_paths)
+    for path, text in scan.fixed_text.items():
+        if is_bundled(path):
+            continue  # reedtool's own files are never rewritten
+        count = sum(1 for tag in scan.tags if tag.file == display_path(path))
+        backup = atomic_write_text(path, text, force=True, backup=True)
+        click.echo(f"reedtool: rewrote {count} legacy xacro tag(s) in {display_path(path)} "
+                   f"(backup: {display_path(backup) if backup else 'none'})", err=True)
+
+
+@click.command(name="expand")
+@click.argument("model", type=click.Path(path_type=Path, dir_okay=False))
+@click.argument("args", nargs=-1, metavar="[NAME:=VALUE]...")
+@click.option("-o", "--output", type=click.Path(path_type=Path, dir_okay=False),
+              help="Write the URDF here instead of standard output.")
+@click.option("--package-path", "package_paths", multiple=True,
+              type=click.Path(path_type=Path, file_okay=False),
+              help="Directory searched first for ROS packages (repeatable).")
+@click.option("--force", is_flag=True, help="Overwrite an existing output file.")
+@click.option("--fix-legacy", is_flag=True,
+              help="Rewrite legacy xacro tags (<property>, <macro>, <include>, unprefixed "
+                   "macro calls) in the model's files first, keeping a .bak of each.")
+def command(model: Path, args: tuple[str, ...], output: Path | None,
+            package_paths: tuple[Path, ...], force: bool, fix_legacy: bool) -> int:
+    """Expand a xacro MODEL into URDF, with $(find) and package:// resolved without ROS.
+
+    Arguments NAME:=VALUE set $(arg NAME), as roslaunch and xacro take them.
+    """
+    from ..expand import expand_xacro, parse_mappings
+    from ..fileio import atomic_write_text, check_writable
+
+    mappings = parse_mappings(args)
+    if output is not None:
+        check_writable(output, force)   # fail before the work, not after
+    if fix_legacy:
+        _fix_legacy(model, mappings, list(package_paths))
+
+    expansion = expand_xacro(model, mappings, list(package_paths))
+    if expansion.legacy:
+        for tag in expansion.legacy:
+            click.echo(f"reedtool: {tag}", err=True)
+        raise ReedtoolError(
+            f"{len(expansion.legacy)} legacy xacro tag(s): xacro 2.x and ROS copy them into "
+            "the URDF unexpanded, so the model is broken as written", file=model,
+            hint=f"rewrite them with 'reedtool expand --fix-legacy {model}'; "
+                 "each file keeps a .bak backup")
+    for warning in expansion.warnings:
+        click.echo(f"reedtool: warning: {warning}", err=True)
+
+    if output is None:
+        click.echo(expansion.urdf_xml, nl=False)
+    else:
+        atomic_write_text(output, expansion.urdf_xml, force=force)
+        click.echo(f"reedtool: wrote {output}", err=True)
+    return 0

@@ -1,0 +1,191 @@
+"""Find ROS packages and resolve `package://` URIs without ROS.
+
+A package is a directory whose package.xml declares that <name>. Roots are searched in
+the order ROS users expect (issue 2, item 4):
+
+1. `--package-path` directories,
+2. `ROS_PACKAGE_PATH` entries (catkin workspaces, roslib's search path),
+3. `AMENT_PREFIX_PATH` prefixes, as `<prefix>/share/<pkg>` (ament's install layout),
+4. the package that contains the model (walk up from the model file to a package.xml),
+5. reedtool's bundled packages (reedtool/ros_packages), last, so a real
+   rotors_description anywhere earlier always wins.
+
+Each root may itself be a package or hold packages a few levels down (a catkin `src/`
+with `repo/pkg/package.xml`). Like rospack, the crawl stops descending at a package,
+skips hidden directories and honours CATKIN_IGNORE/COLCON_IGNORE/AMENT_IGNORE markers.
+"""
+
+from __future__ import annotations
+
+import os
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Sequence
+from urllib.parse import unquote, urlparse
+
+from .errors import ReedtoolError
+from .model import SourceLoc
+
+BUNDLED_PACKAGES_DIR = Path(__file__).resolve().parent / "ros_packages"
+
+# How deep below a root a package.xml is looked for: root/src/repo/group/pkg is 4.
+MAX_CRAWL_DEPTH = 5
+_IGNORE_MARKERS = ("CATKIN_IGNORE", "COLCON_IGNORE", "AMENT_IGNORE")
+
+
+@dataclass(frozen=True)
+class SearchRoot:
+    origin: str        # why this root is searched, e.g. "--package-path", "ROS_PACKAGE_PATH"
+    path: Path
+    ament: bool = False  # an AMENT_PREFIX_PATH prefix: packages live in <prefix>/share/<pkg>
+
+    def describe(self) -> str:
+        where = self.path / "share" if self.ament else self.path
+        return f"{where} ({self.origin})"
+
+
+def package_name(package_xml: Path) -> str | None:
+    """The <name> a package.xml declares, or None when it cannot be read."""
+    try:
+        root = ET.parse(package_xml).getroot()
+    except (ET.ParseError, OSError):
+        return None
+    name = root.findtext("name")
+    return name.strip() if name else None
+
+
+def enclosing_package(path: Path) -> Path | None:
+    """The nearest directory at or above `path` that holds a package.xml."""
+    path = Path(path).resolve()
+    for candidate in [path, *path.parents] if path.is_dir() else path.parents:
+        if (candidate / "package.xml").is_file():
+            return candidate
+    return None
+
+
+def is_bundled(path: str | Path) -> bool:
+    """True for files of reedtool's own bundled packages (never the user's to edit)."""
+    try:
+        Path(path).resolve().relative_to(BUNDLED_PACKAGES_DIR)
+    except ValueError:
+        return False
+    return True
+
+
+def _crawl(root: Path) -> dict[str, Path]:
+    """All packages under `root` (root included), first found per name wins."""
+    found: dict[str, Path] = {}
+    if not root.is_dir():
+        return found
+
+    def visit(directory: Path, depth: int) -> None:
+        if any((directory / marker).exists() for marker in _IGNORE_MARKERS):
+            return
+        manifest = directory / "package.xml"
+        if manifest.is_file():
+            name = package_name(manifest)
+            if name:
+                found.setdefault(name, directory)
+            return  # packages do not nest (rospack/catkin rule)
+        if depth >= MAX_CRAWL_DEPTH:
+            return
+        try:
+            children = sorted(p for p in directory.iterdir()
+                              if p.is_dir() and not p.name.startswith("."))
+        except OSError:
+            return
+        for child in children:
+            visit(child, depth + 1)
+
+    visit(root, 0)
+    return found
+
+
+class PackageResolver:
+    """Resolves package names and mesh/include URIs the way ROS would, without ROS."""
+
+    def __init__(self, package_paths: Sequence[Path] = (), model_path: Path | None = None):
+        self.package_paths = [Path(p) for p in package_paths]
+        self.model_path = Path(model_path) if model_path is not None else None
+        self._roots: list[SearchRoot] | None = None
+        self._index: dict[SearchRoot, dict[str, Path]] = {}
+        self._found: dict[str, Path] = {}
+
+    # ------------------------------------------------------------ roots
+    @property
+    def roots(self) -> list[SearchRoot]:
+        if self._roots is None:
+            self._roots = self._search_roots()
+        return self._roots
+
+    def _search_roots(self) -> list[SearchRoot]:
+        roots = [SearchRoot("--package-path", p) for p in self.package_paths]
+        for entry in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep):
+            if entry:
+                roots.append(SearchRoot("ROS_PACKAGE_PATH", Path(entry)))
+        for entry in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep):
+            if entry:
+                roots.append(SearchRoot("AMENT_PREFIX_PATH", Path(entry), ament=True))
+        if self.model_path is not None:
+            own = enclosing_package(self.model_path)
+            if own is not None:
+                roots.append(SearchRoot("package containing the model", own))
+        roots.append(SearchRoot("bundled with reedtool", BUNDLED_PACKAGES_DIR))
+        return roots
+
+    def _lookup(self, root: SearchRoot, name: str) -> Path | None:
+        if root.ament:
+            candidate = root.path / "share" / name
+            manifest = candidate / "package.xml"
+            if manifest.is_file() and package_name(manifest) == name:
+                return candidate
+            return None
+        if root not in self._index:
+            self._index[root] = _crawl(root.path)
+        return self._index[root].get(name)
+
+    # ------------------------------------------------------------ api
+    def find(self, name: str, *, requested_by: SourceLoc | None = None) -> Path:
+        """The directory of package `name`; ReedtoolError naming what was searched."""
+        if name in self._found:
+            return self._found[name]
+        for root in self.roots:
+            hit = self._lookup(root, name)
+            if hit is not None:
+                hit = hit.absolute()   # xacro reads relative paths against the including file
+                self._found[name] = hit
+                return hit
+        searched = "; ".join(root.describe() for root in self.roots)
+        raise ReedtoolError(
+            f"package '{name}' not found; searched {searched}",
+            file=requested_by.file if requested_by else None,
+            line=requested_by.line if requested_by else None,
+            hint="add the directory that contains it with --package-path DIR")
+
+    def resolve_uri(self, uri: str, base_dir: Path, *,
+                    requested_by: SourceLoc | None = None) -> Path:
+        """Map a URDF/xacro file reference to a path. Existence is the caller's check.
+
+        Handles package://pkg/rel, file:///abs, absolute and relative (to `base_dir`) paths.
+        """
+        uri = uri.strip()
+        if uri.startswith("package://"):
+            rest = uri[len("package://"):]
+            name, _, rel = rest.partition("/")
+            if not name:
+                raise ReedtoolError(f"malformed package URI '{uri}'",
+                                    file=requested_by.file if requested_by else None,
+                                    line=requested_by.line if requested_by else None,
+                                    hint="write package://PACKAGE/relative/path")
+            return self.find(name, requested_by=requested_by) / unquote(rel)
+        if uri.startswith("file://"):
+            return Path(unquote(urlparse(uri).path))
+        if "://" in uri:
+            scheme = uri.split("://", 1)[0]
+            raise ReedtoolError(f"unsupported URI scheme '{scheme}://' in '{uri}'",
+                                file=requested_by.file if requested_by else None,
+                                line=requested_by.line if requested_by else None,
+                                hint="use package://, file:// or a file path")
+        path = Path(uri)
+        return path if path.is_absolute() else Path(base_dir) / path

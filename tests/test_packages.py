@@ -1,0 +1,116 @@
+"""Package search order and URI resolution (reedtool.packages)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from reedtool.errors import ReedtoolError
+from reedtool.model import SourceLoc
+from reedtool.packages import BUNDLED_PACKAGES_DIR, PackageResolver
+
+
+def make_package(directory: Path, name: str) -> Path:
+    directory.mkdir(parents=True, exist_ok=True)
+    (directory / "package.xml").write_text(
+        f'<?xml version="1.0"?>\n<package format="2"><name>{name}</name></package>\n')
+    return directory
+
+
+@pytest.fixture(autouse=True)
+def clean_env(monkeypatch):
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    monkeypatch.delenv("AMENT_PREFIX_PATH", raising=False)
+
+
+def test_name_comes_from_package_xml_not_directory(tmp_path):
+    pkg = make_package(tmp_path / "ws" / "src" / "repo" / "some_dir", "real_name")
+    resolver = PackageResolver([tmp_path / "ws"])
+    assert resolver.find("real_name") == pkg.absolute()
+    with pytest.raises(ReedtoolError):
+        resolver.find("some_dir")
+
+
+def test_search_order(tmp_path, monkeypatch):
+    cli = make_package(tmp_path / "cli" / "p", "p")
+    ros = make_package(tmp_path / "ros" / "p", "p")
+    ament = make_package(tmp_path / "prefix" / "share" / "p", "p")
+    make_package(tmp_path / "ros" / "only_ros", "only_ros")
+    make_package(tmp_path / "prefix" / "share" / "only_ament", "only_ament")
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path / "ros"))
+    monkeypatch.setenv("AMENT_PREFIX_PATH", str(tmp_path / "prefix"))
+    assert PackageResolver([tmp_path / "cli"]).find("p") == cli.absolute()
+    assert PackageResolver().find("p") == ros.absolute()
+    monkeypatch.delenv("ROS_PACKAGE_PATH")
+    assert PackageResolver().find("p") == ament.absolute()
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path / "ros"))
+    assert PackageResolver().find("only_ament").name == "only_ament"
+    assert PackageResolver().find("only_ros").name == "only_ros"
+
+
+def test_model_package_then_bundled(tmp_path):
+    own = make_package(tmp_path / "my_pkg", "my_pkg")
+    model = own / "urdf" / "robot.xacro"
+    model.parent.mkdir()
+    model.write_text("<robot/>")
+    resolver = PackageResolver(model_path=model)
+    assert resolver.find("my_pkg") == own.absolute()
+    assert resolver.find("rotors_description") == BUNDLED_PACKAGES_DIR / "rotors_description"
+    # a real rotors_description earlier on the path wins over the bundled one
+    real = make_package(tmp_path / "ws" / "rotors_description", "rotors_description")
+    assert PackageResolver([tmp_path / "ws"], model).find("rotors_description") == real.absolute()
+
+
+def test_hidden_and_ignored_directories_are_skipped(tmp_path):
+    make_package(tmp_path / ".git" / "p", "p")
+    make_package(tmp_path / "build" / "p", "p")
+    (tmp_path / "build" / "CATKIN_IGNORE").write_text("")
+    with pytest.raises(ReedtoolError):
+        PackageResolver([tmp_path]).find("p")
+
+
+def test_packages_do_not_nest(tmp_path):
+    make_package(tmp_path / "outer", "outer")
+    make_package(tmp_path / "outer" / "test" / "inner", "inner")
+    with pytest.raises(ReedtoolError):
+        PackageResolver([tmp_path]).find("inner")
+
+
+def test_missing_package_error_names_package_requester_and_places(tmp_path):
+    resolver = PackageResolver([tmp_path / "extra"])
+    with pytest.raises(ReedtoolError) as info:
+        resolver.find("nope", requested_by=SourceLoc("robot.xacro", 12))
+    err = info.value
+    assert (err.file, err.line) == ("robot.xacro", 12)
+    text = err.one_line()
+    assert "'nope'" in text
+    assert str(tmp_path / "extra") in text and str(BUNDLED_PACKAGES_DIR) in text
+    assert "--package-path" in text
+
+
+def test_resolve_uri_forms(tmp_path):
+    pkg = make_package(tmp_path / "meshes_pkg", "meshes_pkg")
+    resolver = PackageResolver([tmp_path])
+    base = tmp_path / "urdf"
+    assert resolver.resolve_uri("package://meshes_pkg/meshes/a b.stl", base) == \
+        pkg.absolute() / "meshes" / "a b.stl"
+    assert resolver.resolve_uri("file:///opt/m/x.dae", base) == Path("/opt/m/x.dae")
+    assert resolver.resolve_uri("/abs/x.stl", base) == Path("/abs/x.stl")
+    assert resolver.resolve_uri("../meshes/x.stl", base) == base / "../meshes/x.stl"
+    # existence is the caller's business
+    assert not resolver.resolve_uri("package://meshes_pkg/missing.stl", base).exists()
+    with pytest.raises(ReedtoolError, match="'other'"):
+        resolver.resolve_uri("package://other/x.stl", base)
+    with pytest.raises(ReedtoolError, match="model://"):
+        resolver.resolve_uri("model://x/mesh.dae", base)
+
+
+def test_bundled_package_ships_as_package_data():
+    """The bundled files live inside the reedtool package, so a wheel carries them."""
+    import reedtool
+
+    root = Path(reedtool.__file__).parent / "ros_packages" / "rotors_description"
+    assert root == BUNDLED_PACKAGES_DIR / "rotors_description"
+    for rel in ("package.xml", "urdf/component_snippets.xacro", "urdf/multirotor_base.xacro"):
+        assert (root / rel).is_file()
