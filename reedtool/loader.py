@@ -9,6 +9,7 @@ from .errors import ReedtoolError
 from .model import ParseIssue, Robot, SourceLoc
 
 URDF_SUFFIXES = {".urdf"}
+SDF_SUFFIXES = {".sdf", ".world"}
 
 
 def load_robot(path: Path | str, mappings: Mapping[str, str] | None = None,
@@ -25,7 +26,14 @@ def load_robot(path: Path | str, mappings: Mapping[str, str] | None = None,
     if not path.exists():
         raise ReedtoolError("file not found", file=path, hint="check the model path")
     if path.is_dir():
-        raise ReedtoolError("is a directory, expected a .urdf or .xacro file", file=path)
+        if not (path / "model.sdf").is_file():
+            raise ReedtoolError("is a directory, expected a .urdf, .xacro or .sdf file "
+                                "(or a model directory holding model.sdf)", file=path)
+        path = path / "model.sdf"
+    if path.suffix.lower() in SDF_SUFFIXES:
+        from .sdf_io import load_sdf_file
+
+        return load_sdf_file(path, resolver=PackageResolver(package_paths, model_path=path))
     if path.suffix.lower() in URDF_SUFFIXES:
         return load_urdf_file(path, resolver=PackageResolver(package_paths, model_path=path))
 
@@ -35,7 +43,8 @@ def load_robot(path: Path | str, mappings: Mapping[str, str] | None = None,
     robot = parse_urdf(expansion.urdf_xml, path, resolver=expansion.resolver,
                        element_locs=expansion.element_locs)
     for tag in expansion.legacy:
+        what = "macro call" if tag.kind == "macro-call" else "legacy xacro tag"
         robot.parse_issues.append(ParseIssue(
-            kind="legacy-xacro", message=str(tag),
-            loc=SourceLoc(str(tag.file), tag.line), subject=getattr(tag, "tag", None)))
+            kind="legacy-xacro", message=f"{what} <{tag.tag}> (write <{tag.modern}>)",
+            loc=SourceLoc(str(tag.file), tag.line), subject=tag.tag))
     return robot

@@ -210,7 +210,7 @@ class _RobotReader:
             return Mesh(uri="", path=None, scale=scale, resolve_error="no filename")
         try:
             # Relative mesh paths are relative to the file the user passed, as in xacro.
-            path = self.resolver.resolve_uri(uri, self.file.parent)
+            path = self.resolver.resolve_uri(uri, self.file.parent, requested_by=self.locate(el))
         except ReedtoolError as exc:
             return Mesh(uri=uri, path=None, scale=scale, resolve_error=exc.message)
         return Mesh(uri=uri, path=Path(path), scale=scale)
