@@ -1,0 +1,132 @@
+"""`reedtool new-package`: scaffold a ROS package that expands, validates and hovers first try."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path, PurePosixPath
+
+import click
+
+from ..airframes import FRAMES
+from ..errors import ReedtoolError
+
+
+@dataclass
+class NewPackageResult:
+    target: Path
+    files: list[PurePosixPath]
+    backup: Path | None
+    context: dict
+
+
+def template_sets(kind: str, ros: int) -> list[str]:
+    """Later sets override files of earlier ones with the same output path."""
+    return ["common/any", f"common/{kind}", f"ros{ros}/any", f"ros{ros}/{kind}"]
+
+
+def _import_body_mesh(spec, units: str, from_frame: str):
+    """Body mesh in metres and FLU, moved so its COM is the body origin, and its inertia."""
+    import numpy as np
+
+    from ..inertia import MassProperties
+    from ..mesh import import_mesh, stl_bytes
+
+    imported = import_mesh(spec.mesh, units=units, from_frame=from_frame,
+                           mass_kg=spec["mass"], recenter="com")
+    props = MassProperties(imported.mass.mass_kg, np.zeros(3), imported.mass.inertia_kg_m2)
+    # The collision box follows the mesh unless the user sized it.
+    size_m = imported.size_m
+    if spec.origin.get("body_width") == "default":
+        wide = max(size_m[0], size_m[1]) if spec.kind == "multirotor" else size_m[1]
+        spec.values["body_width"], spec.origin["body_width"] = float(wide), "the mesh"
+    if spec.origin.get("body_height") == "default":
+        spec.values["body_height"], spec.origin["body_height"] = float(size_m[2]), "the mesh"
+    if spec.kind == "ground" and spec.origin.get("body_length") == "default":
+        spec.values["body_length"], spec.origin["body_length"] = float(size_m[0]), "the mesh"
+    return props, stl_bytes(imported.triangles_m, header=f"reedtool body of {spec.name}"), imported
+
+
+def new_package(spec, output_dir: Path, *, force: bool = False, mesh_units: str = "auto",
+                mesh_frame: str = "flu") -> NewPackageResult:
+    """Render the package for `spec` into output_dir/spec.name, all or nothing."""
+    from ..scaffold import RenderedFile, check_target, render_tree, write_tree
+
+    target = Path(output_dir) / spec.name
+    check_target(target.absolute(), force)   # fail before any expensive work
+    body_props = mesh_data = None
+    if spec.mesh is not None:
+        body_props, mesh_data, _ = _import_body_mesh(spec, mesh_units, mesh_frame)
+    from ..package_spec import template_context
+
+    context = template_context(spec, body_props)
+    files = render_tree(template_sets(spec.kind, spec.ros), context)
+    if mesh_data is not None:
+        files.append(RenderedFile(PurePosixPath("meshes", context["mesh_file"]), mesh_data, 0o644))
+    backup = write_tree(target, files, force=force)
+    return NewPackageResult(target, sorted(f.path for f in files), backup, context)
+
+
+def _summary(result: NewPackageResult, spec) -> list[str]:
+    ctx = result.context
+    lines = [f"created {result.target} ({len(result.files)} files, ROS {spec.ros}, "
+             f"{spec.frame.title})"]
+    if result.backup is not None:
+        lines.append(f"previous contents kept in {result.backup}")
+    if spec.kind == "multirotor":
+        lines.append(f"mass {ctx['p']['mass']} kg body, {ctx['total_mass_kg']} kg total; "
+                     f"max thrust / weight {ctx['thrust_to_weight']}")
+        for r in ctx["rotors"]:
+            lines.append(f"  motor {r['motor_number']}  {r['suffix']:<20} "
+                         f"({', '.join(r['position_m'])}) m  {r['direction']}")
+        model = "urdf/mav_generic_odometry_sensor.gazebo"
+    else:
+        lines.append(f"mass {ctx['p']['mass']} kg body, {ctx['total_mass_kg']} kg total; "
+                     f"{len(ctx['wheels'])} wheels, {ctx['drive'].replace('_', '-')} on cmd_vel")
+        model = f"urdf/{spec.name}.urdf.xacro"
+    lines.append("next:")
+    lines.append(f"  reedtool validate {result.target / model}")
+    if spec.kind == "multirotor":
+        lines.append(f"  reedtool hover-test {result.target / model}")
+    return lines
+
+
+@click.command(name="new-package")
+@click.argument("name")
+@click.option("--frame", type=click.Choice(list(FRAMES)), default=None,
+              help="Vehicle layout (default: the spec's `frame`, else quad-x).")
+@click.option("--ros", type=click.Choice(["1", "2"]), default=None,
+              help="ROS 1 (catkin) or ROS 2 (ament_cmake) (default: the spec's, else 1).")
+@click.option("--spec", "spec_file", type=click.Path(path_type=Path, dir_okay=False),
+              help="YAML file of parameters (see docs/new-package.md); flags override it.")
+@click.option("--mass", metavar="KG", help="Body mass, e.g. 1.5 or '1500 g'.")
+@click.option("--arm-length", metavar="M",
+              help="Centre to rotor axis (quad-x: x and y offset of each rotor), e.g. 0.18738.")
+@click.option("--mesh", type=click.Path(path_type=Path, dir_okay=False), metavar="BODY.stl",
+              help="Body mesh; its shape gives the body inertia.")
+@click.option("--mesh-units", default="auto", show_default=True,
+              help="Units of the mesh: auto, m, cm, mm, in.")
+@click.option("--mesh-frame", default="flu", show_default=True,
+              help="Axes the mesh was exported in (flu, ned, frd, y-up, ...).")
+@click.option("-o", "--output-dir", type=click.Path(path_type=Path, file_okay=False),
+              default=Path("."), show_default=True,
+              help="Directory to create the package directory NAME in.")
+@click.option("--force", is_flag=True,
+              help="Regenerate into an existing package; the old tree is kept as NAME.bak.")
+def command(name, frame, ros, spec_file, mass, arm_length, mesh, mesh_units, mesh_frame,
+            output_dir, force) -> int:
+    """Create the ROS package NAME for a multirotor or ground robot.
+
+    Masses and inertias are computed from the geometry; a multirotor uses the RotorS macro
+    interface and passes `reedtool validate` and `hover-test` as generated.
+    """
+    from ..package_spec import build_spec
+
+    if spec_file is not None and not spec_file.is_file():
+        raise ReedtoolError("spec file not found", file=spec_file)
+    spec = build_spec(name, frame=frame, ros=int(ros) if ros else None, spec_file=spec_file,
+                      flags={"mass": mass, "arm_length": arm_length}, mesh=mesh)
+    result = new_package(spec, output_dir, force=force, mesh_units=mesh_units,
+                         mesh_frame=mesh_frame)
+    for line in _summary(result, spec):
+        click.echo(line)
+    return 0

@@ -1,0 +1,171 @@
+"""Render a template tree into a new directory: all of it, or none of it.
+
+Conventions, after cookiecutter:
+- a template set is a directory under the templates root; every path segment is itself a
+  jinja2 template (`urdf/{{ name }}.xacro.j2` -> `urdf/reed_gazebo.xacro`);
+- files ending in `.j2` are rendered (StrictUndefined: an undefined variable is an error,
+  never an empty string) and lose the suffix; every other file is copied byte for byte,
+  so binary files (meshes, images) are never run through the template engine;
+- directories and files whose name starts with `_` are partials for `{% include %}`, not
+  output.
+
+Writing is all-or-nothing: the whole tree is rendered in memory, written into a hidden
+temporary directory beside the target, then renamed into place. Without `force`, a
+target that exists and is not empty is refused before anything is written. With `force`,
+the new tree is the old one with the generated files laid over it (files reedtool does
+not generate are kept), and the swap is two renames: the old tree is kept whole as
+`NAME.bak` (or `NAME.bak.1`, ...) beside it, so nothing is ever deleted.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path, PurePosixPath
+from typing import Mapping
+
+from .errors import ReedtoolError
+
+TEMPLATE_SUFFIX = ".j2"
+
+
+def templates_root() -> Path:
+    """The templates directory: bundled in a wheel, or the repository's in a checkout.
+
+    pyproject force-includes `templates/` as `reedtool/_data/templates` in the wheel; an
+    editable or source checkout has it at the repository root next to `reedtool/`.
+    """
+    package_dir = Path(__file__).resolve().parent
+    for candidate in (package_dir / "_data" / "templates", package_dir.parent / "templates"):
+        if (candidate / "ros1").is_dir():
+            return candidate
+    raise ReedtoolError("reedtool's package templates are missing from this installation",
+                        file=package_dir, hint="reinstall reedtool")
+
+
+@dataclass(frozen=True)
+class RenderedFile:
+    path: PurePosixPath        # relative to the package root
+    data: bytes
+    mode: int                  # permission bits, from the template file
+
+
+def _environment(root: Path):
+    import jinja2
+
+    return jinja2.Environment(
+        loader=jinja2.FileSystemLoader(str(root)),
+        undefined=jinja2.StrictUndefined,
+        keep_trailing_newline=True,
+        trim_blocks=True,
+        lstrip_blocks=True,
+        autoescape=False,
+    )
+
+
+def render_tree(template_dirs: list[str], context: Mapping[str, object],
+                root: Path | None = None) -> list[RenderedFile]:
+    """Render every file of the given template sets (later sets override earlier ones)."""
+    import jinja2
+
+    root = root or templates_root()
+    env = _environment(root)
+    out: dict[PurePosixPath, RenderedFile] = {}
+    for template_dir in template_dirs:
+        base = root / template_dir
+        if not base.is_dir():
+            raise ValueError(f"no template set '{template_dir}' under {root}")
+        for src in sorted(base.rglob("*")):
+            rel = src.relative_to(base)
+            if src.is_dir() or any(part.startswith("_") for part in rel.parts) \
+                    or src.name == ".keep":
+                continue
+            try:
+                rel_out = PurePosixPath(*(env.from_string(part).render(context)
+                                          for part in rel.parts))
+                if src.name.endswith(TEMPLATE_SUFFIX):
+                    rel_out = rel_out.with_name(rel_out.name[:-len(TEMPLATE_SUFFIX)])
+                    template = env.get_template(PurePosixPath(template_dir, *rel.parts).as_posix())
+                    data = template.render(context).encode("utf-8")
+                else:
+                    data = src.read_bytes()
+            except jinja2.TemplateError as exc:
+                # A template bug, not a user mistake: say which template, loudly.
+                raise RuntimeError(f"template {template_dir}/{rel}: {exc}") from exc
+            out[rel_out] = RenderedFile(rel_out, data, src.stat().st_mode & 0o777)
+    return [out[key] for key in sorted(out)]
+
+
+# ------------------------------------------------------------------ writing
+
+def check_target(target: Path, force: bool) -> None:
+    """Refuse a target we must not touch, before any work is done."""
+    if target.is_symlink() or (target.exists() and not target.is_dir()):
+        raise ReedtoolError("target exists and is not a directory", file=target,
+                            hint="choose another name or -o directory")
+    if target.is_dir() and any(target.iterdir()) and not force:
+        raise ReedtoolError("target directory exists and is not empty", file=target,
+                            hint="choose another name or -o directory, or pass --force to "
+                                 "regenerate it; the old tree is kept as NAME.bak")
+
+
+def _free_backup_name(target: Path) -> Path:
+    candidate = target.with_name(target.name + ".bak")
+    n = 1
+    while candidate.exists() or candidate.is_symlink():
+        candidate = target.with_name(f"{target.name}.bak.{n}")
+        n += 1
+    return candidate
+
+
+def write_tree(target: Path, files: list[RenderedFile], *, force: bool = False) -> Path | None:
+    """Write `files` as the directory `target`, atomically. Returns the backup dir, if any."""
+    target = Path(target).absolute()
+    check_target(target, force)
+    parent = target.parent
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+        staging = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".reedtool-tmp",
+                                        dir=parent))
+    except OSError as exc:
+        raise ReedtoolError(f"cannot create directory: {exc.strerror}", file=parent) from exc
+    replacing = target.is_dir() and any(target.iterdir())
+    try:
+        if replacing:
+            # Start from a copy of the old tree so files reedtool does not generate survive.
+            shutil.rmtree(staging)
+            shutil.copytree(target, staging, symlinks=True)
+        for item in files:
+            dest = staging.joinpath(*item.path.parts)
+            dest.parent.mkdir(parents=True, exist_ok=True)
+            if dest.is_symlink() or dest.is_file():
+                dest.unlink()
+            dest.write_bytes(item.data)
+            os.chmod(dest, item.mode)
+        os.chmod(staging, 0o777 & ~_umask())
+        backup = None
+        if replacing:
+            backup = _free_backup_name(target)
+            os.rename(target, backup)
+            try:
+                os.rename(staging, target)
+            except OSError:
+                os.rename(backup, target)  # put the old tree back
+                raise
+        else:
+            os.rename(staging, target)     # POSIX rename also replaces an empty directory
+        return backup
+    except OSError as exc:
+        raise ReedtoolError(f"cannot write package: {exc.strerror or exc}", file=target,
+                            hint="nothing was changed") from exc
+    finally:
+        if staging.exists():
+            shutil.rmtree(staging, ignore_errors=True)
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
