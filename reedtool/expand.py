@@ -22,6 +22,7 @@ import contextlib
 import difflib
 import io
 import math
+import functools
 import os
 import re
 import sys
@@ -63,12 +64,17 @@ class Expansion:
 
 def display_path(path: str | Path) -> str:
     """A path as shown to the user: relative to the working directory when inside it."""
-    path = Path(path)
+    return _display_path(str(path), os.getcwd())
+
+
+@functools.lru_cache(maxsize=1024)
+def _display_path(path: str, cwd: str) -> str:
+    # Called for every element of an expansion with a handful of distinct files.
     try:
-        rel = os.path.relpath(path)
+        rel = os.path.relpath(path, cwd)
     except ValueError:
-        return str(path)
-    return rel if not rel.startswith("..") else str(path)
+        return path
+    return rel if not rel.startswith("..") else path
 
 
 def parse_mappings(args: Sequence[str]) -> dict[str, str]:

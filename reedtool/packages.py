@@ -17,6 +17,7 @@ skips hidden directories and honours CATKIN_IGNORE/COLCON_IGNORE/AMENT_IGNORE ma
 
 from __future__ import annotations
 
+import functools
 import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
@@ -66,8 +67,14 @@ def enclosing_package(path: Path) -> Path | None:
 
 def is_bundled(path: str | Path) -> bool:
     """True for files of reedtool's own bundled packages (never the user's to edit)."""
+    return _is_bundled(str(path), os.getcwd())
+
+
+@functools.lru_cache(maxsize=1024)
+def _is_bundled(path: str, cwd: str) -> bool:
+    # Asked for every expanded element about a handful of files; resolve() is a syscall chain.
     try:
-        Path(path).resolve().relative_to(BUNDLED_PACKAGES_DIR)
+        (Path(cwd) / path).resolve().relative_to(BUNDLED_PACKAGES_DIR)
     except ValueError:
         return False
     return True
