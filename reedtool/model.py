@@ -247,7 +247,9 @@ class Robot:
     joints: list[Joint] = field(default_factory=list)
     gazebo: list[GazeboBlock] = field(default_factory=list)
     parse_issues: list[ParseIssue] = field(default_factory=list)
-    source_file: Path | None = None      # the file the user passed (URDF or xacro)
+    source_file: Path | None = None      # the file the user passed (URDF, xacro or SDF)
+    source_format: str = "urdf"          # "urdf" (also from xacro) or "sdf": Gazebo converts
+                                         # only the former, with fixed-joint lumping
     urdf_xml: str | None = None          # the URDF text the model was read from
 
     # Lookups keep the first element of a name; duplicates stay visible in the lists.

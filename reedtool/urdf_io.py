@@ -17,6 +17,7 @@ from lxml import etree
 
 from .errors import ReedtoolError
 from .frames import make_T, rpy_to_matrix
+from .xml_lines import start_line
 from .model import (Box, Collision, Cylinder, GazeboBlock, Inertial, Joint, JointLimit, Link,
                     Mesh, ParseIssue, Plugin, Robot, SourceLoc, Sphere, Visual, XmlNode)
 
@@ -45,7 +46,8 @@ def parse_urdf(xml_text: str, file: Path | str, *, resolver=None,
     if resolver is None:
         from .packages import PackageResolver
         resolver = PackageResolver(model_path=file)
-    return _RobotReader(file, _make_locator(root, file, element_locs), resolver).read(root, xml_text)
+    locate = _make_locator(root, file, element_locs, xml_text.splitlines())
+    return _RobotReader(file, locate, resolver).read(root, xml_text)
 
 
 def load_urdf_file(path: Path | str, *, resolver=None) -> Robot:
@@ -59,10 +61,13 @@ def load_urdf_file(path: Path | str, *, resolver=None) -> Robot:
     return parse_urdf(text, path, resolver=resolver)
 
 
-def _make_locator(root: etree._Element, file: Path,
-                  element_locs: Sequence[SourceLoc] | None) -> Locator:
+def _make_locator(root: etree._Element, file: Path, element_locs: Sequence[SourceLoc] | None,
+                  lines: Sequence[str]) -> Locator:
     if element_locs is None:
-        return lambda el: SourceLoc(str(file), el.sourceline, urdf_line=el.sourceline)
+        def locate(el: etree._Element) -> SourceLoc:
+            line = start_line(el.tag, el.sourceline, lines)
+            return SourceLoc(str(file), line, urdf_line=line)
+        return locate
     elements = [el for el in root.iter() if isinstance(el.tag, str)]
     if len(elements) != len(element_locs):
         # A mapping that does not line up would point users at wrong lines; fall back to

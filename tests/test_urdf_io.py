@@ -66,3 +66,11 @@ def test_not_urdf_is_one_line_error(xml, fragment, tmp_path):
     assert fragment in info.value.one_line()
     assert "\n" not in info.value.one_line()
     assert str(tmp_path / "m.urdf") in info.value.one_line()
+
+
+def test_multiline_start_tag_points_at_its_first_line(tmp_path):
+    # lxml reports the line of the closing '>'; users look for the line with '<link'.
+    path = tmp_path / "m.urdf"
+    path.write_text('<robot name="r">\n  <link\n     name="a">\n  </link>\n</robot>\n')
+    robot = load_urdf_file(path)
+    assert robot.link_map["a"].loc.line == 2

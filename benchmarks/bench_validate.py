@@ -1,0 +1,80 @@
+"""Wall time of `reedtool validate` on the seed quadrotor, against check_urdf and --help.
+
+    /work/venv/bin/python benchmarks/bench_validate.py [--runs N]
+
+Each figure is the median of N end-to-end process runs (interpreter start included), the
+way a user or CI meets them. Targets (issue 3): validate within 3x of check_urdf on the
+same expanded URDF; `reedtool --help` under 0.15 s.
+"""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+SEED = ROOT / "tests" / "fixtures" / "seed000" / "reed_gazebo" / "urdf" / "mav_generic_odometry_sensor.gazebo"
+SEED_ARGS = ["mav_name:=reed_quad_x", "namespace:=reed_quad_x", "enable_mavlink_interface:=true",
+             "enable_ground_truth:=true", "enable_logging:=false", "log_file:=reed_quad_x",
+             "wait_to_record_bag:=false"]
+BIN = Path(sys.executable).parent
+
+
+def median_s(argv: list[str], runs: int) -> float:
+    times = []
+    for _ in range(runs):
+        start = time.perf_counter()
+        subprocess.run(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=False)
+        times.append(time.perf_counter() - start)
+    return statistics.median(times)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=15)
+    runs = parser.parse_args().runs
+    reedtool = str(BIN / "reedtool")
+    check_urdf = shutil.which("check_urdf", path=str(BIN)) or shutil.which("check_urdf")
+
+    sys.path.insert(0, str(ROOT))
+    from reedtool.loader import load_robot
+
+    robot = load_robot(SEED, dict(a.split(":=", 1) for a in SEED_ARGS))
+    with tempfile.TemporaryDirectory() as tmp:
+        urdf = Path(tmp) / "reed_quad_x.urdf"
+        urdf.write_text(robot.urdf_xml)
+        rows = {
+            "reedtool --help": median_s([reedtool, "--help"], runs),
+            "reedtool validate seed quad (xacro, end to end)":
+                median_s([reedtool, "validate", str(SEED), *SEED_ARGS], runs),
+            "reedtool validate expanded URDF": median_s([reedtool, "validate", str(urdf)], runs),
+        }
+        if check_urdf:
+            rows["check_urdf expanded URDF"] = median_s([check_urdf, str(urdf)], runs)
+
+    width = max(map(len, rows))
+    print(f"median of {runs} runs")
+    for name, seconds in rows.items():
+        print(f"  {name:<{width}}  {seconds * 1000:7.1f} ms")
+    help_s = rows["reedtool --help"]
+    print(f"\n  --help: {help_s:.3f} s (target < 0.15 s: {'ok' if help_s < 0.15 else 'MISSED'})")
+    if check_urdf:
+        base = rows["check_urdf expanded URDF"]
+        for name in ("reedtool validate seed quad (xacro, end to end)",
+                     "reedtool validate expanded URDF"):
+            ratio = rows[name] / base
+            print(f"  {name} / check_urdf: {ratio:.2f}x "
+                  f"(target <= 3x: {'ok' if ratio <= 3 else 'MISSED'})")
+    else:
+        print("  check_urdf not found: no comparison")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

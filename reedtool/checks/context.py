@@ -1,0 +1,192 @@
+"""Everything rules share, computed once per run and only when a rule asks for it.
+
+Rules never recompute physics or re-import heavy modules: kinematics, rotor discovery,
+whole-robot mass properties, allocation and trim are cached properties here, and the
+modules that compute them (reedtool.kinematics, .rotors, .inertia, .allocation, .trim)
+are imported inside the property so a run that selects only structure rules stays light.
+
+Physics needs a sound tree. `tree_ok` is decided here from the model alone; rules that
+need poses or rotors return nothing when it is False (the structure rules say why).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import TYPE_CHECKING, Any, Sequence
+
+import numpy as np
+
+from ..model import Joint, Link, Robot
+
+if TYPE_CHECKING:
+    from ..rotors import Rotor
+
+
+@dataclass
+class Tree:
+    """The kinematic tree as the joints declare it, tolerant of every structural mistake."""
+
+    parent_joint: dict[str, Joint] = field(default_factory=dict)   # child link -> joint
+    extra_parents: dict[str, list[Joint]] = field(default_factory=dict)  # 2nd, 3rd... parents
+    roots: list[str] = field(default_factory=list)
+    cycles: list[list[str]] = field(default_factory=list)        # link names around each cycle
+    dangling: list[Joint] = field(default_factory=list)          # parent or child not a link
+
+
+def build_tree(robot: Robot) -> Tree:
+    tree = Tree()
+    links = robot.link_map
+    for joint in robot.joints:
+        if joint.parent not in links or joint.child not in links:
+            tree.dangling.append(joint)
+            continue
+        if joint.child in tree.parent_joint:
+            tree.extra_parents.setdefault(joint.child, []).append(joint)
+        else:
+            tree.parent_joint[joint.child] = joint
+    tree.roots = [name for name in links if name not in tree.parent_joint]
+
+    # Walk up from every link; meeting a link already on the current path is a cycle.
+    state: dict[str, int] = {}  # 1: on the current path, 2: done
+    for start in links:
+        path: list[str] = []
+        name: str | None = start
+        while name is not None and state.get(name) is None:
+            state[name] = 1
+            path.append(name)
+            joint = tree.parent_joint.get(name)
+            name = joint.parent if joint else None
+        if name is not None and state.get(name) == 1:
+            tree.cycles.append(path[path.index(name):])
+        for visited in path:
+            state[visited] = 2
+    return tree
+
+
+class CheckContext:
+    def __init__(self, robot: Robot, controllers: Sequence[Any] = ()):
+        self.robot = robot
+        # Controller tables read from files (validate --controller), reedtool.controller_tables.
+        self.controllers = list(controllers)
+        self._geometry_props: dict[str, Any] = {}
+        self._mesh_bounds: dict[str, Any] = {}
+
+    # ------------------------------------------------------------ structure
+
+    @cached_property
+    def tree(self) -> Tree:
+        return build_tree(self.robot)
+
+    @cached_property
+    def tree_ok(self) -> bool:
+        """One root, no cycle, no dangling joint, unique names: poses are well defined."""
+        tree = self.tree
+        unique = (len(self.robot.link_map) == len(self.robot.links)
+                  and len(self.robot.joint_map) == len(self.robot.joints))
+        return (len(tree.roots) == 1 and not tree.cycles and not tree.dangling
+                and not tree.extra_parents and unique)
+
+    def parent_joint(self, link_name: str) -> Joint | None:
+        return self.tree.parent_joint.get(link_name)
+
+    def is_moving(self, link: Link) -> bool:
+        """A link Gazebo simulates as its own body: the child of a non-fixed joint."""
+        joint = self.parent_joint(link.name)
+        return joint is not None and joint.moves
+
+    # ------------------------------------------------------------ physics
+
+    @cached_property
+    def link_poses(self) -> dict[str, np.ndarray]:
+        from ..kinematics import link_poses
+
+        return link_poses(self.robot) if self.tree_ok else {}
+
+    @cached_property
+    def rotors(self) -> list["Rotor"]:
+        if not self.tree_ok:
+            return []
+        from ..rotors import discover_rotors
+
+        return discover_rotors(self.robot)
+
+    @cached_property
+    def controller_tables(self) -> list:
+        """Every controller rotor table: velocity-control plugins in the model, then files."""
+        from ..controller_tables import velocity_control_tables
+
+        return velocity_control_tables(self.robot) + self.controllers
+
+    @cached_property
+    def rotor_count_declarations(self) -> list:
+        from ..rotors import declared_rotor_counts
+
+        return declared_rotor_counts(self.robot)
+
+    @cached_property
+    def whole_robot(self):
+        """Mass, COM (base frame) and inertia of the whole robot (reedtool.inertia)."""
+        from ..inertia import whole_robot
+
+        return whole_robot(self.robot)
+
+    @cached_property
+    def allocation(self) -> np.ndarray:
+        """(4, n) map from rotor thrusts [N] to [thrust, roll, pitch, yaw] about the COM."""
+        from ..allocation import allocation_matrix
+
+        return allocation_matrix(self.rotors, self.whole_robot.com_m)
+
+    @cached_property
+    def trim(self):
+        from ..trim import solve_trim
+
+        whole = self.whole_robot
+        return solve_trim(whole.mass_kg, whole.com_m, self.rotors)
+
+    def geometry_mass_properties(self, link: Link):
+        """Mass properties of the link's own geometry at its declared mass, in the link frame.
+
+        None when the link has no geometry, no positive mass, or the geometry cannot be
+        measured (an unresolved or empty mesh: the structure rules report those).
+        """
+        if link.name in self._geometry_props:
+            return self._geometry_props[link.name]
+        result = None
+        shape = link.geometry_for_mass()
+        mass = link.inertial.mass_kg if link.inertial else None
+        if shape is not None and mass is not None and np.isfinite(mass) and mass > 0:
+            geometry, T_link_geom = shape
+            if getattr(geometry, "path", True) is not None:  # meshes must be resolved
+                from ..errors import ReedtoolError
+                from ..inertia import geometry_mass_properties
+
+                try:
+                    result = geometry_mass_properties(geometry, T_link_geom, mass)
+                except ReedtoolError:
+                    result = None
+        self._geometry_props[link.name] = result
+        return result
+
+    def mesh_bounds(self, mesh) -> np.ndarray | None:
+        """(2, 3) min/max corners of a mesh file in its own frame, scale applied; None if unreadable."""
+        if mesh.path is None:
+            return None
+        key = str(mesh.path)
+        if key not in self._mesh_bounds:
+            from ..errors import ReedtoolError
+            from ..mesh import load_triangles
+
+            try:
+                vertices = load_triangles(key).reshape(-1, 3)
+                bounds = np.vstack([vertices.min(axis=0), vertices.max(axis=0)]) \
+                    if len(vertices) else None
+            except ReedtoolError:  # unreadable: S115 reports it
+                bounds = None
+            self._mesh_bounds[key] = bounds
+        bounds = self._mesh_bounds[key]
+        if bounds is None:
+            return None
+        scaled = bounds * np.asarray(mesh.scale, dtype=float)
+        return np.vstack([scaled.min(axis=0), scaled.max(axis=0)])

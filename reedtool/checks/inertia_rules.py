@@ -1,0 +1,299 @@
+"""Inertia rules (I2xx): each link's mass and inertia are physically possible and plausible.
+
+Physics comes from reedtool.inertia (geometry mass properties, principal moments); this
+module only compares declared values against it and words the findings.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Iterator
+
+import numpy as np
+
+from ..model import Box, Cylinder, Link, Mesh, Sphere
+from .context import CheckContext
+from .finding import Issue
+from .registry import rule
+
+# Principal moments may break A + B >= C by this fraction of the largest moment: hand-rounded
+# values of a thin plate (where A + B = C exactly) stay quiet, real mistakes do not.
+TRIANGLE_REL_TOL = 1e-3
+# Declared vs geometry-derived tensor trace: outside this factor the inertia is implausible.
+# A body's mass can sit at most ~3x further out than a solid of the same outline (all mass
+# in the corners), so 10x in inertia is beyond any real mass distribution.
+PLAUSIBLE_TRACE_RATIO = 10.0
+# How far outside its geometry's bounding box a COM may lie, as a fraction of the box size.
+COM_MARGIN_FRACTION = 0.1
+COM_MARGIN_MIN_M = 0.002
+# Mesh extents (after scale) outside this range are almost always a unit mistake.
+MESH_EXTENT_RANGE_M = (0.001, 20.0)
+
+
+def _fmt(value: float) -> str:
+    return f"{value:.6g}"
+
+
+def _inertia_xml(I: np.ndarray) -> str:
+    I = np.asarray(I, dtype=float)
+    # Products below 1e-4 of the largest entry come from rounded angles (1.57075 for pi/2).
+    tiny = 1e-4 * max(float(np.max(np.abs(I))), 1e-300)
+    v = lambda x: "0" if abs(x) < tiny else _fmt(x)  # noqa: E731
+    return (f'<inertia ixx="{v(I[0, 0])}" ixy="{v(I[0, 1])}" ixz="{v(I[0, 2])}" '
+            f'iyy="{v(I[1, 1])}" iyz="{v(I[1, 2])}" izz="{v(I[2, 2])}"/>')
+
+
+def describe_geometry(geometry, mass_kg: float) -> str:
+    m = f"{_fmt(mass_kg)} kg"
+    if isinstance(geometry, Box):
+        return f"a {m} box of {' x '.join(_fmt(s) for s in geometry.size_m)} m"
+    if isinstance(geometry, Cylinder):
+        return (f"a {m} cylinder of radius {_fmt(geometry.radius_m)} m and length "
+                f"{_fmt(geometry.length_m)} m")
+    if isinstance(geometry, Sphere):
+        return f"a {m} sphere of radius {_fmt(geometry.radius_m)} m"
+    if isinstance(geometry, Mesh):
+        return f"a {m} solid mesh '{geometry.uri}'"
+    return f"a {m} body"
+
+
+def _massive(link: Link) -> bool:
+    inertial = link.inertial
+    return inertial is not None and math.isfinite(inertial.mass_kg) and inertial.mass_kg > 0
+
+
+def _tensor_ok(I: np.ndarray) -> bool:
+    return bool(np.all(np.isfinite(I)))
+
+
+def _positive_definite(I: np.ndarray) -> bool:
+    moments = np.linalg.eigvalsh((I + I.T) / 2)
+    return bool(np.allclose(I, I.T, rtol=0, atol=1e-12 * max(np.max(np.abs(I)), 1e-300))
+                and moments[0] > 1e-12 * max(moments[2], 1e-300) and moments[0] > 0)
+
+
+def _geometry_hint(ctx: CheckContext, link: Link) -> tuple[str, np.ndarray] | None:
+    """(description, tensor in the inertial frame's axes) of the link's own geometry."""
+    props = ctx.geometry_mass_properties(link)
+    if props is None:
+        return None
+    R_link_com = link.inertial.T_link_com[:3, :3]
+    I_com_axes = R_link_com.T @ np.asarray(props.inertia_kg_m2, dtype=float) @ R_link_com
+    geometry, _T = link.geometry_for_mass()
+    return describe_geometry(geometry, link.inertial.mass_kg), I_com_axes
+
+
+def _with_geometry(ctx: CheckContext, link: Link, text: str) -> str:
+    found = _geometry_hint(ctx, link)
+    if found is None:
+        return text
+    described, I = found
+    return f"{text}; {described} gives {_inertia_xml(I)}"
+
+
+@rule("I201", "mass-not-positive", "error", "A link's mass is negative, or zero on a moving link.")
+def mass_not_positive(ctx: CheckContext) -> Iterator[Issue]:
+    """A negative mass is never valid. A zero mass is fine on a link merged into its parent
+    by a fixed joint (a frame marker), but a link that moves on its own joint needs mass:
+    physics engines divide by it.
+    """
+    for link in ctx.robot.links:
+        inertial = link.inertial
+        if inertial is None or not math.isfinite(inertial.mass_kg):
+            continue
+        if any(issue.loc == inertial.mass_loc for issue in ctx.robot.parse_issues):
+            continue  # unreadable <mass>: S101 reports it, the 0 here is a default
+        mass = inertial.mass_kg
+        if mass < 0 or (mass == 0 and ctx.is_moving(link)):
+            why = "negative" if mass < 0 else "zero on a link that moves on its own joint"
+            yield Issue(f"link '{link.name}' has mass {_fmt(mass)} kg ({why})",
+                        inertial.mass_loc or inertial.loc, link.name,
+                        hint="give the link its real (positive) mass in kg")
+
+
+@rule("I202", "inertia-not-positive-definite", "error",
+      "A link's inertia tensor is not symmetric positive definite.")
+def inertia_not_positive_definite(ctx: CheckContext) -> Iterator[Issue]:
+    """The inertia tensor of a body with mass has three positive principal moments. A zero
+    or negative moment (often a zero `ixx`/`iyy`/`izz`, or products of inertia larger than
+    the moments) makes the simulator reject the link or integrate nonsense.
+
+    Links without mass are skipped (I201 covers moving ones; fixed ones are merged).
+    """
+    for link in ctx.robot.links:
+        if not _massive(link):
+            continue
+        I = np.asarray(link.inertial.inertia_kg_m2, dtype=float)
+        if not _tensor_ok(I) or _positive_definite(I):
+            continue
+        moments = np.linalg.eigvalsh((I + I.T) / 2)
+        yield Issue(f"link '{link.name}': inertia is not positive definite (principal moments "
+                    f"{', '.join(_fmt(m) for m in moments)} kg·m²)",
+                    link.inertial.inertia_loc or link.inertial.loc, link.name,
+                    hint=_with_geometry(ctx, link, "every principal moment must be > 0"))
+
+
+@rule("I203", "inertia-triangle-inequality", "error",
+      "A link's principal moments break the triangle inequality.")
+def inertia_triangle_inequality(ctx: CheckContext) -> Iterator[Issue]:
+    """For any real mass distribution each principal moment is at most the sum of the
+    other two (A + B >= C; equality for a flat plate). Gazebo (gz-math) rejects a tensor
+    that breaks it, and ODE/DART produce unphysical motion with it. The tolerance is
+    0.1 % of the largest moment, for rounded hand-written values.
+
+    Hand-edited inertia, or one copied from another model and scaled along one axis only,
+    is the usual cause. Compute the tensor from the geometry (`reedtool inertia`).
+    """
+    for link in ctx.robot.links:
+        if not _massive(link):
+            continue
+        I = np.asarray(link.inertial.inertia_kg_m2, dtype=float)
+        if not _tensor_ok(I) or not _positive_definite(I):
+            continue  # I202
+        a, b, c = np.linalg.eigvalsh((I + I.T) / 2)
+        if a + b < c - TRIANGLE_REL_TOL * c:
+            yield Issue(f"link '{link.name}': principal moments break the triangle inequality: "
+                        f"{_fmt(a)} + {_fmt(b)} = {_fmt(a + b)} < {_fmt(c)} kg·m²",
+                        link.inertial.inertia_loc or link.inertial.loc, link.name,
+                        hint=_with_geometry(ctx, link, f"the largest moment can be at most "
+                                                       f"{_fmt(a + b)} kg·m²"))
+
+
+@rule("I204", "inertia-implausible-for-geometry", "warning",
+      "A link's inertia is far from what its own geometry and mass give.")
+def inertia_implausible_for_geometry(ctx: CheckContext) -> Iterator[Issue]:
+    """Compares the declared tensor with that of the link's geometry (first collision,
+    else first visual) filled uniformly with the declared mass, through the trace (twice
+    the mass times the squared radius of gyration). More than 10x off either way is no
+    real mass distribution: all mass in the corners of a box gives only 3x the solid
+    box's inertia. The typical cause is a placeholder `1.0` copied into every link; a
+    wheel with 1 kg·m² spins up like a flywheel a thousand times its size.
+
+    The hint gives the geometry-derived tensor in the frame of the `<inertial>`.
+    """
+    for link in ctx.robot.links:
+        if not _massive(link):
+            continue
+        I = np.asarray(link.inertial.inertia_kg_m2, dtype=float)
+        if not _tensor_ok(I) or not _positive_definite(I):
+            continue
+        found = _geometry_hint(ctx, link)
+        if found is None or _mesh_extent_implausible(ctx, link):
+            continue  # I206 explains a mis-scaled mesh better
+        described, I_geom = found
+        declared, expected = float(np.trace(I)), float(np.trace(I_geom))
+        if expected <= 0:
+            continue
+        ratio = declared / expected
+        if ratio > PLAUSIBLE_TRACE_RATIO or ratio < 1 / PLAUSIBLE_TRACE_RATIO:
+            r_decl = math.sqrt(declared / (2 * link.inertial.mass_kg))
+            r_geom = math.sqrt(expected / (2 * link.inertial.mass_kg))
+            way = "larger" if ratio > 1 else "smaller"
+            factor = ratio if ratio > 1 else 1 / ratio
+            yield Issue(f"link '{link.name}': inertia is {factor:.3g}x {way} than "
+                        f"{described} (radius of gyration {_fmt(r_decl)} m vs {_fmt(r_geom)} m)",
+                        link.inertial.inertia_loc or link.inertial.loc, link.name,
+                        hint=f"{described} gives {_inertia_xml(I_geom)}")
+
+
+def _local_bounds(ctx: CheckContext, geometry) -> np.ndarray | None:
+    """(2, 3) bounding box of a geometry in its own frame."""
+    if isinstance(geometry, Box):
+        half = np.asarray(geometry.size_m, dtype=float) / 2
+        return np.vstack([-half, half])
+    if isinstance(geometry, Cylinder):
+        half = np.array([geometry.radius_m, geometry.radius_m, geometry.length_m / 2])
+        return np.vstack([-half, half])
+    if isinstance(geometry, Sphere):
+        half = np.full(3, geometry.radius_m)
+        return np.vstack([-half, half])
+    if isinstance(geometry, Mesh):
+        return ctx.mesh_bounds(geometry)
+    return None
+
+
+def link_geometry_bounds(ctx: CheckContext, link: Link) -> np.ndarray | None:
+    """Axis-aligned box (2, 3) around all of a link's visuals and collisions, in the link frame."""
+    corners = []
+    for shape in [*link.visuals, *link.collisions]:
+        bounds = _local_bounds(ctx, shape.geometry)
+        if bounds is None or not np.all(np.isfinite(bounds)):
+            continue
+        box = np.array([[bounds[i, 0], bounds[j, 1], bounds[k, 2]]
+                        for i in (0, 1) for j in (0, 1) for k in (0, 1)])
+        T = shape.T_link_geom
+        corners.append(box @ T[:3, :3].T + T[:3, 3])
+    if not corners:
+        return None
+    points = np.vstack(corners)
+    return np.vstack([points.min(axis=0), points.max(axis=0)])
+
+
+@rule("I205", "com-outside-geometry", "warning",
+      "A link's centre of mass lies outside its geometry.")
+def com_outside_geometry(ctx: CheckContext) -> Iterator[Issue]:
+    """The `<inertial><origin>` is the centre of mass in the link frame; it lies inside
+    the link's visual and collision shapes (their bounding box, plus 10 %). Outside it,
+    the usual cause is an origin given in the parent's frame, or the joint offset applied
+    twice.
+    """
+    for link in ctx.robot.links:
+        if not _massive(link) or _mesh_extent_implausible(ctx, link):
+            continue
+        bounds = link_geometry_bounds(ctx, link)
+        com = np.asarray(link.inertial.com_m, dtype=float)
+        if bounds is None or not np.all(np.isfinite(com)):
+            continue
+        margin = max(COM_MARGIN_FRACTION * float(np.max(bounds[1] - bounds[0])),
+                     COM_MARGIN_MIN_M)
+        if np.any(com < bounds[0] - margin) or np.any(com > bounds[1] + margin):
+            centre = (bounds[0] + bounds[1]) / 2
+            yield Issue(f"link '{link.name}': centre of mass ({', '.join(_fmt(v) for v in com)}) m "
+                        f"is outside its geometry, which spans "
+                        f"({', '.join(_fmt(v) for v in bounds[0])}) to "
+                        f"({', '.join(_fmt(v) for v in bounds[1])}) m",
+                        link.inertial.loc, link.name,
+                        hint="<inertial><origin xyz=> is in the link frame; the geometry's centre "
+                             f"is xyz=\"{' '.join(_fmt(v) for v in centre)}\"")
+
+
+def _mesh_extents(ctx: CheckContext, link: Link) -> Iterator[tuple[object, Mesh, float]]:
+    seen: set[str] = set()
+    for shape in [*link.visuals, *link.collisions]:
+        mesh = shape.geometry
+        if not isinstance(mesh, Mesh) or mesh.path is None:
+            continue
+        key = f"{mesh.path}|{tuple(np.asarray(mesh.scale, dtype=float))}"
+        bounds = ctx.mesh_bounds(mesh) if key not in seen else None
+        seen.add(key)
+        if bounds is not None:
+            yield shape, mesh, float(np.max(bounds[1] - bounds[0]))
+
+
+def _mesh_extent_implausible(ctx: CheckContext, link: Link) -> bool:
+    low, high = MESH_EXTENT_RANGE_M
+    return any(not low <= extent <= high for _s, _m, extent in _mesh_extents(ctx, link))
+
+
+@rule("I206", "mesh-scale-implausible", "warning",
+      "A mesh is implausibly large or small: probably the wrong unit.")
+def mesh_scale_implausible(ctx: CheckContext) -> Iterator[Issue]:
+    """CAD tools export STL in millimetres by default, URDF reads metres: a 470 mm frame
+    becomes 470 m. A mesh larger than 20 m or smaller than 1 mm across (after its
+    `scale`) is reported, with the scale that brings it into range.
+    """
+    low, high = MESH_EXTENT_RANGE_M
+    for link in ctx.robot.links:
+        for shape, mesh, extent in _mesh_extents(ctx, link):
+            if low <= extent <= high or extent <= 0:
+                continue
+            scale = np.asarray(mesh.scale, dtype=float)
+            if extent > high:
+                factor, why = 0.001, "looks like millimetres read as metres"
+            else:
+                factor, why = 1000.0, "looks scaled down twice"
+            fixed = " ".join(_fmt(s * factor) for s in scale)
+            yield Issue(f"link '{link.name}': mesh '{mesh.uri}' is {_fmt(extent)} m across "
+                        f"({why})", shape.loc, link.name,
+                        hint=f"use <mesh filename=\"{mesh.uri}\" scale=\"{fixed}\"/>, or "
+                             "convert the file (reedtool import-stl)")

@@ -1,0 +1,97 @@
+"""The one catalogue of rules. Rules register themselves with the `@rule` decorator.
+
+A rule's metadata (code, slug, default severity, one-line summary) is data; its docstring
+is its documentation (`--explain`, docs/rules.md). Codes are a family letter and three
+digits and are never reused: a retired rule keeps its number, retired.
+"""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+import re
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Callable, Iterable
+
+from .finding import SEVERITIES, Issue
+
+if TYPE_CHECKING:
+    from .context import CheckContext
+
+CheckFn = Callable[["CheckContext"], Iterable[Issue]]
+
+# Family letter -> (module that defines its rules, title).
+FAMILIES: dict[str, tuple[str, str]] = {
+    "S": ("reedtool.checks.structure", "Structure"),
+    "I": ("reedtool.checks.inertia_rules", "Inertia"),
+    "R": ("reedtool.checks.rotor_rules", "Rotors"),
+    "C": ("reedtool.checks.controller_rules", "Controller cross-check"),
+}
+
+_CODE = re.compile(r"^[A-Z]\d{3}$")
+_SLUG = re.compile(r"^[a-z0-9]+(-[a-z0-9]+)*$")
+
+
+@dataclass(frozen=True)
+class Rule:
+    code: str
+    slug: str
+    severity: str          # default; a config may override it
+    summary: str           # one line
+    check: CheckFn
+
+    @property
+    def family(self) -> str:
+        return FAMILIES[self.code[0]][1]
+
+    @property
+    def explanation(self) -> str:
+        return inspect.cleandoc(self.check.__doc__ or "").strip()
+
+
+_RULES: dict[str, Rule] = {}
+
+
+def rule(code: str, slug: str, severity: str, summary: str) -> Callable[[CheckFn], CheckFn]:
+    """Register a check function under a stable code."""
+
+    def register(fn: CheckFn) -> CheckFn:
+        # Programming errors in a rule module, caught at import time by the test suite.
+        if not _CODE.match(code) or code[0] not in FAMILIES:
+            raise ValueError(f"bad rule code {code!r}")
+        if not _SLUG.match(slug):
+            raise ValueError(f"bad rule slug {slug!r}")
+        if severity not in SEVERITIES:
+            raise ValueError(f"bad severity {severity!r} for {code}")
+        if not fn.__doc__:
+            raise ValueError(f"rule {code} has no docstring (its documentation)")
+        if code in _RULES and _RULES[code].check is not fn:
+            raise ValueError(f"rule code {code} registered twice")
+        if any(r.slug == slug and r.code != code for r in _RULES.values()):
+            raise ValueError(f"rule slug {slug!r} registered twice")
+        _RULES[code] = Rule(code, slug, severity, summary, fn)
+        return fn
+
+    return register
+
+
+def _load_families() -> None:
+    for module_name, _title in FAMILIES.values():
+        importlib.import_module(module_name)
+
+
+def all_rules() -> list[Rule]:
+    """Every registered rule, by family (S, I, R) and then by code."""
+    _load_families()
+    order = list(FAMILIES)
+    return sorted(_RULES.values(), key=lambda r: (order.index(r.code[0]), r.code))
+
+
+def get_rule(code_or_slug: str) -> Rule | None:
+    """Look a rule up by code (case-insensitive) or slug."""
+    _load_families()
+    key = code_or_slug.strip()
+    found = _RULES.get(key.upper())
+    if found is not None:
+        return found
+    return next((r for r in _RULES.values() if r.slug == key.lower()), None)

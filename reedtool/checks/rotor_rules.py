@@ -1,0 +1,496 @@
+"""Rotor rules (R3xx): the motor plugins describe rotors that can hold the robot in hover.
+
+They run only when motor-model plugins (RotorS, PX4 classic, gz-sim) are found. Geometry
+comes from reedtool.rotors, the allocation matrix from reedtool.allocation and the hover
+trim from reedtool.trim; this module interprets them.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from typing import TYPE_CHECKING, Iterator
+
+import numpy as np
+
+from ..trim import STANDARD_GRAVITY_M_S2
+from .context import CheckContext
+from .finding import Issue
+from .registry import rule
+
+if TYPE_CHECKING:
+    from ..rotors import Rotor
+
+# Net yaw torque at equal rotor speed, as a fraction of the sum of the rotors' drag
+# torques, above which the directions (or moment constants) do not balance.
+YAW_BALANCE_REL_TOL = 0.01
+# Condition number of the allocation matrix with each row scaled to unit norm: 1 for a
+# symmetric frame, large when two of thrust/roll/pitch/yaw are almost coupled.
+MAX_CONDITION_NUMBER = 25.0
+RANK_TOL = 1e-9
+THRUST_TO_WEIGHT_MIN = 1.0
+THRUST_TO_WEIGHT_WARN = 1.5
+HOVER_THROTTLE_MAX = 0.8
+AXIS_TILT_TOL_DEG = 1.0
+DIRECTIONS = ("ccw", "cw")
+CONSTANTS = (("motor_constant", "motorConstant", "N/(rad/s)²"),
+             ("moment_constant", "momentConstant", "m"),
+             ("max_rot_velocity_rad_s", "maxRotVelocity", "rad/s"))
+
+
+def _fmt(value: float) -> str:
+    return f"{value:.4g}"
+
+
+def _rotors(ctx: CheckContext) -> list["Rotor"]:
+    return ctx.rotors if ctx.tree_ok else []
+
+
+def _constants_ok(rotor: "Rotor") -> bool:
+    return (math.isfinite(rotor.motor_constant) and rotor.motor_constant > 0
+            and math.isfinite(rotor.max_rot_velocity_rad_s) and rotor.max_rot_velocity_rad_s > 0
+            and math.isfinite(rotor.moment_constant) and rotor.moment_constant >= 0)
+
+
+def _physics_ready(ctx: CheckContext) -> bool:
+    """Every rotor placed, turning a known way, with usable constants; the robot has mass."""
+    rotors = _rotors(ctx)
+    if not rotors:
+        return False
+    for rotor in rotors:
+        if not (np.all(np.isfinite(rotor.position_m)) and np.all(np.isfinite(rotor.axis))
+                and np.linalg.norm(rotor.axis) > 0):
+            return False
+        if rotor.direction not in DIRECTIONS or not _constants_ok(rotor):
+            return False
+        joint = ctx.robot.joint_map.get(rotor.joint or "")
+        if joint is None or joint.child != rotor.link:  # R314/R315: geometry of the wrong link
+            return False
+    whole = ctx.whole_robot
+    return math.isfinite(whole.mass_kg) and whole.mass_kg > 0
+
+
+def _direction_loc(rotor: "Rotor"):
+    return rotor.plugin.param_loc("turningDirection")
+
+
+# --------------------------------------------------------------- plugin wiring
+
+@rule("R301", "motor-number-duplicate", "error", "Two rotors have the same motor number.")
+def motor_number_duplicate(ctx: CheckContext) -> Iterator[Issue]:
+    """`<motorNumber>` is the rotor's index in the motor speed command the controller
+    sends. Two rotors with the same number receive the same command and another index
+    drives nothing; the vehicle flips on take-off.
+    """
+    seen: dict[int, "Rotor"] = {}
+    for rotor in _rotors(ctx):
+        number = rotor.motor_number
+        if number is None:
+            continue
+        if number in seen:
+            yield Issue(f"rotor '{rotor.name}' has motor number {number}, already used by "
+                        f"'{seen[number].name}'", rotor.plugin.param_loc("motorNumber"),
+                        rotor.name, hint="number the rotors 0, 1, ..., n-1, each once")
+        else:
+            seen[number] = rotor
+
+
+@rule("R302", "motor-numbers-not-contiguous", "error",
+      "Motor numbers are missing or not 0..n-1.")
+def motor_numbers_not_contiguous(ctx: CheckContext) -> Iterator[Issue]:
+    """With n rotors the motor numbers must be exactly 0, 1, ..., n-1: the command vector
+    has n entries and a rotor numbered n or above never receives one. A missing or
+    unreadable `<motorNumber>` is reported here as well.
+    """
+    rotors = _rotors(ctx)
+    if not rotors:
+        return
+    for rotor in rotors:
+        if rotor.motor_number is None:
+            raw = rotor.plugin.param("motorNumber")
+            what = f"'{raw}' is not a motor number" if raw is not None else "no <motorNumber>"
+            yield Issue(f"rotor '{rotor.name}': {what}", rotor.plugin.param_loc("motorNumber"),
+                        rotor.name, hint="add <motorNumber>N</motorNumber>, N from 0 to "
+                                         f"{len(rotors) - 1}")
+    numbers = {r.motor_number for r in rotors if r.motor_number is not None}
+    expected = set(range(len(rotors)))
+    outside = sorted(numbers - expected)
+    missing = sorted(expected - numbers)
+    for rotor in rotors:
+        if rotor.motor_number in outside:
+            yield Issue(f"rotor '{rotor.name}' has motor number {rotor.motor_number}; with "
+                        f"{len(rotors)} rotors the numbers are 0..{len(rotors) - 1}",
+                        rotor.plugin.param_loc("motorNumber"), rotor.name,
+                        hint=f"unused numbers: {', '.join(map(str, missing))}"
+                        if missing else None)
+
+
+@rule("R303", "rotor-direction-invalid", "error", "A rotor's turning direction is not cw or ccw.")
+def rotor_direction_invalid(ctx: CheckContext) -> Iterator[Issue]:
+    """`<turningDirection>` must be exactly `ccw` or `cw` (lower case: the motor plugins
+    compare the string). Anything else makes the plugin refuse to load or spin the
+    rotor with an undefined sign.
+    """
+    for rotor in _rotors(ctx):
+        if rotor.direction not in DIRECTIONS:
+            what = f"'{rotor.direction}'" if rotor.direction else "missing"
+            yield Issue(f"rotor '{rotor.name}': turning direction {what}", _direction_loc(rotor),
+                        rotor.name, hint="write <turningDirection>ccw</turningDirection> or cw")
+
+
+@rule("R304", "yaw-moment-imbalance", "error",
+      "At equal rotor speed the rotors' yaw moments do not cancel.")
+def yaw_moment_imbalance(ctx: CheckContext) -> Iterator[Issue]:
+    """Each rotor's drag pushes the body the other way round (a ccw rotor pushes it cw),
+    by momentConstant x thrust. When every rotor spins at the same speed these moments
+    must cancel: as many ccw as cw rotors, with equal constants, in a symmetric layout.
+    Otherwise the vehicle spins up in yaw as soon as it lifts off, or the controller
+    must unbalance the rotors just to hold heading.
+
+    The hint names the rotor whose direction, flipped, balances the set when there is one.
+    """
+    found = _yaw_imbalance(ctx)
+    if found is None:
+        return
+    rotors, net_N_m, total_N_m = found
+    counts = Counter(r.direction for r in rotors)
+    hint = "make half of the rotors ccw and half cw, alternating around the frame"
+    best = _best_flip(ctx, rotors)
+    target = rotors[0]
+    if best is not None:
+        target = rotors[best]
+        other = "cw" if target.direction == "ccw" else "ccw"
+        hint = f"set rotor '{target.name}' to {other}"
+    yield Issue(f"at equal rotor speed the yaw moments do not cancel: net {_fmt(net_N_m)} N·m "
+                f"at hover thrust ({counts['ccw']} ccw, {counts['cw']} cw; "
+                f"{100 * abs(net_N_m) / total_N_m:.0f}% of the rotors' drag torque)",
+                _direction_loc(target), target.name, hint=hint)
+
+
+def _equal_speed_yaw(ctx: CheckContext, signs: np.ndarray) -> tuple[float, float]:
+    """(net, total) drag yaw torque [N·m] with every rotor at the speed that carries the weight.
+
+    Only the rotors' drag reaction (-turning_sign * momentConstant * thrust along the
+    rotor axis) counts: the yaw a tilted rotor makes through its lever arm is R311's.
+    """
+    rotors = _rotors(ctx)
+    k = np.array([r.motor_constant for r in rotors])
+    axis_z = np.array([r.axis[2] / np.linalg.norm(r.axis) for r in rotors])
+    km = np.array([r.moment_constant for r in rotors])
+    # Common hover speed^2: sum(k * w2 * axis_z) = m g.
+    weight_N = ctx.whole_robot.mass_kg * STANDARD_GRAVITY_M_S2
+    lift_per_w2 = float(np.sum(k * np.clip(axis_z, 0, None)))
+    w2 = weight_N / lift_per_w2 if lift_per_w2 > 0 else 1.0
+    drag_N_m = km * k * w2 * axis_z
+    return float(np.sum(-signs * drag_N_m)), float(np.sum(np.abs(drag_N_m)))
+
+
+def _yaw_imbalance(ctx: CheckContext):
+    if not _physics_ready(ctx):
+        return None
+    rotors = _rotors(ctx)
+    signs = np.array([r.turning_sign for r in rotors], dtype=float)
+    net, total = _equal_speed_yaw(ctx, signs)
+    if total <= 0 or abs(net) <= YAW_BALANCE_REL_TOL * total:
+        return None
+    return rotors, net, total
+
+
+def _best_flip(ctx: CheckContext, rotors) -> int | None:
+    signs = np.array([r.turning_sign for r in rotors], dtype=float)
+    best, best_net = None, None
+    for i in range(len(rotors)):
+        flipped = signs.copy()
+        flipped[i] = -flipped[i]
+        net, total = _equal_speed_yaw(ctx, flipped)
+        if abs(net) <= YAW_BALANCE_REL_TOL * total and _rank(ctx, flipped) == 4 and \
+                (best_net is None or abs(net) < best_net):
+            best, best_net = i, abs(net)
+    return best
+
+
+# ----------------------------------------------------------------- allocation
+
+def _normalised_allocation(ctx: CheckContext, signs: np.ndarray | None = None) -> np.ndarray:
+    """The allocation matrix with each row scaled to unit norm (unit-free conditioning)."""
+    A = ctx.allocation.copy()
+    if signs is not None:
+        rotors = _rotors(ctx)
+        current = np.array([r.turning_sign for r in rotors], dtype=float)
+        drag = np.array([r.moment_constant * r.axis[2] / np.linalg.norm(r.axis) for r in rotors])
+        A[3] = A[3] + (current - signs) * drag
+    norms = np.linalg.norm(A, axis=1, keepdims=True)
+    return np.divide(A, norms, out=np.zeros_like(A), where=norms > 0)
+
+
+def _rank(ctx: CheckContext, signs: np.ndarray | None = None) -> int:
+    A = _normalised_allocation(ctx, signs)
+    singular = np.linalg.svd(A, compute_uv=False)
+    return int(np.sum(singular > RANK_TOL * max(singular.max(initial=0), 1e-300)))
+
+
+_AXES = ("thrust", "roll", "pitch", "yaw")
+
+
+@rule("R305", "allocation-rank-deficient", "error",
+      "The rotors cannot set thrust, roll, pitch and yaw independently.")
+def allocation_rank_deficient(ctx: CheckContext) -> Iterator[Issue]:
+    """The allocation matrix maps rotor thrusts to collective thrust and roll, pitch and
+    yaw torque about the centre of mass; it is built from the rotors' positions, axes,
+    directions and constants. With rank below 4 some combination of the four cannot be
+    commanded: typically neighbouring rotors of a quad-X turn the same way (yaw becomes
+    roll or pitch), or all rotors lie on one line.
+    """
+    if not _physics_ready(ctx) or _rank(ctx) == 4:
+        return
+    A = _normalised_allocation(ctx)
+    u, s, _vt = np.linalg.svd(A)
+    rank = _rank(ctx)
+    coupled = set()
+    for vector in u[:, rank:].T:  # combinations of outputs no thrust vector can produce
+        coupled |= {_AXES[i] for i in np.flatnonzero(np.abs(vector) > 1e-6)}
+    names = [a for a in _AXES if a in coupled]
+    hint = ("check the turning directions: diagonal rotors of a quad-X share a direction, "
+            "neighbours alternate") if "yaw" in coupled else \
+        "spread the rotors around the centre of mass in both x and y"
+    yield Issue(f"allocation matrix has rank {rank} < 4 for {len(_rotors(ctx))} rotors: "
+                f"{', '.join(names)} cannot be set independently", _rotors(ctx)[0].loc,
+                "rotors", hint=hint)
+
+
+@rule("R306", "allocation-ill-conditioned", "warning",
+      "The allocation matrix is nearly singular.")
+def allocation_ill_conditioned(ctx: CheckContext) -> Iterator[Issue]:
+    """With each row scaled to unit norm, the allocation matrix of a symmetric frame has
+    condition number 1. Above 25 one axis is controlled only by large, opposing thrust
+    changes: the controller saturates motors on small commands.
+    """
+    if not _physics_ready(ctx) or _rank(ctx) < 4:
+        return
+    cond = float(np.linalg.cond(_normalised_allocation(ctx)))
+    if cond > MAX_CONDITION_NUMBER:
+        yield Issue(f"allocation matrix condition number {cond:.3g} > {MAX_CONDITION_NUMBER:g} "
+                    "(rows scaled to unit norm)", _rotors(ctx)[0].loc, "rotors",
+                    hint="place the rotors symmetrically about the centre of mass")
+
+
+# ----------------------------------------------------------------------- trim
+
+@rule("R307", "trim-infeasible", "error",
+      "No rotor thrusts within [0, k·ω_max²] hold the robot level in hover.")
+def trim_infeasible(ctx: CheckContext) -> Iterator[Issue]:
+    """Hover needs thrusts that give collective thrust m·g and no torque about the
+    centre of mass, each between 0 and the rotor's maximum k·ω_max². When the least-
+    squares thrusts leave that range although the rotors can lift the robot, the centre
+    of mass is too far from the rotors' centre (a rotor would have to push down) or the
+    yaw moments cannot cancel.
+
+    Not reported when R304, R305 or R308 already explain it.
+    """
+    if not _physics_ready(ctx) or _rank(ctx) < 4 or _yaw_imbalance(ctx) is not None:
+        return
+    trim = ctx.trim
+    if trim.feasible or trim.thrust_to_weight < THRUST_TO_WEIGHT_MIN:
+        return
+    com = ctx.whole_robot.com_m
+    yield Issue(f"no hover trim: {trim.message} (COM at {', '.join(_fmt(v) for v in com)} m "
+                "in the base frame)", _rotors(ctx)[0].loc, "rotors",
+                hint="move the centre of mass (link masses and <inertial> origins) over the "
+                     "middle of the rotors, or move the rotors")
+
+
+def _weight_and_trim(ctx: CheckContext):
+    if not _physics_ready(ctx):
+        return None
+    trim = ctx.trim
+    if not math.isfinite(trim.thrust_to_weight):
+        return None
+    return trim
+
+
+def _omega_for(ctx: CheckContext, ratio: float) -> str:
+    """maxRotVelocity that would bring thrust-to-weight to `ratio` (same for all rotors)."""
+    trim = ctx.trim
+    omega = max(r.max_rot_velocity_rad_s for r in _rotors(ctx))
+    needed = omega * math.sqrt(ratio / trim.thrust_to_weight) if trim.thrust_to_weight > 0 \
+        else float("inf")
+    return f"{needed:.0f} rad/s"
+
+
+@rule("R308", "thrust-to-weight-below-one", "error",
+      "At full speed the rotors cannot lift the robot.")
+def thrust_to_weight_below_one(ctx: CheckContext) -> Iterator[Issue]:
+    """Thrust-to-weight is the rotors' combined upward thrust at maxRotVelocity,
+    sum(k·ω_max²·axis_z), over the robot's weight m·g. Below 1 the model cannot leave
+    the ground. Usually a mass in grams read as kilograms, a motor constant off by a
+    power of ten, or maxRotVelocity in rpm instead of rad/s.
+    """
+    trim = _weight_and_trim(ctx)
+    if trim is None or trim.thrust_to_weight >= THRUST_TO_WEIGHT_MIN:
+        return
+    yield Issue(f"thrust-to-weight {trim.thrust_to_weight:.3g} < 1: the rotors give at most "
+                f"{_fmt(trim.thrust_to_weight * trim.weight_N)} N, the robot weighs "
+                f"{_fmt(trim.weight_N)} N ({_fmt(ctx.whole_robot.mass_kg)} kg)",
+                _rotors(ctx)[0].plugin.param_loc("maxRotVelocity"), "rotors",
+                hint=f"check mass and motor constants; for thrust-to-weight "
+                     f"{THRUST_TO_WEIGHT_WARN:g} maxRotVelocity would be "
+                     f"{_omega_for(ctx, THRUST_TO_WEIGHT_WARN)}")
+
+
+@rule("R309", "thrust-to-weight-low", "warning",
+      "Thrust-to-weight is below 1.5: little margin to climb and control.")
+def thrust_to_weight_low(ctx: CheckContext) -> Iterator[Issue]:
+    """A multirotor that can lift itself but with thrust-to-weight below 1.5 hovers near
+    full throttle, with little left for attitude control or climbing; real vehicles are
+    built for 2 or more.
+    """
+    trim = _weight_and_trim(ctx)
+    if trim is None or not THRUST_TO_WEIGHT_MIN <= trim.thrust_to_weight < THRUST_TO_WEIGHT_WARN:
+        return
+    yield Issue(f"thrust-to-weight {trim.thrust_to_weight:.3g} < {THRUST_TO_WEIGHT_WARN:g}: "
+                f"{_fmt(trim.thrust_to_weight * trim.weight_N)} N of thrust for "
+                f"{_fmt(trim.weight_N)} N of weight",
+                _rotors(ctx)[0].plugin.param_loc("maxRotVelocity"), "rotors",
+                hint=f"maxRotVelocity {_omega_for(ctx, THRUST_TO_WEIGHT_WARN)} (or a "
+                     "correspondingly larger motor constant, or less mass) gives 1.5")
+
+
+@rule("R310", "hover-throttle-high", "warning",
+      "A rotor needs more than 80 % of its maximum speed to hover.")
+def hover_throttle_high(ctx: CheckContext) -> Iterator[Issue]:
+    """Hover throttle is the trim speed over maxRotVelocity. Above 0.8 for any rotor,
+    that rotor has almost no speed left to correct attitude and the controller
+    saturates in the first gust (or the first Gazebo step with an unlucky contact).
+    """
+    trim = _weight_and_trim(ctx)
+    if trim is None or not trim.feasible or trim.hover_throttle_max <= HOVER_THROTTLE_MAX:
+        return
+    rotors = _rotors(ctx)
+    worst = int(np.argmax(trim.throttle))
+    rotor = rotors[worst]
+    needed = trim.omega_rad_s[worst] / HOVER_THROTTLE_MAX
+    yield Issue(f"rotor '{rotor.name}' hovers at {trim.omega_rad_s[worst]:.0f} rad/s, "
+                f"{100 * trim.throttle[worst]:.0f}% of its maximum "
+                f"{_fmt(rotor.max_rot_velocity_rad_s)} rad/s",
+                rotor.plugin.param_loc("maxRotVelocity"), rotor.name,
+                hint=f"maxRotVelocity >= {needed:.0f} rad/s keeps hover at 80%")
+
+
+# ------------------------------------------------------------------- geometry
+
+@rule("R311", "rotor-axis-tilted", "warning", "A rotor's thrust axis is not along body z.")
+def rotor_axis_tilted(ctx: CheckContext) -> Iterator[Issue]:
+    """Motor plugins push along the rotor link's z axis. For a conventional multirotor
+    that axis is the base link's z; a tilt usually comes from an `rpy` on the rotor joint
+    or an axis written in the wrong frame. Deliberately tilted designs can ignore this
+    rule (`--ignore R311`).
+    """
+    for rotor in _rotors(ctx):
+        axis = np.asarray(rotor.axis, dtype=float)
+        norm = np.linalg.norm(axis)
+        if not np.all(np.isfinite(axis)) or norm == 0:
+            continue
+        tilt_deg = math.degrees(math.acos(float(np.clip(axis[2] / norm, -1, 1))))
+        if tilt_deg > AXIS_TILT_TOL_DEG:
+            joint = ctx.robot.joint_map.get(rotor.joint or "")
+            loc = (joint.origin_loc or joint.loc) if joint else rotor.loc
+            down = "; it points down, so its thrust pushes the robot to the ground" \
+                if tilt_deg > 90 else ""
+            yield Issue(f"rotor '{rotor.name}' thrust axis ({', '.join(f'{v:.3f}' for v in axis / norm)}) "
+                        f"is tilted {tilt_deg:.1f}° from body z{down}", loc, rotor.name,
+                        hint="check the rpy of the rotor joint's <origin>")
+
+
+@rule("R312", "rotor-count-mismatch", "error",
+      "The MAVLink/PX4 interface declares a different number of rotors than exist.")
+def rotor_count_mismatch(ctx: CheckContext) -> Iterator[Issue]:
+    """The autopilot interface plugin forwards one motor command per declared rotor
+    (`rotor_count`, or its control channels). More than there are motor plugins and the
+    autopilot mixes for a frame that does not exist; fewer and some rotors never spin.
+    """
+    if not ctx.tree_ok:
+        return
+    found = len(ctx.rotors)
+    for declaration in ctx.rotor_count_declarations:
+        if declaration.rotor_count != found:
+            plugin = declaration.plugin
+            yield Issue(f"'{plugin.name}' declares {declaration.rotor_count} rotors but the model "
+                        f"has {found} motor plugin{'s' if found != 1 else ''}",
+                        declaration.loc, plugin.name,
+                        hint=f"set rotor_count to {found}")
+
+
+@rule("R313", "rotor-joint-not-continuous", "error", "A rotor turns on a joint that is not continuous.")
+def rotor_joint_not_continuous(ctx: CheckContext) -> Iterator[Issue]:
+    """A motor plugin spins its joint without end: the joint must be `continuous`. A
+    revolute joint stops at its limits, a fixed one is merged away by Gazebo and the
+    plugin finds no joint.
+    """
+    for rotor in _rotors(ctx):
+        joint = ctx.robot.joint_map.get(rotor.joint or "")
+        if joint is not None and joint.type != "continuous":
+            yield Issue(f"rotor '{rotor.name}' spins joint '{joint.name}', which is {joint.type}",
+                        joint.loc, joint.name, hint='use type="continuous"')
+
+
+@rule("R314", "rotor-plugin-target-missing", "error",
+      "A motor plugin names a joint or link that does not exist.")
+def rotor_plugin_target_missing(ctx: CheckContext) -> Iterator[Issue]:
+    """`<jointName>` and `<linkName>` of a motor plugin must name the rotor's joint and
+    link exactly (namespace prefix included); the plugin fails to load otherwise and the
+    rotor does not exist in the simulation.
+    """
+    import difflib
+
+    for rotor in _rotors(ctx):
+        for tag, name, table in (("jointName", rotor.joint, ctx.robot.joint_map),
+                                 ("linkName", rotor.plugin.param("linkName"), ctx.robot.link_map)):
+            if tag == "jointName" and name is None:
+                yield Issue(f"motor plugin '{rotor.plugin.name}' has no <jointName>", rotor.loc,
+                            rotor.name, hint="add <jointName> naming the rotor's joint")
+            elif name is not None and name not in table:
+                close = difflib.get_close_matches(name, list(table), n=1)
+                yield Issue(f"motor plugin '{rotor.plugin.name}' <{tag}> '{name}' does not exist",
+                            rotor.plugin.param_loc(tag), rotor.name,
+                            hint=f"did you mean '{close[0]}'?" if close else None)
+
+
+@rule("R315", "rotor-link-not-joint-child", "error",
+      "A motor plugin's link is not the child of its joint.")
+def rotor_link_not_joint_child(ctx: CheckContext) -> Iterator[Issue]:
+    """The plugin spins `<jointName>` and applies thrust to `<linkName>`; they must be the
+    same rotor: the link is the joint's child. Otherwise thrust is applied to a link that
+    does not turn, typically after copying a rotor block and renaming only one of them.
+    """
+    for rotor in _rotors(ctx):
+        joint = ctx.robot.joint_map.get(rotor.joint or "")
+        link = rotor.plugin.param("linkName")
+        if joint is not None and link is not None and link in ctx.robot.link_map \
+                and joint.child != link:
+            yield Issue(f"motor plugin '{rotor.plugin.name}': link '{link}' is not the child of "
+                        f"joint '{joint.name}' (its child is '{joint.child}')",
+                        rotor.plugin.param_loc("linkName"), rotor.name,
+                        hint=f"<linkName>{joint.child}</linkName>")
+
+
+@rule("R316", "rotor-constant-invalid", "error",
+      "A rotor's motor constant, moment constant or maximum speed is missing or not positive.")
+def rotor_constant_invalid(ctx: CheckContext) -> Iterator[Issue]:
+    """`motorConstant` (thrust = k·ω², N/(rad/s)²) and `maxRotVelocity` (rad/s) must be
+    positive and `momentConstant` (yaw drag torque per newton of thrust, m) must not be
+    negative. Missing values silently fall back to a plugin default that differs between
+    RotorS, PX4 and gz-sim; write them out.
+    """
+    for rotor in _rotors(ctx):
+        for attr, tag, unit in CONSTANTS:
+            value = getattr(rotor, attr)
+            raw = rotor.plugin.param(tag)
+            floor_ok = value >= 0 if attr == "moment_constant" else value > 0
+            if raw is None:
+                yield Issue(f"rotor '{rotor.name}': no <{tag}>", rotor.loc, rotor.name,
+                            hint=f"add <{tag}> ({unit})")
+            elif not (math.isfinite(value) and floor_ok):
+                yield Issue(f"rotor '{rotor.name}': <{tag}> is '{raw}'",
+                            rotor.plugin.param_loc(tag), rotor.name,
+                            hint=f"a {'non-negative' if attr == 'moment_constant' else 'positive'}"
+                                 f" number in {unit}")

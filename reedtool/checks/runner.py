@@ -1,0 +1,99 @@
+"""Run the selected rules over one robot and collect findings.
+
+Selection follows ruff: `select` and `ignore` are code prefixes and, for each rule, the
+longest prefix that matches it decides (an ignore wins a tie). Severity overrides are
+prefixes too, longest match wins.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from typing import Iterable, Mapping, Sequence
+
+from ..errors import ReedtoolError
+from ..model import Robot
+from .context import CheckContext
+from .finding import SEVERITIES, Finding
+from .registry import Rule, all_rules
+
+_SELECTOR = re.compile(r"^[A-Z]\d{0,3}$")
+
+
+def _longest(prefixes: Iterable[str], code: str) -> int:
+    return max((len(p) for p in prefixes if code.startswith(p)), default=-1)
+
+
+@dataclass(frozen=True)
+class Selection:
+    select: tuple[str, ...] = ("",)
+    ignore: tuple[str, ...] = ()
+    severity: Mapping[str, str] = field(default_factory=dict)  # code prefix -> severity
+
+    def enabled(self, code: str) -> bool:
+        selected, ignored = _longest(self.select, code), _longest(self.ignore, code)
+        return selected >= 0 and selected > ignored
+
+    def severity_of(self, rule: Rule) -> str:
+        best, severity = -1, rule.severity
+        for prefix, value in self.severity.items():
+            if rule.code.startswith(prefix) and len(prefix) > best:
+                best, severity = len(prefix), value
+        return severity
+
+
+def parse_selectors(values: Iterable[str], *, origin: str) -> tuple[str, ...]:
+    """Normalise user selectors ("R3", "i203", "ALL") and reject ones that match no rule.
+
+    `origin` names where they came from (an option or a config file) for the error.
+    """
+    codes = [r.code for r in all_rules()]
+    out: list[str] = []
+    for raw in values:
+        for part in str(raw).split(","):
+            selector = part.strip().upper()
+            if not selector:
+                continue
+            if selector == "ALL":
+                selector = ""
+            elif not _SELECTOR.match(selector) or not any(c.startswith(selector) for c in codes):
+                raise ReedtoolError(f"unknown rule selector '{part.strip()}' in {origin}",
+                                    hint="use a code or code prefix such as S1, I203 or R; "
+                                         "see `reedtool validate --explain CODE`")
+            out.append(selector)
+    return tuple(out)
+
+
+def parse_severity_overrides(values: Mapping[str, str], *, origin: str) -> dict[str, str]:
+    out: dict[str, str] = {}
+    for key, value in values.items():
+        (prefix,) = parse_selectors([key], origin=origin) or ("",)
+        severity = str(value).strip().lower()
+        if severity not in SEVERITIES:
+            raise ReedtoolError(f"severity for '{key}' in {origin} must be one of "
+                                f"{', '.join(SEVERITIES)}, not '{value}'")
+        out[prefix] = severity
+    return out
+
+
+def run_checks(robot: Robot, selection: Selection | None = None, *,
+               controllers: Sequence = ()) -> list[Finding]:
+    """Every finding of every selected rule, in deterministic order, duplicates removed.
+
+    `controllers`: controller rotor tables read from files (reedtool.controller_tables).
+    """
+    selection = selection or Selection()
+    ctx = CheckContext(robot, controllers)
+    findings: set[Finding] = set()
+    for rule in all_rules():
+        if not selection.enabled(rule.code):
+            continue
+        severity = selection.severity_of(rule)
+        for issue in rule.check(ctx):
+            loc = issue.loc or robot.loc
+            findings.add(Finding(code=rule.code, slug=rule.slug, severity=severity,
+                                 message=issue.message, subject=issue.subject,
+                                 file=loc.file if loc else None,
+                                 line=loc.line if loc else None, hint=issue.hint,
+                                 macro=loc.macro if loc else None))
+    return sorted(findings, key=Finding.sort_key)

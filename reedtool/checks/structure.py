@@ -1,0 +1,364 @@
+"""Structure rules (S1xx): the model is a well-formed URDF tree that Gazebo will load as written.
+
+A superset of what `check_urdf` (urdfdom) verifies, plus what the URDF->SDF conversion in
+Gazebo does silently: dropping links without mass and resolving every mesh.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from typing import Iterator
+
+import numpy as np
+
+from ..model import JOINT_TYPES, Box, Cylinder, Mesh, Sphere
+from .context import CheckContext
+from .finding import Issue
+from .registry import rule
+
+# Below this mass Gazebo's URDF->SDF conversion treats a link as massless and drops it.
+SDF_MIN_MASS_KG = 1e-6
+
+# Parse-issue kinds that have a rule of their own; every other kind is S101.
+_NON_FINITE_KINDS = {"non-finite"}
+_LEGACY_KINDS = {"legacy-xacro"}
+_PER_AXIS_JOINTS = {"revolute", "continuous", "prismatic", "planar"}
+_LIMITED_JOINTS = {"revolute", "prismatic"}
+
+
+def _fmt_names(names) -> str:
+    return ", ".join(f"'{n}'" for n in names)
+
+
+@rule("S101", "urdf-parse-error", "error", "An element or attribute could not be read as URDF.")
+def urdf_parse_error(ctx: CheckContext) -> Iterator[Issue]:
+    """The URDF reader could not read an element: a number that is not a number, a missing
+    required attribute (a link or joint without name=, a <mass> without value=), a missing
+    required element (<inertial> without <mass>) or an unknown geometry.
+
+    urdfdom refuses such a file outright (check_urdf fails); Gazebo's parser may instead
+    substitute defaults (zero mass, zero inertia) and simulate something you did not write.
+    Fix the element at the reported line.
+    """
+    for issue in ctx.robot.parse_issues:
+        if issue.kind not in _NON_FINITE_KINDS | _LEGACY_KINDS:
+            yield Issue(issue.message, issue.loc, issue.subject)
+
+
+@rule("S102", "non-finite-number", "error", "A number in the model is NaN or infinite.")
+def non_finite_number(ctx: CheckContext) -> Iterator[Issue]:
+    """Every number in a URDF must be finite. `nan` and `inf` usually come from an xacro
+    expression that divided by zero or used an undefined property default.
+
+    Physics engines propagate a NaN through the whole simulation: the model explodes or
+    vanishes on the first step.
+    """
+    for issue in ctx.robot.parse_issues:
+        if issue.kind in _NON_FINITE_KINDS:
+            yield Issue(issue.message, issue.loc, issue.subject,
+                        hint="check the xacro expression that computes this value")
+
+
+@rule("S103", "legacy-xacro-tag", "error", "An old-style xacro tag was copied into the URDF.")
+def legacy_xacro_tag(ctx: CheckContext) -> Iterator[Issue]:
+    """Old tutorials use `<property>`, `<include>`, `<macro>` and macro calls without the
+    `xacro:` prefix. xacro 2.x no longer understands them and copies them into the URDF
+    unchanged, so properties are never defined and macros never expanded: the model is
+    silently broken.
+
+    Spell them `<xacro:property>`, `<xacro:include>`, `<xacro:macro>` and `<xacro:NAME/>`
+    (`reedtool expand --fix-legacy` rewrites them).
+    """
+    for issue in ctx.robot.parse_issues:
+        if issue.kind in _LEGACY_KINDS:
+            message = issue.message.removeprefix(f"{issue.loc}: ")  # the finding says where
+            yield Issue(message, issue.loc, issue.subject,
+                        hint="use the xacro: prefix (reedtool expand --fix-legacy rewrites it)")
+
+
+@rule("S104", "single-root", "error", "The model must have exactly one root link.")
+def single_root(ctx: CheckContext) -> Iterator[Issue]:
+    """A URDF is a tree: exactly one link is not the child of any joint. Two roots mean a
+    joint is missing (or names the wrong child); urdfdom rejects the file with "two root
+    links found". A model without any link is rejected too.
+    """
+    if not ctx.robot.links:
+        yield Issue("the model has no <link>", ctx.robot.loc, ctx.robot.name,
+                    hint="a URDF needs at least one link")
+        return
+    roots = ctx.tree.roots
+    if len(roots) > 1:
+        first, *others = roots
+        for name in others:
+            link = ctx.robot.link_map[name]
+            yield Issue(f"link '{name}' is a second root: no joint has it as child "
+                        f"(the first root is '{first}')", link.loc, name,
+                        hint=f"add a joint with <child link=\"{name}\"/> to attach it")
+
+
+@rule("S105", "joint-link-missing", "error", "A joint's parent or child link does not exist.")
+def joint_link_missing(ctx: CheckContext) -> Iterator[Issue]:
+    """Every joint's `<parent link=>` and `<child link=>` must name a link of the model.
+    A typo or a missing namespace prefix here makes urdfdom reject the file.
+    """
+    links = ctx.robot.link_map
+    for joint in ctx.robot.joints:
+        for role, name in (("parent", joint.parent), ("child", joint.child)):
+            if name is not None and name not in links:
+                yield Issue(f"joint '{joint.name}': {role} link '{name}' does not exist",
+                            joint.loc, joint.name, hint=_closest_hint(name, links))
+
+
+def _closest_hint(name: str, candidates) -> str:
+    import difflib
+
+    close = difflib.get_close_matches(name, list(candidates), n=1)
+    return f"did you mean '{close[0]}'?" if close else "declare the link or fix the name"
+
+
+@rule("S106", "duplicate-link-name", "error", "Two links have the same name.")
+def duplicate_link_name(ctx: CheckContext) -> Iterator[Issue]:
+    """Link names must be unique. A macro instantiated twice without a distinct prefix or
+    suffix is the usual cause; urdfdom rejects the file.
+    """
+    seen: set[str] = set()
+    for link in ctx.robot.links:
+        if link.name in seen:
+            first = ctx.robot.link_map[link.name]
+            yield Issue(f"link '{link.name}' is declared again (first at {first.loc})",
+                        link.loc, link.name, hint="give each link a unique name")
+        seen.add(link.name)
+
+
+@rule("S107", "duplicate-joint-name", "error", "Two joints have the same name.")
+def duplicate_joint_name(ctx: CheckContext) -> Iterator[Issue]:
+    """Joint names must be unique; urdfdom rejects the file otherwise, and Gazebo plugins
+    that look a joint up by name would find only one of them.
+    """
+    seen: set[str] = set()
+    for joint in ctx.robot.joints:
+        if joint.name in seen:
+            first = ctx.robot.joint_map[joint.name]
+            yield Issue(f"joint '{joint.name}' is declared again (first at {first.loc})",
+                        joint.loc, joint.name, hint="give each joint a unique name")
+        seen.add(joint.name)
+
+
+@rule("S108", "link-multiple-parents", "error", "A link is the child of more than one joint.")
+def link_multiple_parents(ctx: CheckContext) -> Iterator[Issue]:
+    """In a tree every link has at most one parent joint. A second joint naming the same
+    child closes a loop that URDF cannot express.
+    """
+    for child, joints in ctx.tree.extra_parents.items():
+        first = ctx.tree.parent_joint[child]
+        for joint in joints:
+            yield Issue(f"link '{child}' is already the child of joint '{first.name}'; "
+                        f"joint '{joint.name}' makes it a child again", joint.loc, joint.name,
+                        hint="each link can be the child of one joint only")
+
+
+@rule("S109", "kinematic-cycle", "error", "The joints form a cycle.")
+def kinematic_cycle(ctx: CheckContext) -> Iterator[Issue]:
+    """Following parent links from some link leads back to it. urdfdom reports this as
+    "no root link found"; the links on the cycle are named here.
+    """
+    for cycle in ctx.tree.cycles:
+        joint = ctx.tree.parent_joint[cycle[0]]
+        yield Issue(f"links {' <- '.join(cycle + [cycle[0]])} form a cycle", joint.loc,
+                    joint.name, hint="remove or re-parent one of these joints")
+
+
+@rule("S110", "joint-type-invalid", "error", "A joint has an unknown type.")
+def joint_type_invalid(ctx: CheckContext) -> Iterator[Issue]:
+    """URDF joint types are revolute, continuous, prismatic, fixed, floating and planar."""
+    import difflib
+
+    for joint in ctx.robot.joints:
+        if joint.type not in JOINT_TYPES:
+            close = difflib.get_close_matches(joint.type, JOINT_TYPES, n=1)
+            hint = f"did you mean '{close[0]}'?" if close else f"use one of {', '.join(JOINT_TYPES)}"
+            what = f"type '{joint.type}'" if joint.type else "no type="
+            yield Issue(f"joint '{joint.name}' has {what}", joint.loc, joint.name, hint=hint)
+
+
+@rule("S111", "joint-limit-missing", "error", "A revolute or prismatic joint lacks <limit>.")
+def joint_limit_missing(ctx: CheckContext) -> Iterator[Issue]:
+    """Revolute and prismatic joints need `<limit lower= upper= effort= velocity=/>`;
+    urdfdom requires effort and velocity and rejects the joint without them. A spinning
+    joint (a wheel, a rotor) should be `continuous` instead.
+    """
+    for joint in ctx.robot.joints:
+        if joint.type not in _LIMITED_JOINTS:
+            continue
+        if joint.limit is None:
+            yield Issue(f"{joint.type} joint '{joint.name}' has no <limit>", joint.loc,
+                        joint.name, hint="add <limit lower=\"..\" upper=\"..\" effort=\"..\" "
+                                         "velocity=\"..\"/>, or make it continuous")
+            continue
+        missing = [a for a in ("effort", "velocity") if getattr(joint.limit, a) is None]
+        if missing:
+            yield Issue(f"{joint.type} joint '{joint.name}': <limit> has no "
+                        f"{' or '.join(m + '=' for m in missing)}", joint.limit.loc, joint.name,
+                        hint="urdfdom requires both effort= and velocity=")
+
+
+@rule("S112", "joint-limit-inverted", "error", "A joint's lower limit is above its upper limit.")
+def joint_limit_inverted(ctx: CheckContext) -> Iterator[Issue]:
+    """With lower > upper the allowed range is empty; simulators pin the joint or
+    behave erratically.
+    """
+    for joint in ctx.robot.joints:
+        limit = joint.limit
+        if joint.type in _LIMITED_JOINTS and limit is not None and limit.lower is not None \
+                and limit.upper is not None and limit.lower > limit.upper:
+            yield Issue(f"joint '{joint.name}': lower limit {limit.lower:g} > upper limit "
+                        f"{limit.upper:g}", limit.loc, joint.name, hint="swap lower and upper")
+
+
+@rule("S113", "joint-axis-zero", "error", "A moving joint's axis is the zero vector.")
+def joint_axis_zero(ctx: CheckContext) -> Iterator[Issue]:
+    """Revolute, continuous, prismatic and planar joints move along or about their
+    `<axis xyz=>`, which must not be zero (it is normalised by every consumer).
+    """
+    for joint in ctx.robot.joints:
+        axis = np.asarray(joint.axis, dtype=float)
+        if joint.type in _PER_AXIS_JOINTS and np.all(np.isfinite(axis)) \
+                and np.linalg.norm(axis) < 1e-12:
+            yield Issue(f"joint '{joint.name}' has axis 0 0 0", joint.axis_loc or joint.loc,
+                        joint.name, hint="give a unit axis, e.g. xyz=\"0 0 1\"")
+
+
+@rule("S114", "gazebo-reference-missing", "warning",
+      "A <gazebo reference=> names no link or joint.")
+def gazebo_reference_missing(ctx: CheckContext) -> Iterator[Issue]:
+    """A `<gazebo reference="NAME">` block applies to the link or joint called NAME.
+    When there is none, Gazebo ignores the block silently: its material, friction or
+    sensor never appears.
+    """
+    names = set(ctx.robot.link_map) | set(ctx.robot.joint_map)
+    for block in ctx.robot.gazebo:
+        if block.reference is not None and block.reference not in names:
+            yield Issue(f"<gazebo reference=\"{block.reference}\">: no link or joint is "
+                        f"named '{block.reference}'", block.loc, block.reference,
+                        hint=_closest_hint(block.reference, names))
+
+
+@rule("S115", "mesh-unresolved", "error", "A mesh file cannot be found or read.")
+def mesh_unresolved(ctx: CheckContext) -> Iterator[Issue]:
+    """Every `<mesh filename=>` must resolve to a readable file: `package://PKG/...`
+    through the package search path, `file://` and plain paths relative to the model.
+    Gazebo shows nothing (or fails to spawn) for a mesh it cannot find.
+    """
+    for link in ctx.robot.links:
+        for shape in [*link.visuals, *link.collisions]:
+            mesh = shape.geometry
+            if not isinstance(mesh, Mesh) or not mesh.uri:
+                continue
+            kind = "visual" if shape in link.visuals else "collision"
+            if mesh.path is None:
+                reason = mesh.resolve_error or "cannot be resolved"
+                yield Issue(f"link '{link.name}' {kind} mesh '{mesh.uri}': {reason}",
+                            shape.loc, link.name,
+                            hint="pass --package-path DIR for the package that holds it")
+            elif not mesh.path.is_file() or not os.access(mesh.path, os.R_OK):
+                yield Issue(f"link '{link.name}' {kind} mesh '{mesh.uri}': {mesh.path} "
+                            "is not a readable file", shape.loc, link.name,
+                            hint="check the file name and its case")
+
+
+def _geometry_sizes(geometry) -> dict[str, float]:
+    if isinstance(geometry, Box):
+        return {f"size[{i}]": float(v) for i, v in enumerate(geometry.size_m)}
+    if isinstance(geometry, Cylinder):
+        return {"radius": geometry.radius_m, "length": geometry.length_m}
+    if isinstance(geometry, Sphere):
+        return {"radius": geometry.radius_m}
+    if isinstance(geometry, Mesh):
+        return {f"scale[{i}]": float(v) for i, v in enumerate(geometry.scale)}
+    return {}
+
+
+@rule("S116", "geometry-size-invalid", "error", "A geometry has a zero or negative size.")
+def geometry_size_invalid(ctx: CheckContext) -> Iterator[Issue]:
+    """Box sizes, cylinder radius and length, sphere radius and mesh scale must be
+    positive. A zero size makes a collision shape degenerate (objects fall through it),
+    a negative mesh scale mirrors the mesh and turns its normals inside out.
+    """
+    for link in ctx.robot.links:
+        for shape in [*link.visuals, *link.collisions]:
+            for name, value in _geometry_sizes(shape.geometry).items():
+                if value is not None and math.isfinite(value) and value <= 0:
+                    kind = type(shape.geometry).__name__.lower()
+                    yield Issue(f"link '{link.name}': {kind} {name} is {value:g}", shape.loc,
+                                link.name, hint="sizes must be positive (metres)")
+
+
+@rule("S117", "link-dropped-by-sdf", "error",
+      "A moving link has no inertial or a mass below 1e-6 kg; Gazebo drops it.")
+def link_dropped_by_sdf(ctx: CheckContext) -> Iterator[Issue]:
+    """When Gazebo converts URDF to SDF it silently drops a link that is attached by a
+    non-fixed joint and has no `<inertial>` or a mass below 1e-6 kg, together with its
+    joint and everything below it. A rotor link dropped this way means a motor plugin
+    that cannot find its joint. Links on fixed joints are merged into their parent
+    instead and need no mass of their own.
+
+    Negative or zero masses are reported by I201. Native SDF models are not converted
+    (sdformat gives a link without `<inertial>` 1 kg), so this rule reads URDF input only.
+    """
+    if ctx.robot.source_format != "urdf":
+        return
+    for link in ctx.robot.links:
+        if not ctx.is_moving(link):
+            continue
+        joint = ctx.parent_joint(link.name)
+        if link.inertial is None:
+            yield Issue(f"link '{link.name}' (child of {joint.type} joint '{joint.name}') has "
+                        "no <inertial>; Gazebo drops it", link.loc, link.name,
+                        hint="add <inertial> with the link's mass and inertia")
+        elif 0 < link.inertial.mass_kg < SDF_MIN_MASS_KG:
+            yield Issue(f"link '{link.name}' has mass {link.inertial.mass_kg:g} kg < "
+                        f"{SDF_MIN_MASS_KG:g} kg; Gazebo drops it",
+                        link.inertial.mass_loc or link.inertial.loc, link.name,
+                        hint="give the link its real mass")
+
+
+# Plugin parameters that name a link Gazebo must find at run time.
+_PLUGIN_LINK_PARAMS = ("linkName", "bodyName", "link_name", "body_name")
+_KEEP_FIXED_JOINT = ("disableFixedJointLumping", "preserveFixedJoint")
+
+
+def _keeps_fixed_joint(ctx: CheckContext, joint_name: str) -> bool:
+    for block in ctx.robot.gazebo:
+        if block.reference == joint_name:
+            for node in block.elements:
+                if node.tag in _KEEP_FIXED_JOINT and (node.text or "").strip().lower() == "true":
+                    return True
+    return False
+
+
+@rule("S118", "plugin-link-merged", "warning",
+      "A plugin names a link that fixed-joint lumping merges away.")
+def plugin_link_merged(ctx: CheckContext) -> Iterator[Issue]:
+    """Gazebo merges every link attached by a fixed joint into its parent when it converts
+    URDF to SDF, so the link's name no longer exists in the simulation. A plugin told to
+    use that link (`<linkName>`, `<bodyName>`) then fails to load or attaches to nothing.
+
+    Keep the joint with `<gazebo reference="JOINT"><preserveFixedJoint>true</preserveFixedJoint>
+    </gazebo>` (`disableFixedJointLumping` on older Gazebo), or make it a revolute joint
+    with zero limits, as RotorS does for its sensor links. Native SDF models are not
+    lumped, so this rule reads URDF input only.
+    """
+    if ctx.robot.source_format != "urdf":
+        return
+    for _block, plugin in ctx.robot.plugins():
+        for tag in _PLUGIN_LINK_PARAMS:
+            name = plugin.param(tag)
+            joint = ctx.parent_joint(name) if name else None
+            if joint is None or joint.moves or _keeps_fixed_joint(ctx, joint.name):
+                continue
+            yield Issue(f"plugin '{plugin.name}' <{tag}> names link '{name}', which fixed joint "
+                        f"'{joint.name}' merges into '{joint.parent}' in Gazebo",
+                        plugin.param_loc(tag), plugin.name or name,
+                        hint=f"add <gazebo reference=\"{joint.name}\"><preserveFixedJoint>true"
+                             "</preserveFixedJoint></gazebo>")

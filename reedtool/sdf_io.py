@@ -1,0 +1,520 @@
+"""SDF text -> the same Robot model urdf_io builds, keeping the source line of every element.
+
+Supported subset (SDF 1.6 to 1.11, the shape of Gazebo's own multirotor models):
+
+* The model read is the `<model>` directly under `<sdf>`, else the one model of a `<world>`
+  that is not `<static>` (if a world holds several, the one with a motor-model plugin,
+  else the first). `<include>`d models are not fetched; each one is a parse issue.
+  Nested `<model>`s are flattened with scoped names (`arm::rotor_0`).
+* Frames (SDF 1.7 semantics, which 1.6 files also follow when they use no `frame=`):
+  a link's `<pose>` is relative to the model frame; a joint's `<pose>` is relative to its
+  CHILD link; a `<frame>`'s pose is relative to its `attached_to` (default the model);
+  `relative_to=` (or 1.6's `frame=`) overrides any of them and may name a link, joint,
+  frame, nested model or `__model__`. Poses may be `degrees="true"` or
+  `rotation_format="quat_xyzw"` (SDF 1.9+). The top model's own `<pose>` is its spawn pose
+  and is ignored: the model frame is the base frame.
+* URDF has no separate joint frame: the joint frame is the child link frame. So here
+  `T_parent_joint` is the child link's pose in the parent link, and the axis is rotated
+  from the frame it is expressed in (`expressed_in=`, 1.6's `<use_parent_model_frame>`,
+  default the SDF joint frame) into the child link frame. A joint pose with a translation
+  relative to its child moves the axis line to the child origin; zero-configuration
+  poses, which everything in reedtool uses, are exact.
+* Joint types: `revolute` with no `<limit>` or with limits at +-1e16 (sdformat's
+  "unbounded", which is how sdformat writes a URDF continuous joint) is `continuous`;
+  revolute, prismatic, continuous and fixed map one to one; ball, universal, revolute2,
+  screw and gearbox keep their SDF type, which `validate` reports (S110). A parent named
+  `world` is kept as written (a model welded to the world).
+* A link without `<inertial>`, or an `<inertial>` without `<mass>`/`<inertia>`, gets
+  sdformat's defaults (1 kg, 1 kg*m^2 on the diagonal), as Gazebo simulates it, and a
+  parse issue. `<inertial auto="true">` (SDF 1.11) is not computed: a parse issue.
+* Geometry: box, cylinder, sphere and mesh (uri, scale). `model://NAME/...` resolves
+  through GZ_SIM_RESOURCE_PATH, IGN_GAZEBO_RESOURCE_PATH, SDF_PATH, GAZEBO_MODEL_PATH and
+  the directory holding the model; `package://` through the package resolver; Fuel
+  (http/https) URIs are not fetched. Planes, capsules, ellipsoids, heightmaps and
+  polylines are kept as "no geometry".
+* `<plugin>` elements directly under a `<model>` become one GazeboBlock(reference=None), so
+  rotor discovery reads gz-sim MulticopterMotorModel systems exactly as it reads URDF
+  `<gazebo>` plugins.
+
+`Robot.urdf_xml` is set to an equivalent URDF (links, inertials, primitive geometry,
+joints) so URDF-only consumers such as the Pinocchio cross-check see the same model.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+from lxml import etree
+
+from .errors import ReedtoolError
+from .xml_lines import start_line
+from .frames import make_T, matrix_to_rpy, rpy_to_matrix
+from .model import (Box, Collision, Cylinder, GazeboBlock, Inertial, Joint, JointLimit, Link,
+                    Mesh, ParseIssue, Plugin, Robot, SourceLoc, Sphere, Visual, XmlNode)
+
+MODEL_FRAME = "__model__"
+# sdformat writes "no limit" as +-1e16; anything beyond this is unbounded.
+UNBOUNDED_LIMIT = 1e15
+SDF_DEFAULT_MASS_KG = 1.0
+RESOURCE_PATH_VARS = ("GZ_SIM_RESOURCE_PATH", "IGN_GAZEBO_RESOURCE_PATH", "SDF_PATH",
+                      "GAZEBO_MODEL_PATH")
+
+
+def load_sdf_file(path: Path | str, *, resolver=None) -> Robot:
+    """Read an SDF file (a model.sdf, or a world holding one model) into a Robot."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError as exc:
+        raise ReedtoolError("file not found", file=path, hint="check the path") from exc
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ReedtoolError(f"cannot read file: {exc}", file=path) from exc
+    return parse_sdf(text, path, resolver=resolver)
+
+
+def parse_sdf(xml_text: str, file: Path | str, *, resolver=None) -> Robot:
+    file = Path(file)
+    try:
+        parser = etree.XMLParser(remove_blank_text=False, resolve_entities=False, huge_tree=True)
+        root = etree.fromstring(xml_text.encode("utf-8"), parser)
+    except etree.XMLSyntaxError as exc:
+        raise ReedtoolError(f"malformed XML: {exc.msg}", file=file, line=exc.lineno,
+                            hint="fix the XML syntax at that position") from exc
+    if root.tag != "sdf":
+        raise ReedtoolError(f"not an SDF file: the root element is <{root.tag}>, expected <sdf>",
+                            file=file, line=root.sourceline)
+    model = _pick_model(root, file)
+    if resolver is None:
+        from .packages import PackageResolver
+        resolver = PackageResolver(model_path=file)
+    robot = _ModelReader(file, resolver, xml_text).read(model)
+    robot.urdf_xml = equivalent_urdf(robot)
+    return robot
+
+
+def _children(el: etree._Element, tag: str) -> list[etree._Element]:
+    return [c for c in el if c.tag == tag]
+
+
+def _is_static(model: etree._Element) -> bool:
+    static = model.find("static")
+    return static is not None and (static.text or "").strip().lower() in ("true", "1")
+
+
+def _has_motor_plugin(model: etree._Element) -> bool:
+    return any(any(key in (p.get("name") or "") + (p.get("filename") or "")
+                   for key in ("MulticopterMotorModel", "multicopter-motor-model", "motor_model"))
+               for p in model.iter("plugin"))
+
+
+def _pick_model(root: etree._Element, file: Path) -> etree._Element:
+    models = _children(root, "model")
+    if models:
+        return models[0]
+    for world in _children(root, "world"):
+        candidates = [m for m in _children(world, "model") if not _is_static(m)]
+        if candidates:
+            with_motors = [m for m in candidates if _has_motor_plugin(m)]
+            return (with_motors or candidates)[0]
+        if _children(world, "include"):
+            include = _children(world, "include")[0]
+            raise ReedtoolError(
+                "the world only <include>s its models, which reedtool does not fetch",
+                file=file, line=include.sourceline,
+                hint="pass the included model's model.sdf instead")
+    raise ReedtoolError("no <model> found in the SDF file", file=file, line=root.sourceline,
+                        hint="pass an SDF file that contains a <model>")
+
+
+# ------------------------------------------------------------------ frames
+
+@dataclass
+class _FrameEntry:
+    relative_to: str          # scoped name of the frame the pose is expressed in
+    T_rel_frame: np.ndarray   # pose of this frame in `relative_to`
+    el: etree._Element
+
+
+class _ModelReader:
+    def __init__(self, file: Path, resolver, xml_text: str = ""):
+        self.file = file
+        self.lines = xml_text.splitlines()
+        self.resolver = resolver
+        self.issues: list[ParseIssue] = []
+        self.frames: dict[str, _FrameEntry] = {}
+        self._resolved: dict[str, np.ndarray] = {MODEL_FRAME: np.eye(4)}
+        self.link_els: list[tuple[str, str, etree._Element]] = []   # (scoped name, scope, el)
+        self.joint_els: list[tuple[str, str, etree._Element]] = []
+        self.plugin_els: list[etree._Element] = []
+        self.canonical: str | None = None
+
+    # ------------------------------------------------------------ helpers
+    def loc(self, el: etree._Element) -> SourceLoc:
+        return SourceLoc(str(self.file), start_line(el.tag, el.sourceline, self.lines))
+
+    def _issue(self, kind: str, message: str, el: etree._Element, subject: str | None) -> None:
+        self.issues.append(ParseIssue(kind, message, self.loc(el), subject))
+
+    def _numbers(self, el: etree._Element | None, counts: tuple[int, ...], default,
+                 subject: str | None) -> np.ndarray:
+        if el is None or el.text is None or not el.text.strip():
+            return np.array(default, dtype=float)
+        raw = " ".join(el.text.split())
+        try:
+            values = [float(v) for v in raw.split()]
+        except ValueError:
+            self._issue("bad-number", f"<{el.tag}>{raw}</{el.tag}> is not a list of numbers",
+                        el, subject)
+            return np.array(default, dtype=float)
+        if len(values) not in counts:
+            expected = " or ".join(str(c) for c in counts)
+            self._issue("bad-number", f"<{el.tag}>{raw}</{el.tag}> has {len(values)} number(s), "
+                        f"expected {expected}", el, subject)
+            return np.array(default, dtype=float)
+        if not all(math.isfinite(v) for v in values):
+            self._issue("non-finite", f"<{el.tag}>{raw}</{el.tag}> is not finite", el, subject)
+        return np.array(values, dtype=float)
+
+    def _number(self, parent: etree._Element | None, tag: str, default: float,
+                subject: str | None, required: bool = False) -> float:
+        el = parent.find(tag) if parent is not None else None
+        if el is None and required and parent is not None:
+            self._issue("missing-element", f"<{parent.tag}> has no <{tag}>; sdformat uses "
+                        f"{default:g}", parent, subject)
+        return float(self._numbers(el, (1,), [default], subject)[0])
+
+    def _pose(self, el: etree._Element | None,
+              subject: str | None) -> tuple[np.ndarray, str | None]:
+        """(T, relative_to as written) of a <pose>; identity and None when absent."""
+        if el is None:
+            return np.eye(4), None
+        relative_to = el.get("relative_to") or el.get("frame") or None
+        if (el.get("rotation_format") or "euler_rpy") == "quat_xyzw":
+            v = self._numbers(el, (7,), [0, 0, 0, 0, 0, 0, 1], subject)
+            x, y, z, w = v[3:]
+            norm = math.sqrt(x * x + y * y + z * z + w * w) or 1.0
+            x, y, z, w = x / norm, y / norm, z / norm, w / norm
+            R = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                          [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                          [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+            return make_T(R, v[:3]), relative_to
+        v = self._numbers(el, (6,), [0, 0, 0, 0, 0, 0], subject)
+        rpy = np.radians(v[3:]) if (el.get("degrees") or "").lower() in ("true", "1") else v[3:]
+        return make_T(rpy_to_matrix(rpy), v[:3]), relative_to
+
+    @staticmethod
+    def _scoped(scope: str, name: str | None) -> str:
+        if not name or name == MODEL_FRAME:
+            return scope + MODEL_FRAME
+        if name == "world":
+            return "world"
+        return scope + name
+
+    def T_model(self, name: str, el: etree._Element, subject: str | None,
+                _seen: tuple[str, ...] = ()) -> np.ndarray:
+        """Pose of frame `name` (scoped) in the top model frame at zero joint positions."""
+        if name in self._resolved:
+            return self._resolved[name]
+        entry = self.frames.get(name)
+        if entry is None or name in _seen:
+            what = "is part of a cycle of relative_to frames" if name in _seen else \
+                "names no link, joint, frame or model"
+            self._issue("unknown-frame", f"frame '{name}' {what}; using the model frame", el,
+                        subject)
+            self._resolved[name] = np.eye(4)
+            return self._resolved[name]
+        T = self.T_model(entry.relative_to, entry.el, subject, _seen + (name,)) @ entry.T_rel_frame
+        self._resolved[name] = T
+        return T
+
+    def _node(self, el: etree._Element) -> XmlNode:
+        children = [self._node(c) for c in el if isinstance(c.tag, str)]
+        return XmlNode(tag=el.tag, attrib=dict(el.attrib), text=el.text, children=children,
+                       loc=self.loc(el))
+
+    # ------------------------------------------------------------ collect
+    def _collect(self, model: etree._Element, scope: str) -> None:
+        """Register every frame of `model` (and its nested models) under scoped names."""
+        for el in model:
+            if not isinstance(el.tag, str):
+                continue
+            name = el.get("name") or ""
+            if el.tag == "link":
+                T, rel = self._pose(el.find("pose"), name)
+                self.frames[scope + name] = _FrameEntry(self._scoped(scope, rel), T, el)
+                self.link_els.append((scope + name, scope, el))
+            elif el.tag == "joint":
+                T, rel = self._pose(el.find("pose"), name)
+                child = (el.findtext("child") or "").strip()
+                self.frames[scope + name] = _FrameEntry(
+                    self._scoped(scope, rel) if rel else self._scoped(scope, child), T, el)
+                self.joint_els.append((scope + name, scope, el))
+            elif el.tag == "frame":
+                T, rel = self._pose(el.find("pose"), name)
+                self.frames[scope + name] = _FrameEntry(
+                    self._scoped(scope, rel or el.get("attached_to")), T, el)
+            elif el.tag == "model":
+                T, rel = self._pose(el.find("pose"), name)
+                nested = scope + name + "::"
+                self.frames[nested + MODEL_FRAME] = _FrameEntry(self._scoped(scope, rel), T, el)
+                self._collect(el, nested)
+            elif el.tag == "plugin":
+                self.plugin_els.append(el)
+            elif el.tag == "include":
+                uri = (el.findtext("uri") or "").strip()
+                self._issue("sdf-include", f"<include> of '{uri}' is not read; its links, joints "
+                            "and plugins are missing from the model reedtool checks", el, uri)
+
+    # ------------------------------------------------------------ elements
+    def read(self, model: etree._Element) -> Robot:
+        name = model.get("name", "")
+        self._collect(model, "")
+        canonical = model.get("canonical_link")
+        robot = Robot(name=name, loc=self.loc(model), source_file=self.file,
+                      source_format="sdf")
+        for scoped, scope, el in self.link_els:
+            robot.links.append(self._link(scoped, scope, el))
+        for scoped, scope, el in self.joint_els:
+            robot.joints.append(self._joint(scoped, scope, el))
+        # The canonical link is the model's base; keep it first so it is the root found first.
+        if canonical and canonical in robot.link_map:
+            robot.links.sort(key=lambda link: link.name != canonical)
+            robot.__dict__.pop("link_map", None)
+        if self.plugin_els:
+            block = GazeboBlock(reference=None, loc=self.loc(self.plugin_els[0]))
+            for el in self.plugin_els:
+                node = self._node(el)
+                block.plugins.append(Plugin(name=el.get("name"), filename=el.get("filename"),
+                                            node=node, loc=node.loc))
+            robot.gazebo.append(block)
+        robot.parse_issues = self.issues
+        return robot
+
+    def _T_link_X(self, link_scoped: str, scope: str, pose_el: etree._Element | None,
+                  subject: str) -> np.ndarray:
+        """Pose of a <visual>/<collision>/<inertial> frame in its link frame."""
+        T, rel = self._pose(pose_el, subject)
+        if not rel or self._scoped(scope, rel) == link_scoped:
+            return T
+        T_model_link = self.T_model(link_scoped, pose_el, subject)
+        T_model_rel = self.T_model(self._scoped(scope, rel), pose_el, subject)
+        return np.linalg.inv(T_model_link) @ T_model_rel @ T
+
+    def _link(self, scoped: str, scope: str, el: etree._Element) -> Link:
+        link = Link(name=scoped, loc=self.loc(el))
+        if not el.get("name"):
+            self._issue("missing-attribute", "<link> has no name= attribute", el, None)
+        inertial_el = el.find("inertial")
+        if inertial_el is None:
+            self._issue("missing-element", f"link '{scoped}' has no <inertial>: sdformat gives it "
+                        "a mass of 1 kg and an inertia of 1 kg*m^2", el, scoped)
+            link.inertial = Inertial(SDF_DEFAULT_MASS_KG, np.eye(4), np.eye(3), self.loc(el))
+        else:
+            link.inertial = self._inertial(scoped, scope, inertial_el)
+        for v in _children(el, "visual"):
+            material = v.find("material")
+            script = material.findtext("script/name") if material is not None else None
+            link.visuals.append(Visual(
+                geometry=self._geometry(v.find("geometry"), scoped),
+                T_link_geom=self._T_link_X(scoped, scope, v.find("pose"), scoped),
+                loc=self.loc(v), name=v.get("name"), material=script))
+        for c in _children(el, "collision"):
+            link.collisions.append(Collision(
+                geometry=self._geometry(c.find("geometry"), scoped),
+                T_link_geom=self._T_link_X(scoped, scope, c.find("pose"), scoped),
+                loc=self.loc(c), name=c.get("name")))
+        return link
+
+    def _inertial(self, link: str, scope: str, el: etree._Element) -> Inertial:
+        if (el.get("auto") or "").lower() in ("true", "1"):
+            self._issue("sdf-auto-inertial", f"link '{link}': <inertial auto=\"true\"> is not "
+                        "computed by reedtool; write the mass and inertia out", el, link)
+        mass_el = el.find("mass")
+        mass = self._number(el, "mass", SDF_DEFAULT_MASS_KG, link, required=True)
+        inertia_el = el.find("inertia")
+        if inertia_el is None:
+            self._issue("missing-element", f"link '{link}': <inertial> has no <inertia>; "
+                        "sdformat uses 1 kg*m^2 on the diagonal", el, link)
+        v = {k: self._number(inertia_el, k, 1.0 if k in ("ixx", "iyy", "izz") else 0.0, link)
+             for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
+        tensor = np.array([[v["ixx"], v["ixy"], v["ixz"]],
+                           [v["ixy"], v["iyy"], v["iyz"]],
+                           [v["ixz"], v["iyz"], v["izz"]]])
+        return Inertial(mass_kg=mass, T_link_com=self._T_link_X(link, scope, el.find("pose"), link),
+                        inertia_kg_m2=tensor, loc=self.loc(el),
+                        mass_loc=self.loc(mass_el) if mass_el is not None else None,
+                        inertia_loc=self.loc(inertia_el) if inertia_el is not None else None)
+
+    def _geometry(self, el: etree._Element | None, link: str):
+        if el is None:
+            return None
+        shape = next((c for c in el if isinstance(c.tag, str)), None)
+        if shape is None:
+            self._issue("missing-element", "<geometry> is empty", el, link)
+            return None
+        if shape.tag == "box":
+            return Box(size_m=self._numbers(shape.find("size"), (3,), [1.0, 1.0, 1.0], link))
+        if shape.tag == "cylinder":
+            return Cylinder(radius_m=self._number(shape, "radius", 1.0, link, required=True),
+                            length_m=self._number(shape, "length", 1.0, link, required=True))
+        if shape.tag == "sphere":
+            return Sphere(radius_m=self._number(shape, "radius", 1.0, link, required=True))
+        if shape.tag == "mesh":
+            return self._mesh(shape, link)
+        return None  # plane, capsule, ellipsoid, heightmap, polyline: not modelled
+
+    def _mesh(self, el: etree._Element, link: str) -> Mesh:
+        uri = (el.findtext("uri") or "").strip()
+        scale = self._numbers(el.find("scale"), (3,), [1.0, 1.0, 1.0], link)
+        if not uri:
+            self._issue("missing-element", "<mesh> has no <uri>", el, link)
+            return Mesh(uri="", path=None, scale=scale, resolve_error="no uri")
+        try:
+            return Mesh(uri=uri, path=self._resolve_uri(uri), scale=scale)
+        except ReedtoolError as exc:
+            return Mesh(uri=uri, path=None, scale=scale, resolve_error=exc.message)
+
+    def _resolve_uri(self, uri: str) -> Path:
+        if uri.startswith("model://"):
+            name, _, rel = uri[len("model://"):].partition("/")
+            model_dir = self.file.parent
+            roots = [Path(p) for var in RESOURCE_PATH_VARS
+                     for p in os.environ.get(var, "").split(os.pathsep) if p]
+            candidates = [root / name for root in roots]
+            if model_dir.name == name:
+                candidates.append(model_dir)
+            candidates.append(model_dir.parent / name)
+            for candidate in candidates:
+                if candidate.is_dir():
+                    return candidate / rel
+            raise ReedtoolError(f"model '{name}' not found in {', '.join(RESOURCE_PATH_VARS)} "
+                                "or next to the model")
+        if uri.startswith(("http://", "https://")):
+            raise ReedtoolError("Fuel/HTTP URIs are not fetched")
+        return Path(self.resolver.resolve_uri(uri, self.file.parent))
+
+    def _joint(self, scoped: str, scope: str, el: etree._Element) -> Joint:
+        sdf_type = el.get("type", "")
+        parent_text, child_text = el.findtext("parent"), el.findtext("child")
+        parent = self._scoped(scope, parent_text.strip()) if parent_text else None
+        child = self._scoped(scope, child_text.strip()) if child_text else None
+        if parent is None:
+            self._issue("missing-element", f"joint '{scoped}' has no <parent>", el, scoped)
+        if child is None:
+            self._issue("missing-element", f"joint '{scoped}' has no <child>", el, scoped)
+
+        # URDF-style joint frame = child link frame.
+        T_parent_child = np.eye(4)
+        if parent and child and child in self.frames:
+            T_model_parent = np.eye(4) if parent == "world" else self.T_model(parent, el, scoped)
+            T_parent_child = np.linalg.inv(T_model_parent) @ self.T_model(child, el, scoped)
+
+        axis_el = el.find("axis")
+        xyz_el = axis_el.find("xyz") if axis_el is not None else None
+        axis = self._numbers(xyz_el, (3,), [0.0, 0.0, 1.0], scoped)
+        if xyz_el is not None and child in self.frames:
+            expressed_in = xyz_el.get("expressed_in")
+            if expressed_in is None and (axis_el.findtext("use_parent_model_frame") or "") \
+                    .strip().lower() in ("true", "1"):
+                expressed_in = MODEL_FRAME
+            frame = self._scoped(scope, expressed_in) if expressed_in else scoped
+            R_child_frame = (np.linalg.inv(self.T_model(child, el, scoped))
+                             @ self.T_model(frame, xyz_el, scoped))[:3, :3]
+            axis = R_child_frame @ axis
+
+        limit_el = axis_el.find("limit") if axis_el is not None else None
+        joint_type, limit = self._joint_type(sdf_type, limit_el, scoped)
+        # T_parent_joint is written in the child link's <pose> (URDF writes it in <origin>).
+        child_entry = self.frames.get(child or "")
+        pose_el = child_entry.el.find("pose") if child_entry is not None else None
+        return Joint(name=scoped, type=joint_type, parent=parent, child=child,
+                     T_parent_joint=T_parent_child, axis=axis, loc=self.loc(el), limit=limit,
+                     axis_loc=self.loc(xyz_el) if xyz_el is not None else None,
+                     origin_loc=self.loc(pose_el) if pose_el is not None else None)
+
+    def _joint_type(self, sdf_type: str, limit_el: etree._Element | None,
+                    name: str) -> tuple[str, JointLimit | None]:
+        if sdf_type not in ("revolute", "prismatic", "continuous"):
+            return sdf_type, None
+        lower = self._number(limit_el, "lower", -1e16, name)
+        upper = self._number(limit_el, "upper", 1e16, name)
+        effort = self._number(limit_el, "effort", -1.0, name)
+        velocity = self._number(limit_el, "velocity", -1.0, name)
+        # SDF writes "no effort/velocity limit" as -1; URDF needs a number, so: unlimited.
+        limit = JointLimit(lower=lower, upper=upper,
+                           effort=effort if effort >= 0 else math.inf,
+                           velocity=velocity if velocity >= 0 else math.inf,
+                           loc=self.loc(limit_el) if limit_el is not None else SourceLoc(
+                               str(self.file)))
+        if sdf_type == "continuous" or (sdf_type == "revolute" and lower <= -UNBOUNDED_LIMIT
+                                        and upper >= UNBOUNDED_LIMIT):
+            return "continuous", limit if limit_el is not None else None
+        return sdf_type, limit
+
+
+# ------------------------------------------------------------ equivalent URDF
+
+def _fmt(values) -> str:
+    return " ".join(f"{float(v):.12g}" for v in values)
+
+
+def _origin(T: np.ndarray) -> str:
+    return f'<origin xyz="{_fmt(T[:3, 3])}" rpy="{_fmt(matrix_to_rpy(T[:3, :3]))}"/>'
+
+
+def _geometry_xml(geometry) -> str | None:
+    if isinstance(geometry, Box):
+        return f'<box size="{_fmt(geometry.size_m)}"/>'
+    if isinstance(geometry, Cylinder):
+        return f'<cylinder radius="{geometry.radius_m:.12g}" length="{geometry.length_m:.12g}"/>'
+    if isinstance(geometry, Sphere):
+        return f'<sphere radius="{geometry.radius_m:.12g}"/>'
+    if isinstance(geometry, Mesh) and geometry.path is not None:
+        return f'<mesh filename={quoteattr(str(geometry.path))} scale="{_fmt(geometry.scale)}"/>'
+    return None
+
+
+def _limit_number(value: float | None) -> float:
+    return 1e16 if value is None or not math.isfinite(value) else value
+
+
+def equivalent_urdf(robot: Robot) -> str:
+    """A URDF with the same links, inertials, primitive geometry and joints as `robot`."""
+    lines = [f"<robot name={quoteattr(robot.name)}>"]
+    for link in robot.links:
+        lines.append(f"  <link name={quoteattr(link.name)}>")
+        if link.inertial is not None:
+            I = link.inertial.inertia_kg_m2
+            lines.append(
+                f"    <inertial>{_origin(link.inertial.T_link_com)}"
+                f'<mass value="{link.inertial.mass_kg:.12g}"/>'
+                f'<inertia ixx="{I[0, 0]:.12g}" ixy="{I[0, 1]:.12g}" ixz="{I[0, 2]:.12g}" '
+                f'iyy="{I[1, 1]:.12g}" iyz="{I[1, 2]:.12g}" izz="{I[2, 2]:.12g}"/></inertial>')
+        for tag, shapes in (("visual", link.visuals), ("collision", link.collisions)):
+            for shape in shapes:
+                geometry = _geometry_xml(shape.geometry)
+                if geometry:
+                    lines.append(f"    <{tag}>{_origin(shape.T_link_geom)}"
+                                 f"<geometry>{geometry}</geometry></{tag}>")
+        lines.append("  </link>")
+    for joint in robot.joints:
+        if joint.parent is None or joint.child is None:
+            continue
+        lines.append(f"  <joint name={quoteattr(joint.name)} type={quoteattr(joint.type)}>"
+                     f"<parent link={quoteattr(joint.parent)}/>"
+                     f"<child link={quoteattr(joint.child)}/>"
+                     f'{_origin(joint.T_parent_joint)}<axis xyz="{_fmt(joint.axis)}"/>')
+        if joint.limit is not None and joint.type in ("revolute", "prismatic", "continuous"):
+            lim = joint.limit
+            bounds = "" if joint.type == "continuous" else \
+                f'lower="{_limit_number(lim.lower):.12g}" upper="{_limit_number(lim.upper):.12g}" '
+            lines.append(f'    <limit {bounds}effort="{_limit_number(lim.effort):.12g}" '
+                         f'velocity="{_limit_number(lim.velocity):.12g}"/>')
+        lines.append("  </joint>")
+    lines.append("</robot>")
+    return "\n".join(lines) + "\n"

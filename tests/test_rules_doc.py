@@ -1,0 +1,27 @@
+"""docs/rules.md is generated from the registry; this fails when they drift apart."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from reedtool.checks.registry import all_rules
+from reedtool.rules_doc import DOC_PATH, render
+
+
+def test_rules_md_is_up_to_date():
+    assert DOC_PATH == Path(__file__).resolve().parent.parent / "docs" / "rules.md"
+    assert DOC_PATH.read_text(encoding="utf-8") == render(), (
+        "docs/rules.md is stale: run `python -m reedtool.rules_doc --write`")
+
+
+def test_every_rule_is_documented_once():
+    text = render()
+    rules = all_rules()
+    assert len({r.code for r in rules}) == len(rules)
+    assert len({r.slug for r in rules}) == len(rules)
+    for rule in rules:
+        assert re.fullmatch(r"[A-Z]\d{3}", rule.code)
+        assert text.count(f"\n### {rule.code} {rule.slug}\n") == 1
+        assert len(rule.explanation) > 80, f"{rule.code} needs a real explanation"
+        assert "\n" not in rule.summary

@@ -1,0 +1,65 @@
+"""Inertia rules (I2xx): codes per fixture, and the hint's tensor against the textbook formula."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from reedtool.checks.runner import run_checks
+from reedtool.loader import load_robot
+
+FIXTURES = Path(__file__).parent / "fixtures" / "validate"
+
+
+def codes(name: str) -> list[str]:
+    return sorted(f.code for f in run_checks(load_robot(FIXTURES / name)))
+
+
+CASES = [
+    ("I201_bad_negative_mass.urdf", ["I201"]),
+    ("I201_bad_zero_mass.urdf", ["I201"]),
+    ("I202_bad_zero_moment.urdf", ["I202"]),
+    ("I202_bad_products.urdf", ["I202"]),
+    ("I203_bad_triangle.urdf", ["I203"]),
+    ("I204_bad_placeholder.urdf", ["I204"]),
+    ("I204_bad_too_small.urdf", ["I204"]),
+    ("I205_bad_com.urdf", ["I205"]),
+    ("I206_bad_mm_mesh.urdf", ["I206"]),
+    # Good: zero mass on a fixed frame, a thin but valid cylinder, a mesh in metres.
+    ("clean_arm.urdf", []),
+    ("clean_car.urdf", []),
+]
+
+
+@pytest.mark.parametrize("name,expected", CASES, ids=[c[0] for c in CASES])
+def test_inertia_rule_codes(name, expected):
+    assert codes(name) == expected
+
+
+def _attrs(text: str) -> dict[str, float]:
+    return {k: float(v) for k, v in re.findall(r'(i[xyz]{2})="([^"]+)"', text)}
+
+
+def test_placeholder_hint_gives_the_cylinder_tensor():
+    (finding,) = run_checks(load_robot(FIXTURES / "I204_bad_placeholder.urdf"))
+    m, r, h = 0.5, 0.05, 0.3  # link1: solid cylinder along z
+    expected = {"ixx": m * (3 * r * r + h * h) / 12, "iyy": m * (3 * r * r + h * h) / 12,
+                "izz": m * r * r / 2, "ixy": 0.0, "ixz": 0.0, "iyz": 0.0}
+    assert _attrs(finding.hint) == pytest.approx(expected, rel=1e-5)
+
+
+def test_triangle_threshold_is_relative_to_the_largest_moment():
+    from reedtool.checks import inertia_rules
+
+    # A flat plate: izz = ixx + iyy exactly; hand-rounding it stays within tolerance.
+    assert 0.0833 + 0.0833 >= 0.1667 - inertia_rules.TRIANGLE_REL_TOL * 0.1667
+    # The seed's body (0.0347563 + 0.0458929 < 0.0977) is far outside it.
+    assert 0.0347563 + 0.0458929 < 0.0977 * (1 - inertia_rules.TRIANGLE_REL_TOL)
+
+
+def test_mm_mesh_hint_suggests_millimetre_scale():
+    (finding,) = run_checks(load_robot(FIXTURES / "I206_bad_mm_mesh.urdf"))
+    assert 'scale="0.001 0.001 0.001"' in finding.hint
+    assert "60 m" in finding.message  # the 60 mm camera read as metres
