@@ -92,6 +92,16 @@ class Collision:
     name: str | None = None
 
 
+INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+
+
+def inertia_tensor(values: dict[str, float]) -> np.ndarray:
+    """The symmetric 3x3 tensor from URDF/SDF's six numbers (keys INERTIA_KEYS)."""
+    return np.array([[values["ixx"], values["ixy"], values["ixz"]],
+                     [values["ixy"], values["iyy"], values["iyz"]],
+                     [values["ixz"], values["iyz"], values["izz"]]], dtype=float)
+
+
 @dataclass
 class Inertial:
     mass_kg: float

@@ -54,8 +54,9 @@ from lxml import etree
 from .errors import ReedtoolError
 from .xml_lines import start_line
 from .frames import make_T, matrix_to_rpy, rpy_to_matrix
-from .model import (Box, Collision, Cylinder, GazeboBlock, Inertial, Joint, JointLimit, Link,
-                    Mesh, ParseIssue, Plugin, Robot, SourceLoc, Sphere, Visual, XmlNode)
+from .model import (INERTIA_KEYS, Box, Collision, Cylinder, GazeboBlock, Inertial, Joint,
+                    JointLimit, Link, Mesh, ParseIssue, Plugin, Robot, SourceLoc, Sphere, Visual,
+                    XmlNode, inertia_tensor)
 
 MODEL_FRAME = "__model__"
 # sdformat writes "no limit" as +-1e16; anything beyond this is unbounded.
@@ -340,11 +341,10 @@ class _ModelReader:
         if inertia_el is None:
             self._issue("missing-element", f"link '{link}': <inertial> has no <inertia>; "
                         "sdformat uses 1 kg*m^2 on the diagonal", el, link)
+        # sdformat's defaults: 1 kg*m^2 on the diagonal, 0 off it.
         v = {k: self._number(inertia_el, k, 1.0 if k in ("ixx", "iyy", "izz") else 0.0, link)
-             for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
-        tensor = np.array([[v["ixx"], v["ixy"], v["ixz"]],
-                           [v["ixy"], v["iyy"], v["iyz"]],
-                           [v["ixz"], v["iyz"], v["izz"]]])
+             for k in INERTIA_KEYS}
+        tensor = inertia_tensor(v)
         return Inertial(mass_kg=mass, T_link_com=self._T_link_X(link, scope, el.find("pose"), link),
                         inertia_kg_m2=tensor, loc=self.loc(el),
                         mass_loc=self.loc(mass_el) if mass_el is not None else None,

@@ -18,8 +18,9 @@ from lxml import etree
 from .errors import ReedtoolError
 from .frames import make_T, rpy_to_matrix
 from .xml_lines import start_line
-from .model import (Box, Collision, Cylinder, GazeboBlock, Inertial, Joint, JointLimit, Link,
-                    Mesh, ParseIssue, Plugin, Robot, SourceLoc, Sphere, Visual, XmlNode)
+from .model import (INERTIA_KEYS, Box, Collision, Cylinder, GazeboBlock, Inertial, Joint,
+                    JointLimit, Link, Mesh, ParseIssue, Plugin, Robot, SourceLoc, Sphere, Visual,
+                    XmlNode, inertia_tensor)
 
 Locator = Callable[[etree._Element], SourceLoc]
 
@@ -179,12 +180,9 @@ class _RobotReader:
         if inertia_el is None:
             self._issue("missing-element", "<inertial> has no <inertia>", el, link)
         values = {k: self._float(inertia_el, k, 0.0, link, required=inertia_el is not None)
-                  for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
-        tensor = np.array([[values["ixx"], values["ixy"], values["ixz"]],
-                           [values["ixy"], values["iyy"], values["iyz"]],
-                           [values["ixz"], values["iyz"], values["izz"]]], dtype=float)
+                  for k in INERTIA_KEYS}
         return Inertial(mass_kg=float(mass), T_link_com=self._origin(el.find("origin"), link),
-                        inertia_kg_m2=tensor, loc=self.locate(el),
+                        inertia_kg_m2=inertia_tensor(values), loc=self.locate(el),
                         mass_loc=self.locate(mass_el) if mass_el is not None else None,
                         inertia_loc=self.locate(inertia_el) if inertia_el is not None else None)
 

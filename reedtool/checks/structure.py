@@ -122,13 +122,7 @@ def duplicate_link_name(ctx: CheckContext) -> Iterator[Issue]:
     """Link names must be unique. A macro instantiated twice without a distinct prefix or
     suffix is the usual cause; urdfdom rejects the file.
     """
-    seen: set[str] = set()
-    for link in ctx.robot.links:
-        if link.name in seen:
-            first = ctx.robot.link_map[link.name]
-            yield Issue(f"link '{link.name}' is declared again (first at {first.loc})",
-                        link.loc, link.name, hint="give each link a unique name")
-        seen.add(link.name)
+    yield from _redeclared(ctx.robot.links, ctx.robot.link_map, "link")
 
 
 @rule("S107", "duplicate-joint-name", "error", "Two joints have the same name.")
@@ -136,13 +130,18 @@ def duplicate_joint_name(ctx: CheckContext) -> Iterator[Issue]:
     """Joint names must be unique; urdfdom rejects the file otherwise, and Gazebo plugins
     that look a joint up by name would find only one of them.
     """
+    yield from _redeclared(ctx.robot.joints, ctx.robot.joint_map, "joint")
+
+
+def _redeclared(elements, first_by_name, kind: str) -> Iterator[Issue]:
+    """Every element whose name an earlier element already took."""
     seen: set[str] = set()
-    for joint in ctx.robot.joints:
-        if joint.name in seen:
-            first = ctx.robot.joint_map[joint.name]
-            yield Issue(f"joint '{joint.name}' is declared again (first at {first.loc})",
-                        joint.loc, joint.name, hint="give each joint a unique name")
-        seen.add(joint.name)
+    for element in elements:
+        if element.name in seen:
+            first = first_by_name[element.name]
+            yield Issue(f"{kind} '{element.name}' is declared again (first at {first.loc})",
+                        element.loc, element.name, hint=f"give each {kind} a unique name")
+        seen.add(element.name)
 
 
 @rule("S108", "link-multiple-parents", "error", "A link is the child of more than one joint.")
