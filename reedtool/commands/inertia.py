@@ -1,0 +1,249 @@
+"""`reedtool inertia`: declared link inertia against the geometry's; whole-robot properties."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import click
+import numpy as np
+
+from ..errors import ReedtoolError
+
+
+def _vec(v, fmt: str = ".6g") -> str:
+    # Sub-picometre values are round-off, not geometry: show them as 0.
+    return "(" + ", ".join(format((0.0 if abs(x) < 1e-12 else float(x)) + 0.0, fmt)
+                           for x in v) + ")"
+
+
+def _tensor_line(I) -> str:
+    from ..inertia import clean_tensor
+
+    I = clean_tensor(I)
+    return (f"ixx {I[0, 0]:.4g}  iyy {I[1, 1]:.4g}  izz {I[2, 2]:.4g}  "
+            f"ixy {I[0, 1]:.4g}  ixz {I[0, 2]:.4g}  iyz {I[1, 2]:.4g}")
+
+
+def _props_json(props) -> dict | None:
+    if props is None:
+        return None
+    out = {"mass_kg": props.mass_kg, "com_m": [float(x) for x in props.com_m],
+           "inertia_kg_m2": [[float(x) for x in row] for row in props.inertia_kg_m2]}
+    if props.volume_m3 is not None:
+        out["volume_m3"] = props.volume_m3
+    if props.from_hull:
+        out["from_hull"] = True
+    return out
+
+
+def _finite_or_none(value):
+    return None if value is None or not np.isfinite(value) else value
+
+
+def format_text(model: Path, robot, comparisons, whole, own) -> str:
+    from ..inertia import clean_tensor
+    from ..report import display_path
+
+    lines = [f"{display_path(str(model))}: {len(robot.links)} links, base frame "
+             f"'{robot.base_link}'", ""]
+    for c in comparisons:
+        where = display_path(c.loc.file) + (f":{c.loc.line}" if c.loc.line else "")
+        lines.append(f"{c.link}  [{c.verdict}]  {where}")
+        lines.append(f"  {c.message}")
+        if c.declared is not None and c.derived is not None:
+            lines.append(f"  mass      {c.declared.mass_kg:.6g} kg")
+            lines.append(f"  COM       declared {_vec(c.declared.com_m)} m, geometry "
+                         f"{_vec(c.derived.com_m)} m, offset {c.com_offset_m * 1000:.3g} mm")
+            lines.append(f"  declared  {_tensor_line(c.declared.inertia_kg_m2)}")
+            lines.append(f"  {c.geometry.split()[0]:<9} {_tensor_line(c.derived.inertia_kg_m2)}")
+            lines.append(f"  relative difference {c.inertia_rel_diff:.3g}")
+        elif c.declared is not None:
+            lines.append(f"  mass      {c.declared.mass_kg:.6g} kg, COM {_vec(c.declared.com_m)} m")
+            lines.append(f"  declared  {_tensor_line(c.declared.inertia_kg_m2)}")
+        lines.append("")
+    lines.append(f"whole robot (Pinocchio; base frame '{robot.base_link}', joints at zero):")
+    lines.append(f"  total mass  {whole.mass_kg:.6g} kg")
+    lines.append(f"  COM         {_vec(whole.com_m)} m")
+    I = whole.inertia_kg_m2
+    lines.append(f"  inertia about the COM, base axes [kg*m^2]:")
+    for row in clean_tensor(I):
+        lines.append("    [" + " ".join(f"{x:>13.6g}" for x in row) + " ]")
+    mass_gap = abs(own.mass_kg - whole.mass_kg)
+    com_gap = float(np.linalg.norm(own.com_m - whole.com_m))
+    agree = mass_gap <= 1e-9 * max(1.0, whole.mass_kg) and com_gap <= 1e-9
+    lines.append(f"  reedtool's own sum over links {'agrees' if agree else 'DISAGREES'}: "
+                 f"mass {own.mass_kg:.6g} kg, COM {_vec(own.com_m)} m")
+    failing = [c for c in comparisons if c.failing]
+    lines.append("")
+    if failing:
+        lines.append(f"{len(failing)} of {len(comparisons)} links need attention: "
+                     + ", ".join(f"{c.link} ({c.verdict})" for c in failing))
+        lines.append("pass --fix to write the geometry's inertia into a .urdf, or to print "
+                     "the blocks to paste into a .xacro")
+    else:
+        lines.append("no link inertia needs attention")
+    return "\n".join(lines) + "\n"
+
+
+def format_json(model: Path, robot, comparisons, whole, own) -> str:
+    doc = {
+        "model": str(model),
+        "base_link": robot.base_link,
+        "links": [{
+            "link": c.link, "file": c.loc.file, "line": c.loc.line, "verdict": c.verdict,
+            "message": c.message, "geometry": c.geometry,
+            "declared": _props_json(c.declared), "derived": _props_json(c.derived),
+            "inertia_rel_diff": _finite_or_none(c.inertia_rel_diff),
+            "trace_ratio": _finite_or_none(c.trace_ratio),
+            "com_offset_m": c.com_offset_m,
+        } for c in comparisons],
+        "whole_robot": {**_props_json(whole), "source": "pinocchio"},
+        "own_sum": _props_json(own),
+        "failing": sum(c.failing for c in comparisons),
+    }
+    return json.dumps(doc, indent=2) + "\n"
+
+
+# ------------------------------------------------------------------ --fix
+
+_INERTIAL_OPEN = re.compile(r"<inertial\b[^>]*?(/?)>")
+
+
+def _inertial_span(text: str, line: int) -> tuple[int, int]:
+    """Character span of the <inertial> element that starts on `line` (1-based)."""
+    start_of_line = 0
+    for _ in range(line - 1):
+        start_of_line = text.index("\n", start_of_line) + 1
+    match = _INERTIAL_OPEN.search(text, start_of_line)
+    if match is None:
+        raise ValueError(f"no <inertial> at line {line}")
+    if match.group(1):                       # <inertial/>
+        return match.start(), match.end()
+    close = text.find("</inertial>", match.end())
+    if close < 0:
+        raise ValueError(f"unclosed <inertial> at line {line}")
+    return match.start(), close + len("</inertial>")
+
+
+def fix_urdf_text(text: str, fixes: list[tuple[int, object]]) -> str:
+    """Replace each <inertial> starting on the given line with a block for the given props.
+
+    Text is spliced, not re-serialised, so everything else in the file stays byte for byte.
+    """
+    from ..inertia import inertial_xml
+
+    spans = []
+    for line, props in fixes:
+        start, end = _inertial_span(text, line)
+        indent = text[text.rfind("\n", 0, start) + 1:start]
+        block = inertial_xml(props, indent=indent if not indent.strip() else "")
+        spans.append((start, end, block.lstrip()))
+    for start, end, block in sorted(spans, reverse=True):
+        text = text[:start] + block + text[end:]
+    return text
+
+
+def apply_fix_urdf(model: Path, comparisons, force: bool) -> list[str]:
+    from ..fileio import atomic_write_text
+    from ..urdf_io import parse_urdf
+
+    todo = [(c, c.corrected()) for c in comparisons]
+    todo = [(c, props) for c, props in todo if props is not None]
+    if not todo:
+        return ["--fix: nothing to change"]
+    backup = model.with_name(model.name + ".bak")
+    if backup.exists() and not force:
+        raise ReedtoolError("refusing to overwrite the existing backup", file=backup,
+                            hint="move it away, or pass --force to replace it")
+    text = model.read_text(encoding="utf-8")
+    fixes = []
+    for c, props in todo:
+        if c.loc.line is None or Path(c.loc.file).resolve() != model.resolve():
+            raise ReedtoolError(f"cannot locate the <inertial> of link '{c.link}'", file=model)
+        fixes.append((c.loc.line, props))
+    new_text = fix_urdf_text(text, fixes)
+    # Check the edit before it replaces the user's file: every fixed link reads back as meant.
+    check = parse_urdf(new_text, model)
+    for c, props in todo:
+        read_back = check.link_map[c.link].inertial
+        if (read_back is None or not np.isclose(read_back.mass_kg, props.mass_kg, rtol=1e-9)
+                or not np.allclose(read_back.inertia_in_link_axes(), props.inertia_kg_m2,
+                                   rtol=1e-8, atol=1e-12 * np.abs(props.inertia_kg_m2).max())):
+            raise ReedtoolError(f"internal check failed rewriting link '{c.link}'; "
+                                "the file was left unchanged", file=model)
+    atomic_write_text(model, new_text, force=True, backup=True)
+    return [f"--fix: rewrote <inertial> of {', '.join(c.link for c, _ in todo)} in {model} "
+            f"(backup: {backup})"]
+
+
+def print_fix_xacro(comparisons) -> list[str]:
+    from ..inertia import inertial_xml
+
+    lines = []
+    for c in comparisons:
+        props = c.corrected()
+        if props is None:
+            continue
+        if c.loc.macro:
+            # The element is written once in the macro body; the call says which link.
+            where = f"in the macro body at {c.loc.macro} (the call at {c.loc})"
+        else:
+            where = f"at {c.loc}"
+        lines.append(f"--fix: link '{c.link}': replace the <inertial> {where} with")
+        lines.append(inertial_xml(props, indent="  "))
+        lines.append("")
+    return lines or ["--fix: nothing to change"]
+
+
+@click.command("inertia")
+@click.argument("model", type=click.Path(path_type=Path, dir_okay=False))
+@click.argument("mappings", nargs=-1)
+@click.option("--package-path", "package_paths", multiple=True, metavar="DIR",
+              type=click.Path(path_type=Path, file_okay=False),
+              help="Directory to search for ROS packages first (repeatable).")
+@click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
+              show_default=True, help="Output format.")
+@click.option("--fix", is_flag=True,
+              help="Write the geometry's inertia into a .urdf (with a .bak backup); for a "
+                   ".xacro, print the blocks to paste and where.")
+@click.option("--force", is_flag=True, help="With --fix, replace an existing .bak backup.")
+def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...], fmt: str,
+            fix: bool, force: bool) -> int:
+    """Compare each link's declared inertia with its geometry's; whole-robot mass properties.
+
+    MODEL is a .urdf or .xacro (xacro arguments as NAME:=VALUE). Geometry is the first
+    collision shape, else the first visual, as a uniform solid with the declared mass.
+    Exit 0 when no link needs attention, 1 otherwise, 2 on unreadable input.
+    """
+    from ..expand import parse_mappings
+    from ..inertia import compare_links, whole_robot
+    from ..loader import load_robot
+    from ..pinocchio_bridge import whole_robot_pinocchio
+
+    robot = load_robot(model, parse_mappings(mappings), list(package_paths))
+    if fix and robot.source_format != "urdf":
+        # The blocks --fix writes or prints are URDF <inertial>; SDF spells them differently.
+        raise ReedtoolError("--fix edits URDF and xacro models only", file=model,
+                            hint="run without --fix and copy the geometry values into the "
+                                 "SDF <inertial> by hand")
+    if not robot.links:
+        raise ReedtoolError("the model has no links", file=model)
+    comparisons = compare_links(robot)
+    own = whole_robot(robot)
+    whole = whole_robot_pinocchio(robot)
+
+    render = format_json if fmt == "json" else format_text
+    click.echo(render(model, robot, comparisons, whole, own), nl=False)
+    failing = [c for c in comparisons if c.failing]
+    if fix:
+        is_urdf = model.suffix.lower() == ".urdf"
+        notes = (apply_fix_urdf(model, comparisons, force) if is_urdf
+                 else print_fix_xacro(comparisons))
+        # Keep JSON on stdout parseable: fix notes go to stderr there.
+        click.echo("\n".join(notes), err=(fmt == "json"))
+        if is_urdf:
+            # What --fix rewrote no longer fails; what it could not fix still does.
+            failing = [c for c in failing if c.corrected() is None]
+    return 1 if failing else 0

@@ -1,0 +1,54 @@
+"""Whole-robot mass properties from Pinocchio: an oracle reedtool did not write.
+
+The model is built with a FREE-FLYER root joint. With a fixed base Pinocchio welds the
+root link to its `universe` body, and computeTotalMass, which sums the bodies of real
+joints, would leave the root link's mass out. With a free-flyer at its neutral
+configuration (identity pose) the root link frame coincides with the world frame, so
+every world-frame quantity is in the base (root link) frame, which is where
+reedtool.inertia.whole_robot works too. All joints sit at their neutral (zero) position.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import ReedtoolError
+from .inertia import MassProperties, parallel_axis_term
+from .model import Robot
+
+
+def build_model(robot: Robot):
+    """(pinocchio Model, Data) of the robot's URDF text, with a free-flyer root joint."""
+    import pinocchio as pin
+
+    if not robot.urdf_xml:
+        raise ReedtoolError(f"robot '{robot.name}' has no URDF text to give Pinocchio",
+                            file=robot.source_file)
+    try:
+        model = pin.buildModelFromXML(robot.urdf_xml, pin.JointModelFreeFlyer())
+    except Exception as exc:  # noqa: BLE001 - Pinocchio raises bare RuntimeError and others
+        raise ReedtoolError(f"Pinocchio cannot build the model: {' '.join(str(exc).split())}",
+                            file=robot.source_file,
+                            hint="run `reedtool validate` on the model first") from exc
+    return model, model.createData()
+
+
+def whole_robot_pinocchio(robot: Robot) -> MassProperties:
+    """Total mass, COM and composite inertia about the COM, in the base frame, by Pinocchio."""
+    import pinocchio as pin
+
+    model, data = build_model(robot)
+    q0 = pin.neutral(model)
+    mass_kg = float(pin.computeTotalMass(model))
+    if mass_kg <= 0.0:
+        return MassProperties(0.0, np.zeros(3), np.zeros((3, 3)))
+    com_m = np.array(pin.centerOfMass(model, data, q0), dtype=float)
+    # The free-flyer's 6x6 block of the joint-space inertia matrix is the whole robot's
+    # spatial inertia about the root frame origin, in root axes: [[m E, m [c]x^T],
+    # [m [c]x, I_origin]] (Pinocchio orders velocities linear first, in the local frame).
+    # crba fills the upper triangle only; the 3x3 angular block is on the diagonal.
+    M = pin.crba(model, data, q0)
+    I_origin = np.triu(M[3:6, 3:6]) + np.triu(M[3:6, 3:6], 1).T
+    # Back from the root origin to the COM (parallel-axis theorem, subtracted).
+    I_com = I_origin - parallel_axis_term(mass_kg, com_m)
+    return MassProperties(mass_kg, com_m, I_com)
