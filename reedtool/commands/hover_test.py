@@ -1,0 +1,275 @@
+"""`reedtool hover-test`: static trim, then a headless closed-loop hover, then (optionally)
+a robustness batch of perturbed vehicles.
+
+Exit 0 when the model hovers (and the batch meets --min-pass-rate), 1 when it does not
+(no trim, or the simulation ends in anything but `passed`), 2 on unreadable input.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import sys
+from pathlib import Path
+
+import click
+
+from ..errors import ReedtoolError
+
+SPREAD_HELP = "Half-width of the uniform perturbation"
+
+
+@click.command(name="hover-test")
+@click.argument("model", type=click.Path(path_type=Path, dir_okay=False))
+@click.argument("mappings", nargs=-1)
+@click.option("--package-path", "package_paths", multiple=True, metavar="DIR",
+              type=click.Path(path_type=Path, file_okay=False),
+              help="Directory to search for ROS packages first (repeatable).")
+@click.option("--duration", "duration_s", type=float, default=10.0, show_default=True,
+              help="Simulated time [s].")
+@click.option("--rate", "rate_hz", type=float, default=1000.0, show_default=True,
+              help="Integration and control rate [Hz] (fixed step).")
+@click.option("--offset", "offset_m", type=float, nargs=3, default=(0.5, 0.0, 0.0),
+              show_default=True, metavar="X Y Z", help="Start position minus setpoint [m].")
+@click.option("--roll", "roll_rad", type=float, default=0.2, show_default=True,
+              help="Initial roll [rad].")
+@click.option("--pitch", "pitch_rad", type=float, default=0.0, show_default=True,
+              help="Initial pitch [rad].")
+@click.option("--yaw", "yaw_rad", type=float, default=0.0, show_default=True,
+              help="Initial yaw [rad] (the setpoint heading is 0).")
+@click.option("--plot", "plot_path", type=click.Path(path_type=Path, dir_okay=False),
+              help="Write a PNG of position, attitude and rotor speeds.")
+@click.option("--csv", "csv_path", type=click.Path(path_type=Path, dir_okay=False),
+              help="Write the sampled time series (100 Hz) as CSV.")
+@click.option("--force", is_flag=True, help="Overwrite existing --plot/--csv files.")
+@click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
+              show_default=True, help="Output format.")
+@click.option("--samples", type=click.IntRange(min=1), default=None,
+              help="Also fly N perturbed vehicles (robustness batch).")
+@click.option("--seed", type=int, default=0, show_default=True,
+              help="Random seed of the robustness batch.")
+@click.option("--mass-spread", type=click.FloatRange(0.0, 0.9), default=0.10,
+              show_default=True, help=f"{SPREAD_HELP} of the mass (fraction).")
+@click.option("--com-spread", "com_spread_m", type=click.FloatRange(min=0.0), default=0.01,
+              show_default=True, help=f"{SPREAD_HELP} of the COM on each axis [m].")
+@click.option("--inertia-spread", type=click.FloatRange(0.0, 0.9), default=0.10,
+              show_default=True, help=f"{SPREAD_HELP} of each principal moment (fraction).")
+@click.option("--motor-spread", type=click.FloatRange(0.0, 0.9), default=0.05,
+              show_default=True, help=f"{SPREAD_HELP} of each motor constant (fraction).")
+@click.option("--min-pass-rate", type=click.FloatRange(0.0, 1.0), default=0.95,
+              show_default=True, help="Batch pass rate needed to exit 0.")
+def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
+            duration_s: float, rate_hz: float, offset_m: tuple[float, float, float],
+            roll_rad: float, pitch_rad: float, yaw_rad: float, plot_path: Path | None,
+            csv_path: Path | None, force: bool, fmt: str, samples: int | None, seed: int,
+            mass_spread: float, com_spread_m: float, inertia_spread: float,
+            motor_spread: float, min_pass_rate: float) -> int:
+    """Trim MODEL (.urdf or .xacro, with xacro NAME:=VALUE arguments) for hover and fly it.
+
+    Starts from a disturbance (default 0.5 m off the setpoint, rolled 0.2 rad) and passes
+    when it settles within 5 cm and 2 deg and stays there.
+    """
+    from ..sim import HoverConfig
+
+    config = HoverConfig(duration_s=duration_s, rate_hz=rate_hz, offset_m=tuple(offset_m),
+                         roll_rad=roll_rad, pitch_rad=pitch_rad, yaw_rad=yaw_rad)
+    try:
+        config.validate()
+    except ValueError as exc:
+        raise ReedtoolError(f"bad option: {exc}", hint="see reedtool hover-test --help") from exc
+    for path in (plot_path, csv_path):
+        if path is not None and path.exists() and not force:
+            raise ReedtoolError("refusing to overwrite an existing file", file=path,
+                                hint="pass --force to replace it")
+    if not model.is_file():
+        raise ReedtoolError("model file not found", file=model,
+                            hint="pass the path of a .urdf or .xacro file")
+
+    from ..loader import load_robot
+    from .validate import parse_mappings
+
+    robot = load_robot(model, parse_mappings(mappings), list(package_paths))
+    report = hover_test(robot, config, samples=samples, seed=seed,
+                        spreads=(mass_spread, com_spread_m, inertia_spread, motor_spread),
+                        record=bool(plot_path or csv_path), show_progress=fmt == "text")
+    batch = report.get("batch")
+    if batch is not None:
+        batch["min_pass_rate"] = min_pass_rate
+        if report["passed"] and batch["pass_rate"] < min_pass_rate:
+            report["passed"] = False
+            report["message"] = (f"only {100 * batch['pass_rate']:.1f}% of the perturbed "
+                                 f"vehicles hover, {100 * min_pass_rate:.0f}% required")
+
+    run, omega_max = report.pop("_run", None), report.pop("_omega_max")
+    if run is not None and csv_path is not None:
+        _write_csv(csv_path, run.series, force)
+    if run is not None and plot_path is not None:
+        from ..fileio import atomic_write_bytes
+        from ..sim.plot import render_png
+
+        png = render_png(run.series, omega_max, run.initial_omega_rad_s,
+                         f"{robot.name}: {run.status.value}")
+        atomic_write_bytes(plot_path, png, force=force)
+
+    if fmt == "json":
+        click.echo(json.dumps(_finite(report), indent=2, allow_nan=False))
+    else:
+        click.echo(render_text(report))
+    return 0 if report["passed"] else 1
+
+
+def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
+               spreads: tuple[float, float, float, float] = (0.1, 0.01, 0.1, 0.05),
+               record: bool = False, show_progress: bool = False) -> dict:
+    """Trim, simulate and (optionally) batch one robot; the JSON-ready report.
+
+    Keys: "model", "trim", "sim" (None when the trim failed), "batch" (None without
+    samples), "passed"; plus "_run" (the HoverRun, for CSV/plot) and "_omega_max".
+    """
+    import numpy as np
+
+    from ..pinocchio_bridge import whole_robot_pinocchio
+    from ..rotors import discover_rotors
+    from ..sim import ExitStatus
+    from ..sim.params import VehicleParams, check_rotor_dynamics
+    from ..trim import solve_trim
+
+    rotors = discover_rotors(robot)
+    props = whole_robot_pinocchio(robot)
+    trim = solve_trim(props.mass_kg, props.com_m, rotors)
+    report: dict = {
+        "model": {"name": robot.name, "file": str(robot.source_file or ""),
+                  "mass_kg": props.mass_kg, "com_m": [float(v) for v in props.com_m],
+                  "inertia_kg_m2": [[float(v) for v in row] for row in props.inertia_kg_m2],
+                  "rotors": len(rotors)},
+        "trim": trim.to_dict(),
+        "sim": None,
+        "batch": None,
+        "passed": False,
+        "_omega_max": np.array([r.max_rot_velocity_rad_s for r in rotors], dtype=float),
+    }
+    if not trim.feasible:
+        report["status"] = ExitStatus.TRIM_INFEASIBLE.value
+        report["message"] = f"no hover trim: {trim.message}"
+        return report
+
+    check_rotor_dynamics(rotors)
+    if props.mass_kg <= 0 or not np.all(np.linalg.eigvalsh(props.inertia_kg_m2) > 0):
+        raise ReedtoolError("the whole-robot inertia is not positive definite, nothing can "
+                            "be simulated", file=robot.source_file,
+                            hint="run `reedtool inertia` on the model")
+    params = VehicleParams.from_rotors(props.mass_kg, props.com_m, props.inertia_kg_m2, rotors)
+
+    from ..sim.run import simulate_hover
+
+    run = simulate_hover(params, config, record=record)
+    sim = run.to_dict()
+    sim["trim_omega_rad_s"] = dict(zip(params.rotor_names,
+                                       (float(w) for w in trim.omega_rad_s)))
+    report["sim"] = sim
+    report["_run"] = run
+    report["status"] = run.status.value
+    report["message"] = run.message
+    report["passed"] = run.passed
+
+    if samples:
+        from ..sim.batch import Spreads, robustness_batch
+
+        mass_rel, com_m, inertia_rel, motor_rel = spreads
+        spread = Spreads(mass_rel=mass_rel, com_m=com_m, inertia_rel=inertia_rel,
+                         motor_constant_rel=motor_rel)
+        if show_progress:
+            with click.progressbar(length=config.n_steps, file=sys.stderr,
+                                   label=f"flying {samples} vehicles") as bar:
+                batch = robustness_batch(params, samples, config, spread, seed,
+                                         progress=bar.update)
+        else:
+            batch = robustness_batch(params, samples, config, spread, seed)
+        report["batch"] = batch.to_dict()
+    return report
+
+
+# ------------------------------------------------------------------ output
+
+def render_text(report: dict) -> str:
+    model, trim, sim, batch = report["model"], report["trim"], report["sim"], report["batch"]
+    lines = [f"hover-test {model['name']}: {model['rotors']} rotors, "
+             f"mass {model['mass_kg']:.4g} kg, COM ({', '.join(f'{v:.4g}' for v in model['com_m'])}) m"]
+    if trim["feasible"]:
+        lines.append(f"trim: {trim['message']}")
+    else:
+        lines.append(f"trim: INFEASIBLE ({trim['cause']}): {trim['message']}")
+    if trim["rotors"]:
+        width = max(len(r["name"]) for r in trim["rotors"])
+        lines.append(f"  {'rotor':<{width}}  {'thrust N':>9}  {'omega rad/s':>11}  {'throttle':>8}")
+        for r in trim["rotors"]:
+            lines.append(f"  {r['name']:<{width}}  {_num(r['thrust_N'], '9.4f')}  "
+                         f"{_num(r['omega_rad_s'], '11.2f')}  {_pct(r['throttle']):>8}")
+    if trim["feasible"]:
+        a = trim["torque_authority_N_m"]
+        lines.append(f"  thrust-to-weight {trim['thrust_to_weight']:.3f}; torque authority at "
+                     f"hover: roll {a['roll']:.3g}, pitch {a['pitch']:.3g}, "
+                     f"yaw {a['yaw']:.3g} N*m")
+    if sim is not None:
+        c = sim["config"]
+        lines.append(f"sim: {sim['status'].upper()}: {sim['message']}")
+        lines.append(f"  start {c['offset_m']} m off, roll {c['roll_rad']:g} pitch "
+                     f"{c['pitch_rad']:g} yaw {c['yaw_rad']:g} rad; {c['duration_s']:g} s at "
+                     f"{c['rate_hz']:g} Hz ({c['integrator']})")
+        lines.append(f"  max error {sim['max_position_error_m']:.3f} m, "
+                     f"{sim['max_attitude_error_deg']:.1f} deg; final "
+                     f"{100 * sim['final_position_error_m']:.2f} cm, "
+                     f"{sim['final_attitude_error_deg']:.2f} deg; max throttle "
+                     f"{_pct(sim['max_throttle'])}")
+        if sim["passed"]:
+            speeds = ", ".join(f"{w:.2f}" for w in sim["final_omega_rad_s"].values())
+            lines.append(f"  final rotor speeds {speeds} rad/s")
+    if batch is not None:
+        s = batch["spreads"]
+        counts = ", ".join(f"{k} {v}" for k, v in sorted(batch["counts"].items()))
+        lines.append(f"batch: {batch['passed']}/{batch['samples']} passed "
+                     f"({100 * batch['pass_rate']:.1f}%, need "
+                     f"{100 * batch['min_pass_rate']:.0f}%): {counts}")
+        lines.append(f"  spreads: mass +-{100 * s['mass_rel']:g}%, COM +-{1000 * s['com_m']:g} mm, "
+                     f"inertia +-{100 * s['inertia_rel']:g}%, motor constant "
+                     f"+-{100 * s['motor_constant_rel']:g}%; seed {batch['seed']}")
+        for w in batch["worst"]:
+            lines.append(f"  #{w['index']}: {w['status']}: {w['message']} "
+                         f"(mass {w['mass_kg']:.4g} kg, COM shift "
+                         f"{', '.join(f'{1000 * v:.1f}' for v in w['com_shift_m'])} mm)")
+    lines.append("PASSED" if report["passed"] else f"FAILED: {report.get('message', '')}")
+    return "\n".join(lines)
+
+
+def _write_csv(path: Path, series: dict, force: bool) -> None:
+    from ..fileio import atomic_write_text
+
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    keys = list(series)
+    writer.writerow(keys)
+    for row in zip(*(series[k] for k in keys)):
+        writer.writerow([f"{float(v):.9g}" for v in row])
+    atomic_write_text(path, buffer.getvalue(), force=force)
+
+
+def _num(value, spec: str) -> str:
+    return format(value, spec) if value is not None and math.isfinite(value) else "n/a".rjust(
+        int(spec.split(".")[0]))
+
+
+def _pct(value) -> str:
+    return f"{100 * value:.1f}%" if value is not None and math.isfinite(value) else "n/a"
+
+
+def _finite(value):
+    """JSON has no NaN or infinity: those become null (e.g. the speeds of an invalid trim)."""
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value

@@ -1,0 +1,91 @@
+"""Headless hover simulation: vehicle parameters, motor model, rigid body, controller.
+
+The vocabulary shared by the single-vehicle run (`run`) and the robustness batch
+(`batch`) lives here: how a simulation ends (`ExitStatus`) and what is asked of it
+(`HoverConfig`). Nothing here imports matplotlib; `plot` does, lazily.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass
+
+
+class ExitStatus(enum.Enum):
+    """Every way a hover test ends. `value` is the stable name used in JSON."""
+
+    PASSED = "passed"                  # settled within the tolerances and stayed there
+    NOT_SETTLED = "not-settled"        # ran to the end without settling (or left the band)
+    DIVERGED = "diverged"              # state not finite, or drifting/rotating away without bound
+    CRASHED = "crashed"                # hit the ground or flipped over
+    SATURATED = "saturated"            # not settled, the demand long beyond the rotors' range
+    YAW_SPIN = "yaw-spin"              # spinning about the vertical
+    TRIM_INFEASIBLE = "trim-infeasible"  # no hover trim exists, nothing was simulated
+
+    @property
+    def passed(self) -> bool:
+        return self is ExitStatus.PASSED
+
+
+# Integer codes for the batch engine's status array (0: still running).
+STATUS_CODES = {status: i + 1 for i, status in enumerate(ExitStatus)}
+STATUS_FROM_CODE = {code: status for status, code in STATUS_CODES.items()}
+
+
+@dataclass(frozen=True)
+class HoverConfig:
+    """What a hover test simulates and how it is judged."""
+
+    duration_s: float = 10.0
+    rate_hz: float = 1000.0              # integration and control rate (fixed step)
+    offset_m: tuple[float, float, float] = (0.5, 0.0, 0.0)  # start minus setpoint, world
+    roll_rad: float = 0.2                # initial attitude (URDF rpy convention)
+    pitch_rad: float = 0.0
+    yaw_rad: float = 0.0
+    hover_altitude_m: float = 2.0        # setpoint height above the ground (z = 0)
+    position_tol_m: float = 0.05
+    attitude_tol_deg: float = 2.0
+    hold_s: float = 1.0                  # must stay settled at least this long before the end
+    saturation_limit_s: float = 1.0      # not settled and saturated this long: SATURATED
+    yaw_spin_rad_s: float = math.pi      # |body yaw rate| above this is a spin
+    diverged_rate_rad_s: float = 50.0    # |roll/pitch rate| above this is divergence
+    diverged_distance_m: float = 10.0    # position error above this (plus the offset)
+    sample_hz: float = 100.0             # checks, settling and time series
+
+    @property
+    def dt_s(self) -> float:
+        return 1.0 / self.rate_hz
+
+    @property
+    def n_steps(self) -> int:
+        return int(round(self.duration_s * self.rate_hz))
+
+    @property
+    def sample_every(self) -> int:
+        return max(1, int(round(self.rate_hz / self.sample_hz)))
+
+    @property
+    def offset_norm_m(self) -> float:
+        return math.sqrt(sum(v * v for v in self.offset_m))
+
+    @property
+    def divergence_distance_m(self) -> float:
+        return self.diverged_distance_m + self.offset_norm_m
+
+    @property
+    def cos_attitude_tol(self) -> float:
+        return math.cos(math.radians(self.attitude_tol_deg))
+
+    def validate(self) -> None:
+        """Raise ValueError naming the first setting that makes no sense."""
+        if not (self.rate_hz > 0 and math.isfinite(self.rate_hz)):
+            raise ValueError(f"rate must be positive, got {self.rate_hz}")
+        if not (self.duration_s > 0 and math.isfinite(self.duration_s)):
+            raise ValueError(f"duration must be positive, got {self.duration_s}")
+        if self.hold_s >= self.duration_s:
+            raise ValueError(f"duration {self.duration_s} s must exceed the hold time "
+                             f"{self.hold_s} s")
+        values = (*self.offset_m, self.roll_rad, self.pitch_rad, self.yaw_rad)
+        if not all(math.isfinite(v) for v in values):
+            raise ValueError("the disturbance must be finite numbers")

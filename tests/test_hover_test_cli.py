@@ -1,0 +1,246 @@
+"""`reedtool hover-test` end to end: the seed quadrotor, generated frames, broken variants."""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from lxml import etree
+
+from reedtool.loader import load_robot
+
+TESTS = Path(__file__).parent
+SEED_PACKAGE = TESTS / "fixtures" / "seed000" / "reed_gazebo"
+SEED_MODEL_NAME = "mav_generic_odometry_sensor.gazebo"
+SEED_MODEL = SEED_PACKAGE / "urdf" / SEED_MODEL_NAME
+LAUNCH_ARGS = {"mav_name": "reed_quad_x", "namespace": "reed_quad_x",
+               "enable_mavlink_interface": "true", "enable_ground_truth": "true",
+               "enable_logging": "false", "log_file": "reed_quad_x",
+               "wait_to_record_bag": "false"}
+ARGV = [f"{k}:={v}" for k, v in LAUNCH_ARGS.items()]
+G = 9.80665
+
+
+def run_cli(*args: str) -> int:
+    from reedtool.cli import main
+
+    with pytest.raises(SystemExit) as info:
+        main(list(args))
+    return info.value.code
+
+
+def run_json(capsys, *args: str) -> tuple[int, dict]:
+    code = run_cli("hover-test", *args, "--format", "json")
+    return code, json.loads(capsys.readouterr().out)
+
+
+def urdf_mass_and_motor_constants(urdf_xml: str) -> tuple[float, list[float]]:
+    """Total mass and motor constants read straight from the URDF text (not via reedtool)."""
+    root = etree.fromstring(urdf_xml.encode())
+    mass = sum(float(m.get("value")) for m in root.iterfind(".//link/inertial/mass"))
+    k = [float(e.text) for e in root.iter("motorConstant")]
+    return mass, k
+
+
+# ------------------------------------------------------------------ the seed quadrotor
+
+def test_seed_quadrotor_hovers_at_the_formula_speed(capsys):
+    code, report = run_json(capsys, str(SEED_MODEL), *ARGV)
+    assert code == 0 and report["passed"] is True
+    assert report["sim"]["status"] == "passed"
+
+    robot = load_robot(SEED_MODEL, LAUNCH_ARGS)
+    mass, k = urdf_mass_and_motor_constants(robot.urdf_xml)
+    assert len(k) == 4 and len(set(k)) == 1
+    hover = math.sqrt(mass * G / (4 * k[0]))
+    trim = [r["omega_rad_s"] for r in report["trim"]["rotors"]]
+    np.testing.assert_allclose(trim, hover, rtol=1e-9)
+    final = list(report["sim"]["final_omega_rad_s"].values())
+    np.testing.assert_allclose(final, hover, rtol=1e-6)
+    assert report["trim"]["thrust_to_weight"] == pytest.approx(
+        4 * k[0] * 838.0 ** 2 / (mass * G), rel=1e-9)
+
+
+def test_seed_quadrotor_text_report(capsys):
+    assert run_cli("hover-test", str(SEED_MODEL), *ARGV, "--duration", "5") == 0
+    out = capsys.readouterr().out
+    assert out.rstrip().endswith("PASSED")
+    assert "reed_quad_x/rotor_3" in out
+
+
+def copy_seed(tmp_path: Path) -> Path:
+    """A writable copy of the seed package; returns its xacro with the rotor properties."""
+    shutil.copytree(SEED_PACKAGE, tmp_path / "reed_gazebo")
+    return tmp_path / "reed_gazebo" / "urdf" / "reed_quad_x.xacro"
+
+
+def edit(path: Path, old: str, new: str) -> None:
+    text = path.read_text()
+    assert text.count(old) == 1, old
+    path.write_text(text.replace(old, new))
+
+
+def run_variant(capsys, tmp_path: Path) -> tuple[int, dict]:
+    model = tmp_path / "reed_gazebo" / "urdf" / SEED_MODEL_NAME
+    return run_json(capsys, str(model), *ARGV, "--package-path", str(tmp_path),
+                    "--duration", "4")
+
+
+def test_seed_with_one_rotor_direction_flipped_fails_on_yaw(capsys, tmp_path):
+    xacro = copy_seed(tmp_path)
+    edit(xacro, 'suffix="front_left"\ndirection="cw"', 'suffix="front_left"\ndirection="ccw"')
+    code, report = run_variant(capsys, tmp_path)
+    assert code == 1 and report["passed"] is False
+    assert (report["status"], report["trim"]["cause"]) == ("trim-infeasible", "yaw-unbalanced")
+    assert report["sim"] is None
+
+
+def test_seed_with_motor_constant_divided_by_ten_fails_at_trim(capsys, tmp_path):
+    xacro = copy_seed(tmp_path)
+    edit(xacro, 'name="motor_constant" value="8.54858e-06"',
+         'name="motor_constant" value="8.54858e-07"')
+    code, report = run_variant(capsys, tmp_path)
+    assert code == 1
+    assert (report["status"], report["trim"]["cause"]) == ("trim-infeasible",
+                                                           "insufficient-thrust")
+
+
+def test_seed_with_com_outside_the_rotor_square_fails(capsys, tmp_path):
+    xacro = copy_seed(tmp_path)
+    # A 0.5 kg payload 1 m forward: COM x = 0.5 / 2.04 = 0.25 m, beyond the rotors' 0.187 m.
+    edit(xacro, "</robot>", """<link name="payload">
+<inertial><mass value="0.5" /><origin xyz="0 0 0" rpy="0 0 0" />
+<inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4" /></inertial>
+</link>
+<joint name="payload_joint" type="fixed">
+<origin xyz="1.0 0 0" rpy="0 0 0" />
+<parent link="${namespace}/base_link" /><child link="payload" />
+</joint>
+</robot>""")
+    code, report = run_variant(capsys, tmp_path)
+    assert code == 1
+    assert report["model"]["com_m"][0] > 0.18738
+    assert (report["status"], report["trim"]["cause"]) == ("trim-infeasible", "com-unbalanced")
+
+
+# ------------------------------------------------------------------ generated frames
+
+def multirotor_urdf(n: int, *, arm_m: float = 0.25, body_kg: float = 1.2,
+                    rotor_kg: float = 0.02, imu_kg: float = 0.015,
+                    k: float = 8.54858e-06) -> str:
+    """A flat n-rotor frame with rotor links and an IMU link, RotorS motor plugins."""
+    parts = ['<robot name="frame%d">' % n,
+             '<link name="base_link"><inertial><mass value="%g"/>'
+             '<inertia ixx="0.02" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.04"/>'
+             '</inertial></link>' % body_kg,
+             '<link name="imu_link"><inertial><mass value="%g"/>'
+             '<inertia ixx="1e-5" ixy="0" ixz="0" iyy="1e-5" iyz="0" izz="1e-5"/></inertial></link>'
+             % imu_kg,
+             '<joint name="imu_joint" type="fixed"><origin xyz="0 0 -0.02"/>'
+             '<parent link="base_link"/><child link="imu_link"/></joint>']
+    for i in range(n):
+        angle = 2 * math.pi * (i + 0.5) / n
+        x, y = arm_m * math.cos(angle), arm_m * math.sin(angle)
+        direction = "ccw" if i % 2 == 0 else "cw"
+        parts.append(
+            f'<link name="rotor_{i}"><inertial><mass value="{rotor_kg}"/>'
+            '<inertia ixx="1e-5" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial>'
+            f'</link><joint name="rotor_{i}_joint" type="continuous">'
+            f'<origin xyz="{x} {y} 0.03"/><axis xyz="0 0 1"/>'
+            f'<parent link="base_link"/><child link="rotor_{i}"/></joint>'
+            f'<gazebo><plugin name="motor_{i}" filename="librotors_gazebo_motor_model.so">'
+            f'<jointName>rotor_{i}_joint</jointName><linkName>rotor_{i}</linkName>'
+            f'<turningDirection>{direction}</turningDirection>'
+            '<timeConstantUp>0.0125</timeConstantUp><timeConstantDown>0.025</timeConstantDown>'
+            f'<maxRotVelocity>838</maxRotVelocity><motorConstant>{k}</motorConstant>'
+            '<momentConstant>0.016</momentConstant>'
+            f'<motorNumber>{i}</motorNumber>'
+            '<rotorDragCoefficient>8.06428e-05</rotorDragCoefficient>'
+            '<rollingMomentCoefficient>1e-06</rollingMomentCoefficient>'
+            '</plugin></gazebo>')
+    parts.append("</robot>")
+    return "\n".join(parts)
+
+
+@pytest.mark.parametrize("n", [4, 6, 8])
+def test_symmetric_frames_trim_and_hover_at_the_formula_speed(capsys, tmp_path, n):
+    xml = multirotor_urdf(n)
+    path = tmp_path / f"frame{n}.urdf"
+    path.write_text(xml)
+    code, report = run_json(capsys, str(path))
+    assert code == 0, report["message"]
+    mass, k = urdf_mass_and_motor_constants(xml)
+    assert mass == pytest.approx(1.2 + 0.015 + n * 0.02)
+    hover = math.sqrt(mass * G / (n * k[0]))
+    np.testing.assert_allclose([r["omega_rad_s"] for r in report["trim"]["rotors"]], hover,
+                               rtol=1e-9)
+    np.testing.assert_allclose(list(report["sim"]["final_omega_rad_s"].values()), hover,
+                               rtol=1e-6)
+
+
+def test_model_without_rotors_fails_with_its_cause(capsys, tmp_path):
+    path = tmp_path / "brick.urdf"
+    path.write_text('<robot name="brick"><link name="base_link"><inertial><mass value="1"/>'
+                    '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/>'
+                    '</inertial></link></robot>')
+    code, report = run_json(capsys, str(path))
+    assert (code, report["trim"]["cause"]) == (1, "no-rotors")
+
+
+# ------------------------------------------------------------------ outputs and errors
+
+def test_csv_and_plot_are_written_and_never_clobbered(capsys, tmp_path):
+    path = tmp_path / "quad.urdf"
+    path.write_text(multirotor_urdf(4))
+    csv_path, png_path = tmp_path / "run.csv", tmp_path / "run.png"
+    args = [str(path), "--duration", "2", "--csv", str(csv_path), "--plot", str(png_path)]
+    assert run_cli("hover-test", *args) in (0, 1)
+    rows = csv_path.read_text().splitlines()
+    header = rows[0].split(",")
+    assert header[:4] == ["t_s", "x_m", "y_m", "z_m"]
+    assert sum(h.startswith("omega_") for h in header) == 4
+    assert len(rows) == 1 + 2 * 100 + 1              # 100 Hz samples, both ends
+    first = dict(zip(header, map(float, rows[1].split(","))))
+    assert (first["x_m"], first["z_m"], first["roll_rad"]) == (0.5, 2.0, 0.2)
+    assert png_path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+    capsys.readouterr()
+    csv_path.write_text("keep")
+    assert run_cli("hover-test", *args) == 2
+    assert "--force" in capsys.readouterr().err
+    assert csv_path.read_text() == "keep"
+    assert run_cli("hover-test", *args, "--force") in (0, 1)
+    assert csv_path.read_text().startswith("t_s,")
+
+
+def test_batch_reports_pass_rate_reproducibly(capsys, tmp_path):
+    path = tmp_path / "quad.urdf"
+    path.write_text(multirotor_urdf(4))
+    args = [str(path), "--duration", "4", "--samples", "6", "--seed", "5"]
+    code, first = run_json(capsys, *args)
+    _, again = run_json(capsys, *args)
+    assert first["batch"] == again["batch"]
+    assert first["batch"]["samples"] == 6
+    assert sum(first["batch"]["counts"].values()) == 6
+    assert code == (0 if first["sim"]["passed"] and first["batch"]["pass_rate"] >= 0.95 else 1)
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["missing.urdf"], "not found"),
+    (["{model}", "--duration", "0"], "duration"),
+    (["{model}", "--rate", "-5"], "rate"),
+    (["{model}", "not_a_mapping"], "name:=value"),
+])
+def test_bad_input_is_one_line_and_exit_2(capsys, tmp_path, args, needle):
+    path = tmp_path / "quad.urdf"
+    path.write_text(multirotor_urdf(4))
+    argv = [a.replace("{model}", str(path)) if "{model}" in a else
+            str(tmp_path / a) if a.endswith(".urdf") else a for a in args]
+    assert run_cli("hover-test", *argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and needle in err
+    assert "Traceback" not in err

@@ -1,0 +1,285 @@
+"""Hover simulation: physics against closed forms, the two engines against each other,
+and every way a run ends (asserted by ExitStatus, not wording)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from reedtool.sim import ExitStatus, HoverConfig
+from reedtool.sim.batch import (Spreads, perturbed_plant, robustness_batch,
+                                sample_perturbations, simulate_batch)
+from reedtool.sim.controller import ControllerGains, allocate
+from reedtool.sim.dynamics import (Plant, State, body_wrench, quat_from_rpy, rot_matrices,
+                                   step_rigid_body)
+from reedtool.sim.motor import drag_matrices, speed_command, speed_filter_factors
+from reedtool.sim.params import VehicleParams, symmetric_multirotor
+from reedtool.sim.run import simulate_hover
+
+G = 9.80665
+
+
+def tilted_hex() -> VehicleParams:
+    """An awkward vehicle: tilted rotors, full inertia tensor, COM off the rotor plane."""
+    base = symmetric_multirotor(6, arm_m=0.3, mass_kg=2.0)
+    rng = np.random.default_rng(7)
+    axes = np.array([[0.0, 0.0, 1.0]] * 6) + rng.normal(scale=0.03, size=(6, 3)) * [1, 1, 0]
+    J = np.array([[0.05, 0.002, -0.001], [0.002, 0.055, 0.0015], [-0.001, 0.0015, 0.09]])
+    return base.with_changes(rotor_axis=axes, inertia_kg_m2=J,
+                             rotor_position_m=base.rotor_position_m + [0.004, -0.002, 0.04])
+
+
+# ------------------------------------------------------------------ physics
+
+def one_vehicle_state(params: VehicleParams, omega) -> State:
+    return State(p=np.zeros((3, 1)), v=np.zeros((3, 1)),
+                 q=np.array([[1.0], [0.0], [0.0], [0.0]]), w=np.zeros((3, 1)),
+                 omega=np.asarray(omega, dtype=float).reshape(-1, 1))
+
+
+def test_free_fall_follows_the_discrete_kinematics():
+    params = symmetric_multirotor(4)
+    plant = Plant.from_params(params)
+    state = one_vehicle_state(params, np.zeros(4))
+    dt, steps = 1e-3, 500
+    for _ in range(steps):
+        R = rot_matrices(state.q)
+        force, torque = body_wrench(plant, state, R)
+        step_rigid_body(plant, state, R, force, torque, dt)
+    # Semi-implicit Euler: v_k = -g k dt, z_k = -g dt^2 k (k + 1) / 2.
+    assert state.v[2, 0] == pytest.approx(-G * steps * dt, rel=1e-12)
+    assert state.p[2, 0] == pytest.approx(-G * dt * dt * steps * (steps + 1) / 2, rel=1e-12)
+    assert state.p[2, 0] == pytest.approx(-0.5 * G * (steps * dt) ** 2, rel=2 * 1.0 / steps)
+
+
+def test_torque_free_tumbling_keeps_angular_momentum_and_energy():
+    params = tilted_hex()
+    plant = Plant.from_params(params)
+    state = one_vehicle_state(params, np.zeros(6))
+    state.w[:, 0] = [3.0, -1.0, 2.0]
+    J = params.inertia_kg_m2
+
+    def momentum_world_and_energy():
+        R = rot_matrices(state.q)[:, :, 0]
+        w = state.w[:, 0]
+        return R @ J @ w, 0.5 * w @ J @ w
+
+    L0, E0 = momentum_world_and_energy()
+    plant.g_m_s2 = 0.0
+    for _ in range(2000):
+        R = rot_matrices(state.q)
+        step_rigid_body(plant, state, R, np.zeros((3, 1)), np.zeros((3, 1)), 5e-4)
+    L1, E1 = momentum_world_and_energy()
+    np.testing.assert_allclose(L1, L0, rtol=0, atol=5e-3 * np.linalg.norm(L0))
+    assert E1 == pytest.approx(E0, rel=5e-3)
+
+
+def test_thrust_and_yaw_reaction_follow_rotors_conventions():
+    # One ccw rotor at (l, 0, 0): thrust k w^2 up, pitch torque -l T, and the RotorS
+    # reaction -turning_sign * c_m * T about the axis (a ccw rotor pushes the body cw).
+    params = symmetric_multirotor(4, rotor_drag_coefficient=0.0, rolling_moment_coefficient=0.0)
+    params = params.with_changes(rotor_position_m=[[0.2, 0, 0], [0, 0.2, 0], [-0.2, 0, 0],
+                                                   [0, -0.2, 0]])
+    omega = np.array([600.0, 0.0, 0.0, 0.0])
+    force, torque = body_wrench(Plant.from_params(params), one_vehicle_state(params, omega),
+                                rot_matrices(np.array([[1.0], [0], [0], [0]])))
+    T = params.motor_constant[0] * 600.0 ** 2
+    np.testing.assert_allclose(force[:, 0], [0, 0, T], atol=1e-12)
+    np.testing.assert_allclose(torque[:, 0], [0, -0.2 * T, -params.moment_constant[0] * T],
+                               atol=1e-12)
+
+
+def test_rotor_drag_matrices_match_the_per_rotor_formula():
+    params = tilted_hex()
+    K = drag_matrices(params.rotor_position_m, params.rotor_axis,
+                      params.rotor_drag_coefficient, params.rolling_moment_coefficient)
+    rng = np.random.default_rng(1)
+    v, w = rng.normal(size=3), rng.normal(size=3)
+    for i in range(params.n_rotors):
+        r, a = params.rotor_position_m[i], params.rotor_axis[i]
+        u = v + np.cross(w, r)
+        u_perp = u - (u @ a) * a
+        force = -params.rotor_drag_coefficient[i] * u_perp
+        expected = np.concatenate([force, np.cross(r, force),
+                                   -params.rolling_moment_coefficient[i] * u_perp])
+        np.testing.assert_allclose(K[:, :, i] @ np.concatenate([v, w]), expected, atol=1e-15)
+
+
+def test_motor_response_and_command_limits():
+    up, down = speed_filter_factors(1e-3, np.array([0.0125]), np.array([0.025]))
+    assert up[0] == pytest.approx(math.exp(-1e-3 / 0.0125))
+    assert down[0] == pytest.approx(math.exp(-1e-3 / 0.025))
+    cmd = speed_command(np.array([-1.0, 2.0, 1e9]), np.array([1e-5] * 3), np.array([800.0] * 3))
+    np.testing.assert_allclose(cmd, [0.0, math.sqrt(2.0 / 1e-5), 800.0])
+
+
+def test_allocation_desaturates_keeping_the_torque_direction():
+    params = symmetric_multirotor(4)
+    gains = ControllerGains.from_params(params)
+    t_max = params.thrust_max_N
+    wrench = np.array([[params.weight_N], [3.0], [1.5], [0.4]])   # far beyond authority
+    thrust, saturated, _ = allocate(gains.allocation_pinv, wrench, t_max)
+    assert saturated[0]
+    assert np.all(thrust >= -1e-12) and np.all(thrust <= t_max[:, None] + 1e-9)
+    achieved = params.allocation() @ thrust[:, 0]
+    assert achieved[0] == pytest.approx(params.weight_N)         # thrust kept
+    roll_pitch = achieved[1:3] / np.linalg.norm(achieved[1:3])
+    np.testing.assert_allclose(roll_pitch, np.array([3.0, 1.5]) / math.hypot(3.0, 1.5),
+                               atol=1e-12)                        # direction kept
+
+
+# ------------------------------------------------------------------ the two engines
+
+@pytest.mark.parametrize("make", [lambda: symmetric_multirotor(4), tilted_hex])
+def test_plain_float_engine_matches_the_array_engine(make):
+    params = make()
+    config = HoverConfig(duration_s=2.5, offset_m=(0.3, -0.2, 0.25), roll_rad=0.15,
+                         pitch_rad=-0.1, yaw_rad=0.3)
+    run = simulate_hover(params, config, record=False)
+    out = simulate_batch(params, config)
+    assert out.status(0) is run.status
+    np.testing.assert_allclose(run.final_omega_rad_s, out.final_omega_rad_s[:, 0], rtol=1e-9)
+    assert run.max_position_error_m == pytest.approx(out.max_position_error_m[0], rel=1e-9)
+    assert run.max_attitude_error_deg == pytest.approx(out.max_attitude_error_deg[0], rel=1e-9)
+    assert run.final_position_error_m == pytest.approx(out.final_position_error_m[0],
+                                                       rel=1e-6, abs=1e-12)
+
+
+# ------------------------------------------------------------------ hover results
+
+@pytest.mark.parametrize("n", [4, 6, 8])
+def test_steady_hover_speed_equals_the_trim(n):
+    params = symmetric_multirotor(n, mass_kg=1.0 + 0.2 * n)
+    run = simulate_hover(params, HoverConfig(duration_s=12.0), record=False)
+    assert run.status is ExitStatus.PASSED
+    expected = math.sqrt(params.mass_kg * G / (n * params.motor_constant[0]))
+    np.testing.assert_allclose(run.final_omega_rad_s, expected, rtol=1e-6)
+
+
+def test_undisturbed_hover_stays_exactly_at_trim():
+    params = symmetric_multirotor(6).with_changes(inertia_kg_m2=tilted_hex().inertia_kg_m2)
+    config = HoverConfig(duration_s=2.0, offset_m=(0.0, 0.0, 0.0), roll_rad=0.0)
+    run = simulate_hover(params, config)
+    assert run.status is ExitStatus.PASSED and run.settle_time_s == pytest.approx(0.01)
+    np.testing.assert_allclose(run.final_omega_rad_s, run.initial_omega_rad_s, rtol=1e-9)
+    assert run.max_position_error_m < 1e-3
+
+
+def test_disturbed_awkward_vehicle_settles():
+    run = simulate_hover(tilted_hex(), HoverConfig(duration_s=6.0))
+    assert run.status is ExitStatus.PASSED
+    assert 0.5 < run.settle_time_s < 5.0
+    assert run.max_position_error_m == pytest.approx(0.5, abs=0.05)
+
+
+def test_too_short_a_run_is_not_settled():
+    run = simulate_hover(symmetric_multirotor(4), HoverConfig(duration_s=1.5))
+    assert run.status is ExitStatus.NOT_SETTLED
+
+
+def test_marginal_thrust_climb_ends_saturated():
+    base = symmetric_multirotor(4)
+    # Thrust-to-weight 1.03: holding is possible, climbing 1.5 m is not within 6 s.
+    omega_max = math.sqrt(base.weight_N * 1.03 / (4 * base.motor_constant[0]))
+    params = base.with_changes(omega_max_rad_s=omega_max)
+    run = simulate_hover(params, HoverConfig(duration_s=6.0, offset_m=(0.0, 0.0, -1.5),
+                                             roll_rad=0.0))
+    assert run.status is ExitStatus.SATURATED
+    assert run.longest_saturation_s >= 1.0
+
+
+def test_three_times_heavier_than_modelled_crashes():
+    params = symmetric_multirotor(4)
+    plant = Plant.from_params(params)
+    plant.mass_kg = plant.mass_kg * 3.0
+    out = simulate_batch(params, HoverConfig(duration_s=3.0), plant)
+    assert out.status(0) is ExitStatus.CRASHED
+
+
+def test_a_rotor_spinning_the_other_way_than_modelled_spins_the_vehicle():
+    params = symmetric_multirotor(4)
+    plant = Plant.from_params(params)
+    flipped = params.with_changes(turning_sign=params.turning_sign * [-1, 1, 1, 1])
+    plant.torque_map = flipped.allocation()[1:4].copy()
+    out = simulate_batch(params, HoverConfig(duration_s=6.0), plant)
+    assert out.status(0) is ExitStatus.YAW_SPIN
+
+
+def test_non_finite_state_is_divergence():
+    params = symmetric_multirotor(4)
+    plant = Plant.from_params(params)
+    plant.mass_kg = np.array([np.nan])
+    out = simulate_batch(params, HoverConfig(duration_s=2.0), plant)
+    assert out.status(0) is ExitStatus.DIVERGED
+
+
+# ------------------------------------------------------------------ robustness batch
+
+def test_batch_without_spread_reproduces_the_single_vehicle():
+    params = symmetric_multirotor(4)
+    config = HoverConfig(duration_s=2.5)
+    plant = perturbed_plant(params, sample_perturbations(5, 4, Spreads(0, 0, 0, 0), seed=1))
+    out = simulate_batch(params, config, plant)
+    run = simulate_hover(params, config, record=False)
+    for i in range(5):
+        assert out.status(i) is run.status
+        np.testing.assert_allclose(out.final_omega_rad_s[:, i], run.final_omega_rad_s,
+                                   rtol=1e-9)
+
+
+def test_batch_columns_are_independent_vehicles():
+    # Each vehicle of a perturbed batch flies exactly as it would alone.
+    params = symmetric_multirotor(4)
+    config = HoverConfig(duration_s=1.5)
+    perturbation = sample_perturbations(3, 4, Spreads(0.3, 0.03, 0.3, 0.1), seed=3)
+    together = simulate_batch(params, config, perturbed_plant(params, perturbation))
+    for i in range(3):
+        alone = perturbed_plant(params, type(perturbation)(
+            perturbation.mass_scale[i:i + 1], perturbation.com_shift_m[:, i:i + 1],
+            perturbation.inertia_scale[:, i:i + 1], perturbation.motor_scale[:, i:i + 1]))
+        single = simulate_batch(params, config, alone)
+        assert single.status(0) is together.status(i)
+        np.testing.assert_allclose(single.final_state.p[:, 0], together.final_state.p[:, i],
+                                   rtol=1e-12, atol=1e-12)
+
+
+def test_robustness_batch_reports_pass_rate_and_worst_cases_reproducibly():
+    params = symmetric_multirotor(4)
+    config = HoverConfig(duration_s=2.5)
+    first = robustness_batch(params, 24, config, Spreads(mass_rel=0.2), seed=11, n_worst=3)
+    again = robustness_batch(params, 24, config, Spreads(mass_rel=0.2), seed=11, n_worst=3)
+    assert first.to_dict() == again.to_dict()
+    assert sum(first.counts.values()) == 24
+    assert first.passed == first.counts.get("passed", 0)
+    assert len(first.worst) == 3
+    masses = [w["mass_kg"] for w in first.worst]
+    assert all(0.8 * 1.5 - 1e-9 <= m <= 1.2 * 1.5 + 1e-9 for m in masses)
+
+
+def test_heavy_spread_makes_some_vehicles_fail():
+    params = symmetric_multirotor(4)   # thrust-to-weight 1.63
+    report = robustness_batch(params, 16, HoverConfig(duration_s=4.0),
+                              Spreads(mass_rel=0.6, com_m=0.0, inertia_rel=0.0,
+                                      motor_constant_rel=0.0), seed=2)
+    assert 0 < report.passed < 16
+    failing = [w for w in report.worst if w["status"] != "passed"]
+    # The nominal controller flies a vehicle 20% off its mass fine; the failures are
+    # the far-off ones.
+    assert failing and all(abs(w["mass_kg"] / 1.5 - 1.0) > 0.2 for w in failing)
+
+
+def test_gains_scale_with_mass_and_inertia_not_per_model():
+    small = ControllerGains.from_params(symmetric_multirotor(4, mass_kg=0.5))
+    big = ControllerGains.from_params(symmetric_multirotor(4, mass_kg=5.0))
+    assert (small.kp_1_s2, small.kR_1_s2) == (big.kp_1_s2, big.kR_1_s2)
+    assert big.mass_kg == 10 * small.mass_kg
+
+
+def test_initial_attitude_is_the_urdf_rpy_convention():
+    from reedtool.frames import rpy_to_matrix
+
+    q = quat_from_rpy(0.3, -0.2, 1.1)
+    R = rot_matrices(q.reshape(4, 1))[:, :, 0]
+    np.testing.assert_allclose(R, rpy_to_matrix((0.3, -0.2, 1.1)), atol=1e-12)
