@@ -93,12 +93,14 @@ def include_specs(text: str) -> list[str]:
             and "filename" in tag.attrs]
 
 
-def _legacy_kind(tag: _Tag, macros: set[str]) -> str | None:
+def _legacy_kind(tag: _Tag, macros: set[str], in_gazebo: bool) -> str | None:
     if ":" in tag.name:
         return None
     if tag.name in LEGACY_DIRECTIVES and LEGACY_DIRECTIVES[tag.name] in tag.attrs:
         return "directive"
-    if tag.name in macros and tag.name not in LEGACY_DIRECTIVES:
+    # Gazebo extension content is plugin parameters (gz-sim's <rotorConfiguration><rotor>,
+    # ...), never a macro call, even when a macro happens to share the element's name.
+    if tag.name in macros and tag.name not in LEGACY_DIRECTIVES and not in_gazebo:
         return "macro-call"
     return None
 
@@ -128,7 +130,7 @@ def scan_and_fix(text: str, file: str, macros: set[str]) -> tuple[list[LegacyTag
             root_seen = True
             if "xmlns:xacro" not in tag.attrs:
                 root_needs_ns = tag.start + len(tag.name)
-        kind = _legacy_kind(tag, macros)
+        kind = _legacy_kind(tag, macros, in_gazebo=any(name == "gazebo" for name, _ in stack))
         if kind:
             found.append(LegacyTag(file, tag.line, tag.name, f"xacro:{tag.name}", kind))
             edits.append(tag.start)

@@ -37,6 +37,11 @@ UNITS: dict[str, dict[str, float]] = {
 # generation time; validate and hover-test read the real expanded model.
 SENSOR_MASS_KG = 0.015 + 3 * 0.00001
 
+# Simulators a multirotor package can target. "classic": Gazebo classic with RotorS' plugins
+# (ROS 1 and 2). "gz": Gazebo Sim (Harmonic and later) with its MulticopterMotorModel and
+# MulticopterVelocityControl systems, ROS 2 only (ros_gz has no ROS 1 release for it).
+SIMULATORS = ("gz", "classic")
+
 STANDARD_GRAVITY_M_S2 = 9.80665
 # Below this max-thrust / weight ratio the vehicle hovers at > 80 % throttle and has no
 # authority left to correct attitude; new-package refuses such a spec.
@@ -113,8 +118,8 @@ PARAMS: tuple[Param, ...] = (
 PARAM_MAP = {p.key: p for p in PARAMS}
 
 # Non-numeric spec keys.
-TEXT_KEYS = ("name", "frame", "ros", "mesh", "description", "maintainer", "maintainer_email",
-             "license", "version")
+TEXT_KEYS = ("name", "frame", "ros", "sim", "mesh", "description", "maintainer",
+             "maintainer_email", "license", "version")
 
 
 @dataclass
@@ -130,6 +135,7 @@ class PackageSpec:
     license: str = "BSD-3-Clause"
     version: str = "0.1.0"
     origin: dict[str, str] = field(default_factory=dict)  # key -> "default"|"spec"|"--flag"
+    sim: str = "classic"                       # a SIMULATORS entry
 
     @property
     def kind(self) -> str:
@@ -228,7 +234,7 @@ def read_spec_file(path: Path) -> dict:
 
 def build_spec(name: str, *, frame: str | None = None, ros: int | None = None,
                spec_file: Path | None = None, flags: Mapping[str, object] | None = None,
-               mesh: Path | None = None) -> PackageSpec:
+               mesh: Path | None = None, sim: str | None = None) -> PackageSpec:
     """Merge defaults < spec file < flags, convert to SI and check the result."""
     data = read_spec_file(spec_file) if spec_file else {}
     src = str(spec_file) if spec_file else "<spec>"
@@ -248,6 +254,7 @@ def build_spec(name: str, *, frame: str | None = None, ros: int | None = None,
     ros_value = ros if ros is not None else data.get("ros", 1)
     if str(ros_value) not in ("1", "2"):
         raise ReedtoolError(f"ros: must be 1 or 2, got {ros_value!r}", file=spec_file)
+    sim_value = _choose_simulator(sim, data.get("sim"), frame_obj, int(ros_value), spec_file)
 
     values: dict[str, float] = {}
     origin: dict[str, str] = {}
@@ -291,10 +298,32 @@ def build_spec(name: str, *, frame: str | None = None, ros: int | None = None,
         maintainer_email=str(data.get("maintainer_email", PackageSpec.maintainer_email)),
         license=str(data.get("license", PackageSpec.license)),
         version=str(data.get("version", PackageSpec.version)),
-        origin=origin,
+        origin=origin, sim=sim_value,
     )
     check_geometry(spec)
     return spec
+
+
+def _choose_simulator(flag: str | None, from_spec, frame_obj, ros: int,
+                      spec_file: Path | None) -> str:
+    """--sim, else the spec's `sim`, else gz for ROS 2 multirotors and classic otherwise."""
+    if flag is None and from_spec is None:
+        return "gz" if ros == 2 and frame_obj.kind == "multirotor" else "classic"
+    chosen = str(flag if flag is not None else from_spec)
+    label, where = (f"--sim {chosen}", {}) if flag is not None else \
+        (f"sim: {chosen}", {"file": spec_file})
+    if chosen not in SIMULATORS:
+        raise ReedtoolError(f"sim: must be one of {', '.join(SIMULATORS)}, got {chosen!r}",
+                            **where)
+    if chosen == "gz" and ros != 2:
+        raise ReedtoolError(f"{label} needs ROS 2: Gazebo Sim (Harmonic+) has ROS 2 "
+                            "integration (ros_gz) only", **where,
+                            hint="use --ros 2, or --sim classic for a ROS 1 package")
+    if chosen == "gz" and frame_obj.kind != "multirotor":
+        raise ReedtoolError(f"{label} is available for multirotor frames only, not "
+                            f"'{frame_obj.name}'", **where,
+                            hint="use --sim classic for a ground robot")
+    return chosen
 
 
 # ------------------------------------------------------------------ checks
@@ -307,9 +336,14 @@ def rotor_positions_m(spec: PackageSpec):
 def total_mass_estimate_kg(spec: PackageSpec) -> float:
     """Body + rotors + sensors (multirotor) or body + wheels + caster (ground)."""
     if spec.kind == "multirotor":
-        return spec["mass"] + spec.frame.rotor_count * spec["mass_rotor"] + SENSOR_MASS_KG
+        return spec["mass"] + spec.frame.rotor_count * spec["mass_rotor"] + sensor_mass_kg(spec)
     caster = spec["caster_mass"] if spec.frame.caster else 0.0
     return spec["mass"] + len(spec.frame.wheels) * spec["wheel_mass"] + caster
+
+
+def sensor_mass_kg(spec: PackageSpec) -> float:
+    """RotorS' sensor macros carry mass; the gz-sim model's IMU is a sensor on base_link."""
+    return SENSOR_MASS_KG if spec.sim == "classic" else 0.0
 
 
 def thrust_to_weight(spec: PackageSpec) -> float:
@@ -382,16 +416,23 @@ _FIREFLY_LEE_GAINS = {
 # the simulated rotor turns that many times slower than the real one.
 ROTOR_BLADE_WIDTH_M = 0.015
 ROTOR_BLADE_THICKNESS_M = 0.003
+ROTOR_DISC_THICKNESS_M = 0.005   # the rotor's visual and collision disc
 
 
-def _xacro_coeff(coefficient: float, prop: str) -> str:
+def _py_coeff(coefficient: float, prop: str) -> str:
+    """coefficient * prop as a xacro (Python) expression, e.g. `-arm_length`."""
     if coefficient == 0.0:
         return "0"
     if coefficient == 1.0:
-        return f"${{{prop}}}"
+        return prop
     if coefficient == -1.0:
-        return f"${{-{prop}}}"
-    return f"${{{prop}*{coefficient!r}}}"
+        return f"-{prop}"
+    return f"{prop}*{coefficient!r}"
+
+
+def _xacro_coeff(coefficient: float, prop: str) -> str:
+    expr = _py_coeff(coefficient, prop)
+    return expr if expr == "0" else f"${{{expr}}}"
 
 
 def _inertia_attrs(I) -> dict[str, str]:
@@ -411,7 +452,7 @@ def template_context(spec: PackageSpec, body_props=None) -> dict:
     from .inertia import fmt_number
 
     ctx: dict = {
-        "name": spec.name, "ros": spec.ros, "kind": spec.kind,
+        "name": spec.name, "ros": spec.ros, "kind": spec.kind, "sim": spec.sim,
         "frame": {"name": spec.frame.name, "title": spec.frame.title},
         "description": spec.description, "version": spec.version, "license": spec.license,
         "maintainer": spec.maintainer, "maintainer_email": spec.maintainer_email,
@@ -445,8 +486,10 @@ def _multirotor_context(spec: PackageSpec, body_props) -> dict:
 
     positions = frame.rotor_positions_m(spec["arm_length"], spec["rotor_offset_top"])
     rotors = []
-    parts = [body_props, MassProperties(SENSOR_MASS_KG, np.zeros(3),
-                                        sphere_inertia(SENSOR_MASS_KG, 0.01))]
+    parts = [body_props]
+    if sensor_mass_kg(spec) > 0.0:
+        parts.append(MassProperties(sensor_mass_kg(spec), np.zeros(3),
+                                    sphere_inertia(sensor_mass_kg(spec), 0.01)))
     for slot, position in zip(frame.rotors, positions):
         ux, uy = frame.unit_xy(slot)
         z_expr = "${rotor_offset_top}" if slot.level > 0 else "${-rotor_offset_top}"
@@ -455,6 +498,8 @@ def _multirotor_context(spec: PackageSpec, body_props) -> dict:
             "direction": slot.direction, "direction_sign": 1 if slot.direction == "ccw" else -1,
             "color": "Red" if position[0] < -1e-9 else "Blue",
             "xyz": f"{_xacro_coeff(ux, 'arm_length')} {_xacro_coeff(uy, 'arm_length')} {z_expr}",
+            "xyz_expr": [_py_coeff(ux, "arm_length"), _py_coeff(uy, "arm_length"),
+                         "rotor_offset_top" if slot.level > 0 else "-rotor_offset_top"],
             "angle_rad": fmt_number(float(np.arctan2(position[1], position[0]))),
             "radial_m": fmt_number(float(np.hypot(position[0], position[1]))),
             "position_m": [fmt_number(v) for v in position],
@@ -480,6 +525,10 @@ def _multirotor_context(spec: PackageSpec, body_props) -> dict:
         "total_inertia": _inertia_attrs(I_total),
         "lee_gains": gains,
         "thrust_to_weight": f"{thrust_to_weight(spec):.2f}",
+        "rotor_disc_thickness_m": fmt_number(ROTOR_DISC_THICKNESS_M),
+        # Spawn 5 cm above the ground: below the body box or the lower rotor discs.
+        "spawn_z_m": fmt_number(round(0.05 + max(spec["body_height"] / 2.0, max(
+            -p[2] for p in positions) + ROTOR_DISC_THICKNESS_M / 2.0), 3)),
     }
 
 

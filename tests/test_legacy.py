@@ -115,3 +115,23 @@ def test_fix_adds_missing_xacro_namespace():
     assert len(tags) == 1
     root = etree.fromstring(fixed.encode())
     assert root.nsmap.get("xacro") == "http://ros.org/wiki/xacro"
+
+
+def test_gazebo_plugin_parameter_named_like_a_macro_is_not_a_macro_call():
+    # gz-sim's <rotorConfiguration><rotor> inside a <gazebo> block, in a file that also
+    # defines a macro called `rotor`: only the unprefixed call outside <gazebo> is legacy.
+    from reedtool.legacy import scan_and_fix
+
+    text = """<robot xmlns:xacro="http://ros.org/wiki/xacro">
+  <xacro:macro name="rotor" params="n"><link name="r${n}"/></xacro:macro>
+  <rotor n="1"/>
+  <gazebo>
+    <plugin name="gz::sim::systems::MulticopterVelocityControl" filename="x">
+      <rotorConfiguration><rotor><jointName>j</jointName></rotor></rotorConfiguration>
+    </plugin>
+  </gazebo>
+</robot>
+"""
+    tags, fixed = scan_and_fix(text, "m.xacro", {"rotor"})
+    assert [(t.line, t.kind) for t in tags] == [(3, "macro-call")]
+    assert "<xacro:rotor n=\"1\"/>" in fixed and "<rotor><jointName>" in fixed

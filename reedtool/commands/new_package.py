@@ -19,9 +19,23 @@ class NewPackageResult:
     context: dict
 
 
-def template_sets(kind: str, ros: int) -> list[str]:
-    """Later sets override files of earlier ones with the same output path."""
+def template_sets(kind: str, ros: int, sim: str = "classic") -> list[str]:
+    """Later sets override files of earlier ones with the same output path.
+
+    A gz-sim package shares nothing with the RotorS (`common/<kind>`, `ros2/<kind>`) sets:
+    its own set `ros2/gz/<kind>` replaces them, and overrides package.xml, CMakeLists.txt
+    and README.md of the `any` sets.
+    """
+    if sim == "gz":
+        return ["common/any", f"ros{ros}/any", f"ros{ros}/gz/{kind}"]
     return ["common/any", f"common/{kind}", f"ros{ros}/any", f"ros{ros}/{kind}"]
+
+
+def model_path(spec) -> PurePosixPath:
+    """The file to expand, validate and hover-test in a generated package."""
+    if spec.kind == "multirotor" and spec.sim == "classic":
+        return PurePosixPath("urdf", "mav_generic_odometry_sensor.gazebo")
+    return PurePosixPath("urdf", f"{spec.name}.urdf.xacro")
 
 
 def _import_body_mesh(spec, units: str, from_frame: str):
@@ -59,7 +73,7 @@ def new_package(spec, output_dir: Path, *, force: bool = False, mesh_units: str 
     from ..package_spec import template_context
 
     context = template_context(spec, body_props)
-    files = render_tree(template_sets(spec.kind, spec.ros), context)
+    files = render_tree(template_sets(spec.kind, spec.ros, spec.sim), context)
     if mesh_data is not None:
         files.append(RenderedFile(PurePosixPath("meshes", context["mesh_file"]), mesh_data, 0o644))
     backup = write_tree(target, files, force=force)
@@ -68,7 +82,8 @@ def new_package(spec, output_dir: Path, *, force: bool = False, mesh_units: str 
 
 def _summary(result: NewPackageResult, spec) -> list[str]:
     ctx = result.context
-    lines = [f"created {result.target} ({len(result.files)} files, ROS {spec.ros}, "
+    sim = ", gz-sim" if spec.sim == "gz" else ""
+    lines = [f"created {result.target} ({len(result.files)} files, ROS {spec.ros}{sim}, "
              f"{spec.frame.title})"]
     if result.backup is not None:
         lines.append(f"previous contents kept in {result.backup}")
@@ -78,15 +93,16 @@ def _summary(result: NewPackageResult, spec) -> list[str]:
         for r in ctx["rotors"]:
             lines.append(f"  motor {r['motor_number']}  {r['suffix']:<20} "
                          f"({', '.join(r['position_m'])}) m  {r['direction']}")
-        model = "urdf/mav_generic_odometry_sensor.gazebo"
     else:
         lines.append(f"mass {ctx['p']['mass']} kg body, {ctx['total_mass_kg']} kg total; "
                      f"{len(ctx['wheels'])} wheels, {ctx['drive'].replace('_', '-')} on cmd_vel")
-        model = f"urdf/{spec.name}.urdf.xacro"
+    model = model_path(spec)
     lines.append("next:")
     lines.append(f"  reedtool validate {result.target / model}")
     if spec.kind == "multirotor":
         lines.append(f"  reedtool hover-test {result.target / model}")
+    if spec.sim == "gz":
+        lines.append(f"  ros2 launch {spec.name} {spec.name}.launch.py   (after colcon build)")
     return lines
 
 
@@ -96,6 +112,10 @@ def _summary(result: NewPackageResult, spec) -> list[str]:
               help="Vehicle layout (default: the spec's `frame`, else quad-x).")
 @click.option("--ros", type=click.Choice(["1", "2"]), default=None,
               help="ROS 1 (catkin) or ROS 2 (ament_cmake) (default: the spec's, else 1).")
+@click.option("--sim", type=click.Choice(["gz", "classic"]), default=None,
+              help="Multirotor simulator: gz (Gazebo Sim, Harmonic+; ROS 2 only) or classic "
+                   "(Gazebo classic + RotorS). Default: the spec's `sim`, else gz for ROS 2 "
+                   "multirotors, classic otherwise.")
 @click.option("--spec", "spec_file", type=click.Path(path_type=Path, dir_okay=False),
               help="YAML file of parameters (see docs/new-package.md); flags override it.")
 @click.option("--mass", metavar="KG", help="Body mass, e.g. 1.5 or '1500 g'.")
@@ -112,19 +132,20 @@ def _summary(result: NewPackageResult, spec) -> list[str]:
               help="Directory to create the package directory NAME in.")
 @click.option("--force", is_flag=True,
               help="Regenerate into an existing package; the old tree is kept as NAME.bak.")
-def command(name, frame, ros, spec_file, mass, arm_length, mesh, mesh_units, mesh_frame,
+def command(name, frame, ros, sim, spec_file, mass, arm_length, mesh, mesh_units, mesh_frame,
             output_dir, force) -> int:
     """Create the ROS package NAME for a multirotor or ground robot.
 
-    Masses and inertias are computed from the geometry; a multirotor uses the RotorS macro
-    interface and passes `reedtool validate` and `hover-test` as generated.
+    Masses and inertias are computed from the geometry; a multirotor (gz-sim
+    MulticopterMotorModel systems, or the RotorS macro interface with --sim classic) passes
+    `reedtool validate` and `hover-test` as generated.
     """
     from ..package_spec import build_spec
 
     if spec_file is not None and not spec_file.is_file():
         raise ReedtoolError("spec file not found", file=spec_file)
     spec = build_spec(name, frame=frame, ros=int(ros) if ros else None, spec_file=spec_file,
-                      flags={"mass": mass, "arm_length": arm_length}, mesh=mesh)
+                      flags={"mass": mass, "arm_length": arm_length}, mesh=mesh, sim=sim)
     result = new_package(spec, output_dir, force=force, mesh_units=mesh_units,
                          mesh_frame=mesh_frame)
     for line in _summary(result, spec):
