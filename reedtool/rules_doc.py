@@ -55,6 +55,11 @@ def main(argv: list[str] | None = None) -> int:
     if "--write" in argv:
         from .fileio import atomic_write_text
 
+        # Only a source checkout has a docs/ to keep current; an installed copy does not.
+        if not (DOC_PATH.parent.parent / "pyproject.toml").is_file():
+            sys.stderr.write("reedtool.rules_doc: --write works in a source checkout only; "
+                             "without it the page goes to stdout\n")
+            return 2
         atomic_write_text(DOC_PATH, text, force=True)
         print(f"wrote {DOC_PATH}")
     else:
