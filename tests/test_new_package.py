@@ -13,25 +13,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from click.testing import CliRunner
 
 from reedtool.airframes import FRAMES, GROUND_FRAMES, MULTIROTOR_FRAMES
-from reedtool.cli import SUBCOMMANDS, cli
+from reedtool.cli import SUBCOMMANDS
+from cli_helpers import run_cli
 
 CHECK_URDF = Path(sys.executable).parent / "check_urdf"
 CASES = [(frame, ros) for frame in FRAMES for ros in (1, 2)]
-
-
-def run_cli(*args: str) -> tuple[int, str]:
-    """The CLI in-process; returns (exit code, output). Reedtool errors count as exit 2."""
-    result = CliRunner().invoke(cli, [str(a) for a in args], standalone_mode=False)
-    if result.exception is not None:
-        from reedtool.errors import ReedtoolError
-
-        if isinstance(result.exception, ReedtoolError):
-            return 2, result.output + result.exception.one_line()
-        raise result.exception
-    return result.return_value, result.output
 
 
 def pkg_name(frame: str, ros: int) -> str:

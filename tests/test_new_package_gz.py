@@ -16,10 +16,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from click.testing import CliRunner
 from lxml import etree
 
-from reedtool.cli import SUBCOMMANDS, cli
+from reedtool.cli import SUBCOMMANDS
+from cli_helpers import run_cli
 
 CHECK_URDF = Path(sys.executable).parent / "check_urdf"
 ARM_LENGTH_M = 0.3      # every frame is generated with this --arm-length
@@ -39,18 +39,6 @@ PX4 = {
 FRAMES = list(PX4)
 VELOCITY_CONTROL = "gz::sim::systems::MulticopterVelocityControl"
 MOTOR_MODEL = "gz::sim::systems::MulticopterMotorModel"
-
-
-def run_cli(*args) -> tuple[int, str]:
-    """The CLI in-process; returns (exit code, output). Reedtool errors count as exit 2."""
-    result = CliRunner().invoke(cli, [str(a) for a in args], standalone_mode=False)
-    if result.exception is not None:
-        from reedtool.errors import ReedtoolError
-
-        if isinstance(result.exception, ReedtoolError):
-            return 2, result.output + result.exception.one_line()
-        raise result.exception
-    return result.return_value, result.output
 
 
 def pkg_name(frame: str) -> str:
