@@ -288,18 +288,30 @@ class _GuardOperators(ast.NodeTransformer):
         return ast.copy_location(call, node)
 
 
+@functools.lru_cache(maxsize=4096)
+def _guarded_code(expr: str):
+    """Compiled, operator-guarded code for `expr`; None when xacro's own eval should run.
+
+    Cached per expression text: a model evaluates the same few expressions hundreds of
+    times (once per macro call), and parsing them each time was a third of expansion.
+    """
+    tree = ast.parse(expr, mode="eval")
+    if not any(isinstance(n, ast.BinOp) and type(n.op) in _GUARDED_OPS for n in ast.walk(tree)):
+        return None
+    compile(tree, "<expression>", "eval")   # let xacro's checks see the user's text
+    if any(n.startswith("__") for n in compile(expr, "<expression>", "eval").co_names):
+        return None   # xacro raises its own error
+    tree = ast.fix_missing_locations(_GuardOperators().visit(tree))
+    return compile(tree, "<expression>", "eval")
+
+
 def _guarded_safe_eval(original):
     def safe_eval(expr, globals, locals=None):
-        tree = ast.parse(expr.strip(), mode="eval")
-        if not any(isinstance(n, ast.BinOp) and type(n.op) in _GUARDED_OPS for n in ast.walk(tree)):
+        code = _guarded_code(expr.strip())
+        if code is None:
             return original(expr, globals, locals)
-        compile(tree, "<expression>", "eval")   # let xacro's checks see the user's text
-        original_names = compile(expr.strip(), "<expression>", "eval").co_names
-        if any(n.startswith("__") for n in original_names):
-            return original(expr, globals, locals)   # xacro raises its own error
-        tree = ast.fix_missing_locations(_GuardOperators().visit(tree))
         globals.update(__builtins__={})
-        return eval(compile(tree, "<expression>", "eval"), globals, locals)
+        return eval(code, globals, locals)
     return safe_eval
 
 
