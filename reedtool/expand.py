@@ -289,28 +289,29 @@ class _GuardOperators(ast.NodeTransformer):
 
 
 @functools.lru_cache(maxsize=4096)
-def _guarded_code(expr: str):
-    """Compiled, operator-guarded code for `expr`; None when xacro's own eval should run.
+def _compiled_expression(expr: str):
+    """`expr` compiled as xacro's safe_eval compiles it, with power/product/shift guarded.
 
     Cached per expression text: a model evaluates the same few expressions hundreds of
-    times (once per macro call), and parsing them each time was a third of expansion.
+    times (once per macro call). None when the text uses a dunder name, so that xacro's
+    own safe_eval raises its own error for it.
     """
+    code = compile(expr, "<expression>", "eval")
+    if any(n.startswith("__") for n in code.co_names):
+        return None
     tree = ast.parse(expr, mode="eval")
     if not any(isinstance(n, ast.BinOp) and type(n.op) in _GUARDED_OPS for n in ast.walk(tree)):
-        return None
-    compile(tree, "<expression>", "eval")   # let xacro's checks see the user's text
-    if any(n.startswith("__") for n in compile(expr, "<expression>", "eval").co_names):
-        return None   # xacro raises its own error
+        return code
     tree = ast.fix_missing_locations(_GuardOperators().visit(tree))
     return compile(tree, "<expression>", "eval")
 
 
 def _guarded_safe_eval(original):
     def safe_eval(expr, globals, locals=None):
-        code = _guarded_code(expr.strip())
+        code = _compiled_expression(expr.strip())
         if code is None:
             return original(expr, globals, locals)
-        globals.update(__builtins__={})
+        globals.update(__builtins__={})   # as xacro's safe_eval: no builtins
         return eval(code, globals, locals)
     return safe_eval
 
