@@ -3,7 +3,7 @@
 Run on demand: /work/venv/bin/python benchmarks/bench_hover.py [--vehicles 1000] [--repeats 5]
 Targets (issue 6): single vehicle 10 s at 1 kHz >= 200x real time; batch >= 3 M
 vehicle-steps/s. Prints the median of the repeats and its ratio to each target, plus the
-spread, the load average and, for the single vehicle, the first (cold) run, which also
+spread, the load average (before and after) and, for the single vehicle, the first (cold) run, which also
 generates and compiles the vehicle's step (later runs of the same vehicle reuse it).
 """
 
@@ -62,6 +62,8 @@ def main() -> None:
           f"{statistics.median(batch):.2f} s = {rate / 1e6:.2f} M vehicle-steps/s "
           f"({min(rates) / 1e6:.2f}-{max(rates) / 1e6:.2f}) "
           f"(target {BATCH_TARGET_VS_S / 1e6:.0f} M: {rate / BATCH_TARGET_VS_S:.2f})")
+    # The machine may be shared: a load that rose during the run explains a slow figure.
+    print(f"load average {os.getloadavg()[0]:.2f} at the end")
 
 
 if __name__ == "__main__":

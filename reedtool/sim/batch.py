@@ -18,10 +18,9 @@ from typing import Callable
 import numpy as np
 
 from . import STATUS_CODES, STATUS_FROM_CODE, ExitStatus, HoverConfig
-from .controller import (CONTROL_WORK_ROWS, ControllerDesign, ControllerGains, allocate,
-                         control)
-from .dynamics import (Plant, PlantKernel, State, body_wrench, quat_from_rpy, rot_matrices,
-                       step_rigid_body)
+from .controller import ControllerDesign, ControllerGains, allocation_kernel, control_kernel
+from .dynamics import (Plant, PlantKernel, State, body_wrench_kernel, quat_from_rpy,
+                       rates_buffer, rigid_body_kernel, rotation_kernel)
 from .motor import speed_command, speed_filter_factors
 from .params import VehicleParams
 
@@ -136,9 +135,8 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
     evi[3:6] = state.v
     state.v = evi[3:6]
     p_err, integral = evi[0:3], evi[6:9]
-    products = np.empty((11, N))      # quaternion products, scratch for rot_matrices
-    products[10] = 1.0
-    control_work = np.empty((CONTROL_WORK_ROWS, N))
+    w5 = rates_buffer(state.w)          # body rates, wrapped for the cross products
+    state.w = w5[0:3]
     omega_park = state.omega[:, 0].copy()
     q_park = np.array([1.0, 0.0, 0.0, 0.0])
     # Per-rotor constants as full (n, N) arrays: broadcasting (n, 1) costs more than the
@@ -150,10 +148,23 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
         dt, params.time_constant_up_s, params.time_constant_down_s))
     inv_k_hat = per_rotor(1.0 / gains.motor_constant)
     omega_max = per_rotor(gains.omega_max_rad_s)
-    alloc = gains.allocation_pinv
     thrust_max = per_rotor(gains.motor_constant * gains.omega_max_rad_s ** 2)
     i_max = gains.max_integral_m_s
     p_col = np.repeat(setpoint[:, None], N, axis=1)    # full: no broadcasting per step
+
+    # The step's stages, each bound once to the arrays it works on (see the kernels).
+    R9 = np.empty((9, N))
+    R = R9.reshape(3, 3, N)
+    wrench, thrust_cmd, body = np.empty((4, N)), np.empty((n, N)), np.empty((8, N))
+    rotate = rotation_kernel(state.q, np.empty((11, N)), R9)
+    compute_wrench = control_kernel(gains, evi, R9, state.w, wrench)
+    allocate = allocation_kernel(gains.allocation_pinv, wrench, thrust_max, thrust_cmd)
+    evaluate_body_wrench = body_wrench_kernel(plant, kernel, state.omega, state.v, w5, R9, body)
+    advance_body = rigid_body_kernel(plant, kernel, state.p, state.v, state.q, w5, R9, body, dt)
+    omega = state.omega
+    omega_cmd = np.empty((n, N))
+    spinning_up = np.empty((n, N), dtype=bool)
+    mul, add, sub, sqrt = np.multiply, np.add, np.subtract, np.sqrt
 
     status = np.zeros(N, dtype=np.int64)
     reason = np.zeros(N, dtype=np.int64)
@@ -178,12 +189,12 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
 
     for step in range(n_steps + 1):
         t = step * dt
-        R = rot_matrices(state.q, products)
-        np.subtract(state.p, p_col, out=p_err)
+        rotate()
+        sub(state.p, p_col, p_err)
         last = step == n_steps
         sample = step % every == 0 or last
-        wrench = control(gains, evi, R, state.w, control_work)
-        thrust_cmd, saturated, worst_rotor = allocate(alloc, wrench, thrust_max, sample)
+        compute_wrench()
+        saturated, worst_rotor = allocate(sample)
         if sample:
             # ---- judge every running vehicle on the state at time t
             running = status == 0
@@ -194,48 +205,48 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
             trace = R[0, 0] + R[1, 1] + R22
             cos_att = np.minimum(np.maximum(0.5 * (trace - 1.0), -1.0), 1.0)
             throttle = (state.omega / omega_max).max(axis=0)
-            # Only running vehicles update their record (ufunc `where=`: in place).
-            np.fmax(max_pos, pos, out=max_pos, where=running)
-            np.fmin(min_cos_att, cos_att, out=min_cos_att, where=running)
-            np.fmax(max_throttle, throttle, out=max_throttle, where=running)
-            np.copyto(final_pos, pos, where=running)
-            np.copyto(final_cos, cos_att, where=running)
+            # Only running vehicles update their record (ufunc `where=`: in place; masked
+            # calls cost several times the plain ones, so only when some have ended).
+            if running.all():
+                np.fmax(max_pos, pos, out=max_pos)
+                np.fmin(min_cos_att, cos_att, out=min_cos_att)
+                np.fmax(max_throttle, throttle, out=max_throttle)
+                np.copyto(final_pos, pos)
+                np.copyto(final_cos, cos_att)
+            else:
+                np.fmax(max_pos, pos, out=max_pos, where=running)
+                np.fmin(min_cos_att, cos_att, out=min_cos_att, where=running)
+                np.fmax(max_throttle, throttle, out=max_throttle, where=running)
+                np.copyto(final_pos, pos, where=running)
+                np.copyto(final_cos, cos_att, where=running)
             within = (pos <= config.position_tol_m) & (cos_att >= cos_tol)
             np.copyto(last_out, t, where=running & ~within)
             # Saturated streaks: start, rotor furthest out at the start, longest so far.
-            np.copyto(sat_since, t, where=saturated & np.isnan(sat_since))
-            np.copyto(sat_since, np.nan, where=~saturated)
-            np.copyto(sat_rotor, worst_rotor, where=saturated & (sat_since == t))
-            longer = running & saturated & (t - sat_since > sat_longest)
-            np.copyto(sat_longest, t - sat_since, where=longer)
-            np.copyto(sat_longest_rotor, sat_rotor, where=longer)
-            with np.errstate(invalid="ignore"):
-                w = state.w
+            if saturated is None:           # no rotor of any vehicle out of range
+                sat_since.fill(np.nan)
+            else:
+                np.copyto(sat_since, t, where=saturated & np.isnan(sat_since))
+                np.copyto(sat_since, np.nan, where=~saturated)
+                np.copyto(sat_rotor, worst_rotor, where=saturated & (sat_since == t))
+                longer = running & saturated & (t - sat_since > sat_longest)
+                np.copyto(sat_longest, t - sat_since, where=longer)
+                np.copyto(sat_longest_rotor, sat_rotor, where=longer)
+            w = state.w
+            if (np.isfinite(state.p).all() and np.isfinite(w).all()
+                    and np.isfinite(state.q).all()):
+                # The usual case, cheaply: no vehicle (running or parked) hit any event.
                 rate_xy = np.sqrt(w[0] * w[0] + w[1] * w[1])
-                finite = (np.isfinite(state.p).all(axis=0) & np.isfinite(w).all(axis=0)
-                          & np.isfinite(state.q).all(axis=0))
-                # (hit, status, reason, the value that ended it: computed when needed)
-                events = [
-                    (~finite, ExitStatus.DIVERGED, "non-finite", lambda: np.zeros(N)),
-                    (R22 < 0.0, ExitStatus.CRASHED, "flipped",
-                     lambda: np.degrees(np.arccos(np.clip(R22, -1.0, 1.0)))),
-                    (state.p[2] < 0.0, ExitStatus.CRASHED, "ground", lambda: state.p[2]),
-                    (np.abs(w[2]) > config.yaw_spin_rad_s, ExitStatus.YAW_SPIN,
-                     "yaw-spin", lambda: np.abs(w[2])),
-                    (pos > config.divergence_distance_m, ExitStatus.DIVERGED, "drifted",
-                     lambda: pos),
-                    (rate_xy > config.diverged_rate_rad_s, ExitStatus.DIVERGED, "rate",
-                     lambda: rate_xy),
-                ]
-            ended = np.zeros(N, dtype=bool)
-            for hit, code, why, value in events:
-                new = running & hit & ~ended
-                if new.any():
-                    status[new] = STATUS_CODES[code]
-                    reason[new] = _R[why]
-                    reason_value[new] = value()[new]
-                    end_time[new] = t
-                    ended |= new
+                quiet = (R22.min() >= 0.0 and state.p[2].min() >= 0.0
+                         and np.abs(w[2]).max() <= config.yaw_spin_rad_s
+                         and pos.max() <= config.divergence_distance_m
+                         and rate_xy.max() <= config.diverged_rate_rad_s)
+            else:
+                quiet = False
+            if quiet:
+                ended = None
+            else:
+                ended = _judge_events(config, status, reason, reason_value, end_time,
+                                      running, t, state, R, pos)
             if last:
                 settled = (status == 0) & within & (last_out + sample_dt
                                                     <= config.duration_s - config.hold_s + 1e-9)
@@ -250,7 +261,7 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
                 status[rest] = STATUS_CODES[ExitStatus.NOT_SETTLED]
                 reason[rest] = _R["not-settled"]
                 break
-            if ended.any():
+            if ended is not None and ended.any():
                 # Park finished vehicles at a level hover so they stay finite and cheap.
                 state.p[:, ended] = setpoint[:, None]
                 state.v[:, ended] = 0.0
@@ -262,16 +273,16 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
                     break
         # ---- advance all vehicles one step
         # The allocation keeps thrusts within [0, k w_max^2], so no clamp.
-        omega_cmd = np.sqrt(thrust_cmd * inv_k_hat)
-        force, torque = body_wrench(plant, state, R, kernel)
-        step_rigid_body(plant, state, R, force, torque, dt, kernel)
-        omega = state.omega
-        factor = np.where(omega_cmd > omega, up, down)
-        omega -= omega_cmd
-        omega *= factor
-        omega += omega_cmd
-        p_err *= dt
-        integral += p_err
+        mul(thrust_cmd, inv_k_hat, omega_cmd)
+        sqrt(omega_cmd, omega_cmd)
+        evaluate_body_wrench()
+        advance_body()
+        np.greater(omega_cmd, omega, spinning_up)
+        sub(omega, omega_cmd, omega)
+        mul(omega, np.where(spinning_up, up, down), omega)
+        add(omega, omega_cmd, omega)
+        mul(p_err, dt, p_err)
+        add(integral, p_err, integral)
         np.minimum(integral, i_max, out=integral)
         np.maximum(integral, -i_max, out=integral)
         if progress is not None and step - reported >= report_every:
@@ -296,6 +307,43 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
         max_throttle=max_throttle, longest_saturation_s=sat_longest,
         final_omega_rad_s=state.omega.copy(),
         final_state=state, config=config)
+
+
+def _judge_events(config: HoverConfig, status: np.ndarray, reason: np.ndarray,
+                  reason_value: np.ndarray, end_time: np.ndarray, running: np.ndarray,
+                  t: float, state: State, R: np.ndarray, pos: np.ndarray) -> np.ndarray:
+    """End the running vehicles that hit an event at time t (the first event in this
+    order wins); returns which vehicles ended."""
+    N = len(status)
+    with np.errstate(invalid="ignore"):
+        w = state.w
+        R22 = R[2, 2]
+        rate_xy = np.sqrt(w[0] * w[0] + w[1] * w[1])
+        finite = (np.isfinite(state.p).all(axis=0) & np.isfinite(w).all(axis=0)
+                  & np.isfinite(state.q).all(axis=0))
+        # (hit, status, reason, the value that ended it: computed when needed)
+        events = [
+            (~finite, ExitStatus.DIVERGED, "non-finite", lambda: np.zeros(N)),
+            (R22 < 0.0, ExitStatus.CRASHED, "flipped",
+             lambda: np.degrees(np.arccos(np.clip(R22, -1.0, 1.0)))),
+            (state.p[2] < 0.0, ExitStatus.CRASHED, "ground", lambda: state.p[2]),
+            (np.abs(w[2]) > config.yaw_spin_rad_s, ExitStatus.YAW_SPIN,
+             "yaw-spin", lambda: np.abs(w[2])),
+            (pos > config.divergence_distance_m, ExitStatus.DIVERGED, "drifted",
+             lambda: pos),
+            (rate_xy > config.diverged_rate_rad_s, ExitStatus.DIVERGED, "rate",
+             lambda: rate_xy),
+        ]
+    ended = np.zeros(N, dtype=bool)
+    for hit, code, why, value in events:
+        new = running & hit & ~ended
+        if new.any():
+            status[new] = STATUS_CODES[code]
+            reason[new] = _R[why]
+            reason_value[new] = value()[new]
+            end_time[new] = t
+            ended |= new
+    return ended
 
 
 # ------------------------------------------------------------ robustness batch

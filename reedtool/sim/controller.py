@@ -19,6 +19,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -128,101 +129,125 @@ class ControllerGains:
                 "kR_1_s2": self.kR_1_s2, "kw_1_s": self.kw_1_s}
 
 
-# Rows of the scratch array `control` works in.
-CONTROL_WORK_ROWS = 30
-
-
-def control(gains: ControllerGains, evi: np.ndarray, R: np.ndarray, w: np.ndarray,
-            work: np.ndarray | None = None) -> np.ndarray:
-    """Batched Lee control law towards a setpoint at heading 0 (columns are vehicles).
+def control_kernel(gains: ControllerGains, evi: np.ndarray, R9: np.ndarray, w: np.ndarray,
+                   wrench: np.ndarray) -> Callable[[], None]:
+    """`compute()`: the batched Lee control law towards a setpoint at heading 0, into
+    wrench (4, N) = [thrust along body z, roll, pitch, yaw torque] (columns are vehicles).
 
     evi (9, N): position error, velocity and the integral of the position error (world);
-    R (3, 3, N): body -> world rotations; w (3, N): body rates; `work`: optional
-    (CONTROL_WORK_ROWS, N) scratch array to reuse between calls.
-    Returns the wrench (4, N) = [thrust along body z, roll, pitch, yaw torque].
+    R9 (9, N): rows R00 R01 ... R22 of the body -> world rotations; w (3, N): body rates.
 
-    Written as one numpy call per row operation into reused rows: at N ~ 1000 a call's
-    overhead costs about as much as its arithmetic, and broadcasting, einsum and fresh
-    temporaries each cost more than that.
+    Written as one numpy call per row operation on rows bound once: at N ~ 1000 a call's
+    overhead costs about as much as its arithmetic, and broadcasting, einsum, fresh
+    temporaries and building views each cost more than that. A few calls cover two or
+    three rows where the operands lie next to each other.
     """
+    mul, add, sub, sqrt, div = np.multiply, np.add, np.subtract, np.sqrt, np.divide
+    maximum, minimum, matmul, copyto = np.maximum, np.minimum, np.matmul, np.copyto
     N = evi.shape[1]
-    if work is None:
-        work = np.empty((CONTROL_WORK_ROWS, N))
-    mul, sub, sqrt, div = np.multiply, np.subtract, np.sqrt, np.divide
-    (t0, t1, t2, Fx, Fy, Fz, F_norm, inv_F, b3x, b3y, b3z, n_sq, inv_n, b1x, u, A1,
-     A2) = (work[i] for i in range(17))
-    x = work[17:30]
-    R9 = R.reshape(9, N)
-    R00, R01, R02, R10, R11, R12, R20, R21, R22 = (R9[i] for i in range(9))
-    a = gains.pid_matrix @ evi      # -kp e - kd v - ki integral
-    ax, ay, az = a[0], a[1], a[2]
-    m, g = gains.mass_kg, gains.g_m_s2
-    # Tilt limit: cap the horizontal acceleration, keeping its direction.
-    a_h_max, a_v = gains.max_horizontal_accel_m_s2, gains.max_vertical_accel_m_s2
-    mul(ax, ax, out=t0)
-    t0 += mul(ay, ay, out=t1)
-    sqrt(t0, out=t0)
-    np.maximum(t0, a_h_max, out=t0)
-    div(m * a_h_max, t0, out=t0)
-    mul(t0, ax, out=Fx)
-    mul(t0, ay, out=Fy)
-    np.maximum(az, -a_v, out=Fz)
-    np.minimum(Fz, a_v, out=Fz)
-    Fz += g
-    Fz *= m
-    mul(Fx, Fx, out=F_norm)
-    F_norm += mul(Fy, Fy, out=t0)
-    F_norm += mul(Fz, Fz, out=t0)
-    sqrt(F_norm, out=F_norm)
-    div(1.0, F_norm, out=inv_F)
-    mul(Fx, inv_F, out=b3x)
-    mul(Fy, inv_F, out=b3y)
-    mul(Fz, inv_F, out=b3z)
-    # Heading 0, b1c = (1, 0, 0): b2 = b3 x b1c / |.| = (0, b3z, -b3y) / n and
-    # b1 = b2 x b3 = (n, -b3x b3y / n, -b3x b3z / n) with n = sqrt(b3y^2 + b3z^2).
-    mul(b3y, b3y, out=n_sq)
-    n_sq += mul(b3z, b3z, out=t0)
-    sqrt(n_sq, out=inv_n)
-    div(1.0, inv_n, out=inv_n)
-    mul(n_sq, inv_n, out=b1x)
-    mul(inv_n, b3x, out=u)
-    # x = [thrust; vee(Rd^T R - R^T Rd) = 2 e_R; w; products w_i w_j]: the wrench is
-    # linear in these (gains.wrench_matrix). (Rd^T R)_ij = b_i . R[:, j] =: M_ij.
-    mul(b3y, R11, out=A1)
-    A1 += mul(b3z, R21, out=t0)
-    mul(b3y, R12, out=A2)
-    A2 += mul(b3z, R22, out=t0)
-    mul(b3x, R02, out=t0)                                   # thrust F . R[:, 2]
-    t0 += A2
-    mul(F_norm, t0, out=x[0])
-    mul(b3x, R01, out=t0)                                   # M21 - M12
-    t0 += A1
-    mul(b3z, R12, out=t1)
-    t1 -= mul(b3y, R22, out=t2)
-    t1 *= inv_n
-    sub(t0, t1, out=x[1])
-    mul(b1x, R02, out=t0)                                   # M02 - M20
-    t0 -= mul(u, A2, out=t1)
-    mul(b3x, R00, out=t1)
-    t1 += mul(b3y, R10, out=t2)
-    t1 += mul(b3z, R20, out=t2)
-    sub(t0, t1, out=x[2])
-    mul(b3z, R10, out=t0)                                   # M10 - M01
-    t0 -= mul(b3y, R20, out=t1)
-    t0 *= inv_n
-    mul(b1x, R01, out=t1)
-    t1 -= mul(u, A1, out=t2)
-    sub(t0, t1, out=x[3])
-    x[4:7] = w
     products = gains.gyro_products
-    for row, (i, j) in enumerate(products, start=7):
-        mul(w[i], w[j], out=x[row])
-    return gains.wrench_matrix @ x[:7 + len(products)]
+    work = np.empty((27 + len(products), N))
+    a, t, F = work[0:3], work[3:6], work[6:9]
+    a01, ax, ay, az = a[0:2], a[0], a[1], a[2]
+    t01, t0, t1, t2 = t[0:2], t[0], t[1], t[2]
+    Fx, Fy, Fz = F
+    F_norm, inv_F, n_sq, inv_n, b1x, u, A1, A2 = (work[i] for i in range(9, 17))
+    b3 = work[17:20]
+    b3x, b3y, b3z = b3
+    b3yz = b3[1:3]
+    x = work[20:27 + len(products)]
+    x0, x1, x2, x3, x_w = x[0], x[1], x[2], x[3], x[4:7]
+    gyro = [(w[i], w[j], x[row]) for row, (i, j) in enumerate(products, start=7)]
+    R00, R01, R02, R10, R11, R12, R20, R21, R22 = R9
+    pid, W = gains.pid_matrix, gains.wrench_matrix
+    m, g = gains.mass_kg, gains.g_m_s2
+    a_h_max, a_v = gains.max_horizontal_accel_m_s2, gains.max_vertical_accel_m_s2
+    m_a_h_max = m * a_h_max
+
+    def compute() -> None:
+        matmul(pid, evi, a)          # -kp e - kd v - ki integral
+        # Tilt limit: cap the horizontal acceleration, keeping its direction.
+        mul(a01, a01, t01)
+        add(t0, t1, t0)
+        sqrt(t0, t0)
+        maximum(t0, a_h_max, out=t0)
+        div(m_a_h_max, t0, t0)
+        mul(t0, ax, Fx)
+        mul(t0, ay, Fy)
+        maximum(az, -a_v, out=Fz)
+        minimum(Fz, a_v, out=Fz)
+        add(Fz, g, Fz)
+        mul(Fz, m, Fz)
+        mul(F, F, t)
+        add(t0, t1, F_norm)
+        add(F_norm, t2, F_norm)
+        sqrt(F_norm, F_norm)
+        div(1.0, F_norm, inv_F)
+        mul(Fx, inv_F, b3x)
+        mul(Fy, inv_F, b3y)
+        mul(Fz, inv_F, b3z)
+        # Heading 0, b1c = (1, 0, 0): b2 = b3 x b1c / |.| = (0, b3z, -b3y) / n and
+        # b1 = b2 x b3 = (n, -b3x b3y / n, -b3x b3z / n) with n = sqrt(b3y^2 + b3z^2).
+        mul(b3yz, b3yz, t01)
+        add(t0, t1, n_sq)
+        sqrt(n_sq, inv_n)
+        div(1.0, inv_n, inv_n)
+        mul(n_sq, inv_n, b1x)
+        mul(inv_n, b3x, u)
+        # x = [thrust; vee(Rd^T R - R^T Rd) = 2 e_R; w; products w_i w_j]: the wrench is
+        # linear in these (gains.wrench_matrix). (Rd^T R)_ij = b_i . R[:, j] =: M_ij.
+        mul(b3y, R11, A1)
+        mul(b3z, R21, t0)
+        add(A1, t0, A1)
+        mul(b3y, R12, A2)
+        mul(b3z, R22, t0)
+        add(A2, t0, A2)
+        mul(b3x, R02, t0)                                   # thrust F . R[:, 2]
+        add(t0, A2, t0)
+        mul(F_norm, t0, x0)
+        mul(b3x, R01, t0)                                   # M21 - M12
+        add(t0, A1, t0)
+        mul(b3z, R12, t1)
+        mul(b3y, R22, t2)
+        sub(t1, t2, t1)
+        mul(t1, inv_n, t1)
+        sub(t0, t1, x1)
+        mul(b1x, R02, t0)                                   # M02 - M20
+        mul(u, A2, t1)
+        sub(t0, t1, t0)
+        mul(b3x, R00, t1)
+        mul(b3y, R10, t2)
+        add(t1, t2, t1)
+        mul(b3z, R20, t2)
+        add(t1, t2, t1)
+        sub(t0, t1, x2)
+        mul(b3z, R10, t0)                                   # M10 - M01
+        mul(b3y, R20, t1)
+        sub(t0, t1, t0)
+        mul(t0, inv_n, t0)
+        mul(b1x, R01, t1)
+        mul(u, A1, t2)
+        sub(t1, t2, t1)
+        sub(t0, t1, x3)
+        copyto(x_w, w)
+        for wi, wj, row in gyro:
+            mul(wi, wj, row)
+        matmul(W, x, wrench)
+
+    return compute
 
 
-def allocate(allocation_pinv: np.ndarray, wrench: np.ndarray, thrust_max_N: np.ndarray,
-             want_worst: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
-    """Per-rotor thrusts (n, N) for the wrenches (4, N), desaturated when out of range.
+def control(gains: ControllerGains, evi: np.ndarray, R: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """The control law (control_kernel) once: the wrench (4, N) for R (3, 3, N)."""
+    wrench = np.empty((4, evi.shape[1]))
+    control_kernel(gains, evi, np.ascontiguousarray(R).reshape(9, -1), w, wrench)()
+    return wrench
+
+
+def allocation_kernel(allocation_pinv: np.ndarray, wrench: np.ndarray, thrust_max_N: np.ndarray,
+                      thrust: np.ndarray) -> Callable[[bool], tuple]:
+    """`allocate(want_worst)`: per-rotor thrusts (n, N) into `thrust` for the wrenches
+    (4, N), desaturated when out of range.
 
     The pseudo-inverse solution is used whenever every rotor can deliver it. When some
     cannot, clipping each rotor on its own would distort the torque (a saturated quad then
@@ -232,18 +257,44 @@ def allocate(allocation_pinv: np.ndarray, wrench: np.ndarray, thrust_max_N: np.n
     saturates), then as much of the roll/pitch part as fits, then of the yaw part. The
     torques keep their direction.
 
-    Returns (thrust (n, N), saturated (N,) bool, most-out-of-range rotor (N,) int or None
-    when not `want_worst`). `thrust_max_N` is (n,), or (n, N) (faster: no broadcasting).
+    Returns (saturated (N,) bool, most-out-of-range rotor (N,) int, or None when not
+    `want_worst`), or (None, None) when no rotor of any vehicle is out of range: the
+    per-vehicle answers cost more than that check. `thrust_max_N` is (n, N).
     """
-    hi = thrust_max_N if thrust_max_N.ndim == 2 else thrust_max_N[:, None]
-    thrust = allocation_pinv @ wrench
-    saturated = ((thrust < 0.0) | (thrust > hi)).any(axis=0)
-    worst = (np.maximum(-thrust, thrust - hi) / hi).argmax(axis=0) if want_worst else None
-    if saturated.any():
+    less, greater, logical_or, matmul = np.less, np.greater, np.logical_or, np.matmul
+    hi = thrust_max_N
+    below = np.empty(thrust.shape, dtype=bool)
+    above = np.empty(thrust.shape, dtype=bool)
+
+    def allocate(want_worst: bool) -> tuple:
+        matmul(allocation_pinv, wrench, thrust)
+        less(thrust, 0.0, below)
+        greater(thrust, hi, above)
+        if not (below.any() or above.any()):
+            return None, None
+        saturated = logical_or.reduce(logical_or(below, above, below), axis=0)
+        worst = ((np.maximum(-thrust, thrust - hi) / hi).argmax(axis=0) if want_worst
+                 else None)
         cols = np.flatnonzero(saturated)
-        hi_cols = hi[:, cols] if hi.shape[1] > 1 else hi
-        thrust[:, cols] = _prioritised(allocation_pinv, wrench[:, cols], hi_cols)
-    return thrust, saturated, worst
+        thrust[:, cols] = _prioritised(allocation_pinv, wrench[:, cols], hi[:, cols])
+        return saturated, worst
+
+    return allocate
+
+
+def allocate(allocation_pinv: np.ndarray, wrench: np.ndarray, thrust_max_N: np.ndarray,
+             want_worst: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """allocation_kernel once: (thrust (n, N), saturated (N,) bool, most-out-of-range
+    rotor (N,) int or None when not `want_worst`). `thrust_max_N` is (n,) or (n, N)."""
+    n, N = allocation_pinv.shape[0], wrench.shape[1]
+    hi = np.broadcast_to(thrust_max_N.reshape(n, -1), (n, N)).copy()
+    thrust = np.empty((n, N))
+    saturated, worst = allocation_kernel(allocation_pinv, wrench, hi, thrust)(True)
+    if saturated is None:
+        saturated, worst = np.zeros(N, dtype=bool), np.zeros(N, dtype=np.int64)
+        if want_worst:   # every rotor in range: the one closest to a limit
+            worst = (np.maximum(-thrust, thrust - hi) / hi).argmax(axis=0)
+    return thrust, saturated, (worst if want_worst else None)
 
 
 def _prioritised(allocation_pinv: np.ndarray, wrench: np.ndarray, hi: np.ndarray) -> np.ndarray:

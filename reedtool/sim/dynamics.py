@@ -17,8 +17,10 @@ continuous equilibrium, so the steady hover speed equals the trim.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -67,82 +69,134 @@ _ROT_FROM_PRODUCTS = np.array([
     [0, 2, 0, 0, 0, 0, 0, 0, 2, 0, 0],      # R21
     [0, 0, 0, 0, -2, 0, 0, -2, 0, 0, 1],    # R22
 ], dtype=float)
+# The same columns as [ww xx yy zz | wx xy yz | wy xz | wz | 1]: four array calls make
+# these products (q*q, q[0:3]*q[1:4], q[0:2]*q[2:4], qw*qz). Each R entry keeps the order
+# of its non-zero terms, so the matrix product sums them as before.
+_ROT_FROM_GROUPED_PRODUCTS = _ROT_FROM_PRODUCTS[:, [0, 4, 7, 9, 1, 5, 8, 2, 6, 3, 10]]
+
+
+def rotation_kernel(q: np.ndarray, products: np.ndarray, R9: np.ndarray) -> Callable[[], None]:
+    """`rotate()`: R9 (9, N), rows R00 R01 ... R22, <- the rotations of q (4, N).
+
+    `products` is (11, N) scratch. The arrays are bound once: the engines call this every
+    step, where building views would cost as much as the arithmetic.
+    """
+    mul, matmul = np.multiply, np.matmul
+    products[10] = 1.0
+    qw, qx, qy, qz = q
+    if q.shape[1] == 1:
+        # One vehicle: numpy hands the product to BLAS's matrix-vector routine, which
+        # sums the terms in another order than the matrix-matrix one; the original column
+        # order keeps a lone vehicle flying exactly as a column of a batch does.
+        pairs = [(a, b, products[i]) for i, (a, b) in enumerate(
+            [(qw, qw), (qw, qx), (qw, qy), (qw, qz), (qx, qx), (qx, qy), (qx, qz), (qy, qy),
+             (qy, qz), (qz, qz)])]
+
+        def rotate() -> None:
+            for a, b, out in pairs:
+                mul(a, b, out)
+            matmul(_ROT_FROM_PRODUCTS, products, R9)
+
+        return rotate
+
+    q03, q13, q02, q24 = q[0:3], q[1:4], q[0:2], q[2:4]
+    squares, p3, p2, p1 = products[0:4], products[4:7], products[7:9], products[9]
+
+    def rotate() -> None:
+        mul(q, q, squares)
+        mul(q03, q13, p3)
+        mul(q02, q24, p2)
+        mul(qw, qz, p1)
+        matmul(_ROT_FROM_GROUPED_PRODUCTS, products, R9)
+
+    return rotate
 
 
 def rot_matrices(q: np.ndarray, products: np.ndarray | None = None) -> np.ndarray:
     """(3, 3, N) rotation matrices of (4, N) unit quaternions.
 
-    `products` is an optional (11, N) scratch array (last row all ones) to reuse.
+    `products` is an optional (11, N) scratch array to reuse.
     """
     N = q.shape[1]
-    if products is None:
-        products = np.empty((11, N))
-        products[10] = 1.0
-    mul = np.multiply
-    qw, qx, qy, qz = q[0], q[1], q[2], q[3]
-    mul(qw, qw, out=products[0])
-    mul(qw, qx, out=products[1])
-    mul(qw, qy, out=products[2])
-    mul(qw, qz, out=products[3])
-    mul(qx, qx, out=products[4])
-    mul(qx, qy, out=products[5])
-    mul(qx, qz, out=products[6])
-    mul(qy, qy, out=products[7])
-    mul(qy, qz, out=products[8])
-    mul(qz, qz, out=products[9])
-    return (_ROT_FROM_PRODUCTS @ products).reshape(3, 3, N)
+    R9 = np.empty((9, N))
+    rotation_kernel(q, np.empty((11, N)) if products is None else products, R9)()
+    return R9.reshape(3, 3, N)
 
 
-def _sub_cross(out: np.ndarray, a: np.ndarray, b: np.ndarray, tmp: np.ndarray) -> None:
-    """out -= a x b for (3, N) arrays, row by row through the (N,) scratch `tmp`."""
-    mul = np.multiply
-    for k, i, j in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
-        out[k] -= mul(a[i], b[j], out=tmp)
-        out[k] += mul(a[j], b[i], out=tmp)
+QUATERNION_WORK_ROWS = 11
 
 
-def integrate_quat(q: np.ndarray, w: np.ndarray, dt_s: float) -> np.ndarray:
-    """q * exp(w dt / 2), renormalised. q (4, N), w (3, N) body rates.
+def quaternion_kernel(q: np.ndarray, w: np.ndarray, dt_s: float,
+                      work: np.ndarray) -> Callable[[], None]:
+    """`advance()`: q <- q * exp(w dt / 2), renormalised, in place. q (4, N), w (3, N).
 
     exp(w dt / 2) = (cos h, sin h w / |w|) with h = |w| dt / 2. The result is renormalised,
     so any positive multiple of it will do: (|w| / tan h, w) needs one tangent instead
     of a cosine and a sine (numpy vectorises tan but not cos and sin). Where w = 0 (or h
-    underflows) the step is the identity, (1, 0).
+    underflows) the step is the identity, (1, 0). `work` is (QUATERNION_WORK_ROWS, N).
     """
-    mul = np.multiply
-    N = q.shape[1]
-    work = np.empty((4, N))
-    rate, tan_h, tmp, a = work[0], work[1], work[2], work[3]
-    wx, wy, wz = w[0], w[1], w[2]
-    qw, qx, qy, qz = q[0], q[1], q[2], q[3]
-    sq = w * w
-    np.add(sq[0], sq[1], out=rate)
-    rate += sq[2]
-    np.sqrt(rate, out=rate)
-    mul(rate, 0.5 * dt_s, out=tan_h)
-    np.tan(tan_h, out=tan_h)
-    a.fill(1.0)
-    np.divide(rate, tan_h, out=a, where=tan_h != 0.0)
-    out = np.empty_like(q)
-    # q * (a, w), the Hamilton product, row by row: +-(q component * p component)
-    for o, first, rest in ((out[0], (qw, a), ((-1, qx, wx), (-1, qy, wy), (-1, qz, wz))),
-                           (out[1], (qx, a), ((1, qw, wx), (1, qy, wz), (-1, qz, wy))),
-                           (out[2], (qy, a), ((1, qw, wy), (1, qz, wx), (-1, qx, wz))),
-                           (out[3], (qz, a), ((1, qw, wz), (1, qx, wy), (-1, qy, wx)))):
-        mul(*first, out=o)
-        for sign, qi, pi in rest:
-            if sign > 0:
-                o += mul(qi, pi, out=tmp)
-            else:
-                o -= mul(qi, pi, out=tmp)
-    sq = out * out
-    np.add(sq[0], sq[1], out=rate)
-    rate += sq[2]
-    rate += sq[3]
-    np.sqrt(rate, out=rate)
-    np.divide(1.0, rate, out=rate)
-    for o in out:
-        o *= rate
+    mul, add, sub, sqrt, div = np.multiply, np.add, np.subtract, np.sqrt, np.divide
+    out, tmp, rate, tan_h, a = work[0:4], work[4:8], work[8], work[9], work[10]
+    o0, o123 = out[0], out[1:4]
+    t0, t1, t2, t3, t123, t3rows = tmp[0], tmp[1], tmp[2], tmp[3], tmp[1:4], tmp[0:3]
+    qw, qx, qy, qz = q
+    wx, wy, wz = w
+    o = list(out)
+    half_dt = 0.5 * dt_s
+
+    def advance() -> None:
+        mul(w, w, t3rows)
+        add(t0, t1, rate)
+        add(rate, t2, rate)
+        sqrt(rate, rate)
+        mul(rate, half_dt, tan_h)
+        np.tan(tan_h, tan_h)
+        if tan_h.all():
+            div(rate, tan_h, a)
+        else:
+            a.fill(1.0)
+            div(rate, tan_h, out=a, where=tan_h != 0.0)
+        # q * (a, w), the Hamilton product: the four products of each term, then one
+        # array call adds (or subtracts) them to the four components.
+        mul(qw, a, o[0])
+        mul(qx, a, o[1])
+        mul(qy, a, o[2])
+        mul(qz, a, o[3])
+        mul(qx, wx, t0)
+        mul(qw, wx, t1)
+        mul(qw, wy, t2)
+        mul(qw, wz, t3)
+        sub(o0, t0, o0)
+        add(o123, t123, o123)
+        mul(qy, wy, t0)
+        mul(qy, wz, t1)
+        mul(qz, wx, t2)
+        mul(qx, wy, t3)
+        sub(o0, t0, o0)
+        add(o123, t123, o123)
+        mul(qz, wz, t0)
+        mul(qz, wy, t1)
+        mul(qx, wz, t2)
+        mul(qy, wx, t3)
+        sub(out, tmp, out)
+        mul(out, out, tmp)
+        add(t0, t1, rate)
+        add(rate, t2, rate)
+        add(rate, t3, rate)
+        sqrt(rate, rate)
+        div(1.0, rate, rate)
+        mul(o[0], rate, qw)
+        mul(o[1], rate, qx)
+        mul(o[2], rate, qy)
+        mul(o[3], rate, qz)
+
+    return advance
+
+
+def integrate_quat(q: np.ndarray, w: np.ndarray, dt_s: float) -> np.ndarray:
+    """q * exp(w dt / 2), renormalised, as a new array. q (4, N), w (3, N) body rates."""
+    out = np.array(q, dtype=float)
+    quaternion_kernel(out, w, dt_s, np.empty((QUATERNION_WORK_ROWS, q.shape[1])))()
     return out
 
 
@@ -205,7 +259,7 @@ class State:
 
 
 class PlantKernel:
-    """What body_wrench and step_rigid_body would otherwise re-derive every step.
+    """What the plant's step would otherwise re-derive every step.
 
     Built from a Plant once per run (after any change to the plant's arrays): the wrench
     map and per-vehicle factors, as full (k, N) arrays because numpy broadcasting a (k, 1)
@@ -229,11 +283,11 @@ class PlantKernel:
         # are its components rotated by one and two), so shift x F is two products of
         # (3, N) blocks instead of six of rows.
         self.wrench_map = wrench_map[[0, 1, 2, 0, 1, 3, 4, 5]]
-        self.rows = np.empty((wrench_map.shape[1], N))
+        self.n_rows = wrench_map.shape[1]
         self.n_rotors = n
         self.has_shift = bool(np.any(plant.com_shift_m != 0.0))
-        self.shift5 = plant.com_shift_m[[0, 1, 2, 0, 1]]
-        self.w5 = np.empty((5, N))         # scratch: w wrapped
+        s = plant.com_shift_m
+        self.shift5 = s[[0, 1, 2, 0, 1]]
         self.unit_scale = bool(np.all(plant.inertia_scale_sqrt == 1.0))
         self.inv_scale = 1.0 / plant.inertia_scale_sqrt
         J0 = plant.inertia_kg_m2
@@ -244,7 +298,6 @@ class PlantKernel:
             J = np.diag(J0)[:, None] * plant.inertia_scale_sqrt ** 2       # (3, N)
             self.inertia_diag = J
             self.gyro = np.array([J[2] - J[1], J[0] - J[2], J[1] - J[0]])
-        self.tmp = np.empty(N)             # scratch row
         self._dt_s = None
 
     def scaled(self, plant: Plant, dt_s: float) -> tuple[np.ndarray, np.ndarray | None]:
@@ -259,71 +312,150 @@ class PlantKernel:
         return self._dt_over_mass, self._dt_over_scale
 
 
+def rates_buffer(w: np.ndarray) -> np.ndarray:
+    """(5, N) [w0 w1 w2 w0 w1]: body rates "wrapped", so that the cross products with w
+    are products of (3, N) blocks. The kernels below take w as rows 0:3 of such a buffer
+    and refresh rows 3:5 themselves before using them."""
+    w5 = np.empty((5, w.shape[1]))
+    w5[0:3] = w
+    return w5
+
+
+def body_wrench_kernel(plant: Plant, kernel: PlantKernel, omega: np.ndarray, v: np.ndarray,
+                       w5: np.ndarray, R9: np.ndarray, wrench8: np.ndarray) -> Callable[[], None]:
+    """`evaluate()`: force and torque about the true COM, body axes, into wrench8 (8, N)
+    (force in rows 0:3, torque in rows 5:8): thrust, yaw drag, rotor drag, rolling moment.
+
+    omega (n, N) rotor speeds, v (3, N) world velocity, w5 rates_buffer, R9 (9, N) rows of
+    the body -> world rotations.
+    """
+    mul, add, sub, matmul = np.multiply, np.add, np.subtract, np.matmul
+    N, n = v.shape[1], kernel.n_rotors
+    rows = np.empty((kernel.n_rows, N))
+    thrust_rows = rows[:n]
+    motor_constant = np.array(plant.motor_constant, dtype=float)
+    wrench_map = kernel.wrench_map
+    ops: list[tuple] = []               # the twist part, unrolled once
+    if kernel.twist_used:
+        xi = np.zeros((3, N))           # velocity of the nominal COM, body axes
+        tmp = np.empty((2, 3, N))
+        linear = [j for j in kernel.twist_used if j < 3]
+        if linear:
+            # R^T v for the rows needed (einsum sums exactly as the per-vehicle loop would)
+            lo, hi = min(linear), max(linear) + 1
+            ops.append((functools.partial(np.einsum, "jin,jn->in", R9.reshape(3, 3, N)[:, lo:hi],
+                                          v, out=xi[lo:hi]),))
+        if linear and kernel.has_shift:
+            # minus w x shift: xi_j -= w_a s_b, xi_j += w_b s_a with a, b = j + 1, j + 2
+            # (mod 3), for the rows lo..hi at once
+            s = plant.com_shift_m
+            s_b = np.array([s[(j + 2) % 3] for j in range(lo, hi)])
+            s_a = np.array([s[(j + 1) % 3] for j in range(lo, hi)])
+            ops += [(np.copyto, w5[3:5], w5[0:2]),
+                    (mul, w5[lo + 1:hi + 1], s_b, tmp[0, :hi - lo]),
+                    (sub, xi[lo:hi], tmp[0, :hi - lo], xi[lo:hi]),
+                    (mul, w5[lo + 2:hi + 2], s_a, tmp[1, :hi - lo]),
+                    (add, xi[lo:hi], tmp[1, :hi - lo], xi[lo:hi])]
+        for block, j in enumerate(kernel.twist_used, start=1):
+            ops.append((mul, omega, xi[j] if j < 3 else w5[j - 3],
+                        rows[n * block:n * (block + 1)]))
+    if kernel.has_shift:
+        # Moments were taken about the nominal COM; about the true one: tau - shift x F,
+        # (s x F)_k = s_{k+1} F_{k+2} - s_{k+2} F_{k+1} on the wrapped rows.
+        s5, F5, torque = kernel.shift5, wrench8[0:5], wrench8[5:8]
+        cross = np.empty((3, N))
+        shift_ops = [(mul, s5[1:4], F5[2:5], cross), (sub, torque, cross, torque),
+                     (mul, s5[2:5], F5[1:4], cross), (add, torque, cross, torque)]
+    else:
+        shift_ops = []
+
+    def evaluate() -> None:
+        mul(omega, omega, thrust_rows)
+        mul(thrust_rows, motor_constant, thrust_rows)
+        for f, *args in ops:
+            f(*args)
+        matmul(wrench_map, rows, wrench8)
+        for f, *args in shift_ops:
+            f(*args)
+
+    return evaluate
+
+
+def rigid_body_kernel(plant: Plant, kernel: PlantKernel, p: np.ndarray, v: np.ndarray,
+                      q: np.ndarray, w5: np.ndarray, R9: np.ndarray, wrench8: np.ndarray,
+                      dt_s: float) -> Callable[[], None]:
+    """`advance()`: p, v, q, w one semi-implicit Euler step, in place, under the body
+    wrench in wrench8 (body_wrench_kernel's layout). w5 is a rates_buffer."""
+    mul, add, sub, matmul = np.multiply, np.add, np.subtract, np.matmul
+    N = v.shape[1]
+    dt_over_mass, dt_over_scale = kernel.scaled(plant, dt_s)
+    force, torque = wrench8[0:3], wrench8[5:8]
+    w = w5[0:3]
+    R = R9.reshape(3, 3, N)
+    scratch = np.empty((4, 3, N))
+    fm, dv, rhs, tmp = scratch
+    einsum = np.einsum
+    vz, dt_g = v[2], dt_s * plant.g_m_s2
+    # Euler's equations, J w' = tau - w x J w, with J = S J0 S
+    if kernel.diagonal:
+        # (w x J w)_k = (J_{k+2} - J_{k+1}) w_{k+1} w_{k+2}; dt_over_scale is dt / J here
+        rotation = [(np.copyto, w5[3:5], w5[0:2]), (mul, w5[1:4], w5[2:5], tmp),
+                    (mul, tmp, kernel.gyro, tmp), (sub, torque, tmp, rhs),
+                    (mul, rhs, dt_over_scale, rhs), (add, w, rhs, w)]
+    else:
+        J0, J0_inv = plant.inertia_kg_m2, plant.inertia_inv_kg_m2
+        Jw5 = np.empty((5, N))
+        Jw = Jw5[0:3]
+        rotation = [(np.copyto, w5[3:5], w5[0:2])]
+        if kernel.unit_scale:
+            rotation.append((matmul, J0, w, Jw))
+        else:
+            S = plant.inertia_scale_sqrt
+            rotation += [(mul, S, w, tmp), (matmul, J0, tmp, Jw), (mul, Jw, S, Jw)]
+        rotation += [
+            (np.copyto, Jw5[3:5], Jw5[0:2]),
+            # rhs = tau - w x J w: (w x b)_k = w_{k+1} b_{k+2} - w_{k+2} b_{k+1}
+            (mul, w5[1:4], Jw5[2:5], tmp), (sub, torque, tmp, rhs),
+            (mul, w5[2:5], Jw5[1:4], tmp), (add, rhs, tmp, rhs)]
+        if kernel.unit_scale:
+            rotation += [(mul, rhs, dt_s, rhs), (matmul, J0_inv, rhs, tmp), (add, w, tmp, w)]
+        else:
+            rotation += [(mul, rhs, kernel.inv_scale, rhs), (matmul, J0_inv, rhs, tmp),
+                         (mul, tmp, dt_over_scale, tmp), (add, w, tmp, w)]
+    rotate_q = quaternion_kernel(q, w, dt_s, np.empty((QUATERNION_WORK_ROWS, N)))
+
+    def advance() -> None:
+        mul(force, dt_over_mass, fm)
+        einsum("ijn,jn->in", R, fm, out=dv)
+        add(v, dv, v)
+        sub(vz, dt_g, vz)
+        for f, *args in rotation:
+            f(*args)
+        mul(v, dt_s, tmp)
+        add(p, tmp, p)
+        rotate_q()
+
+    return advance
+
+
 def body_wrench(plant: Plant, state: State, R: np.ndarray,
                 kernel: PlantKernel | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Force and torque about the true COM, body axes: thrust, yaw drag, rotor drag."""
     kernel = kernel or PlantKernel(plant)
-    n, rows, omega, tmp = kernel.n_rotors, kernel.rows, state.omega, kernel.tmp
-    np.multiply(omega, omega, out=rows[:n])
-    rows[:n] *= plant.motor_constant
-    if kernel.twist_used:
-        w, shift = state.w, plant.com_shift_m
-        # velocity of the body point at the nominal COM (which rotor positions are taken
-        # from), body axes: R^T v - w x shift
-        v_o = np.einsum("jin,jn->in", R, state.v) if kernel.twist_used[0] < 3 else None
-        for block, j in enumerate(kernel.twist_used, start=1):
-            if j < 3:
-                xi = v_o[j]
-                if kernel.has_shift:
-                    a, b = (j + 1) % 3, (j + 2) % 3
-                    xi -= np.multiply(w[a], shift[b], out=tmp)
-                    xi += np.multiply(w[b], shift[a], out=tmp)
-            else:
-                xi = w[j - 3]
-            np.multiply(omega, xi, out=rows[n * block:n * (block + 1)])
-    wrench = kernel.wrench_map @ rows
-    force, torque = wrench[0:3], wrench[5:8]
-    if kernel.has_shift:
-        # Moments were taken about the nominal COM; about the true one: tau - shift x F,
-        # (s x F)_k = s_{k+1} F_{k+2} - s_{k+2} F_{k+1} on the wrapped rows.
-        s5, F5 = kernel.shift5, wrench[0:5]
-        torque -= s5[1:4] * F5[2:5]
-        torque += s5[2:5] * F5[1:4]
-    return force, torque
+    wrench8 = np.empty((8, plant.n_vehicles))
+    body_wrench_kernel(plant, kernel, state.omega, state.v, rates_buffer(state.w),
+                       np.ascontiguousarray(R).reshape(9, -1), wrench8)()
+    return wrench8[0:3], wrench8[5:8]
 
 
 def step_rigid_body(plant: Plant, state: State, R: np.ndarray, force_b: np.ndarray,
                     torque_b: np.ndarray, dt_s: float, kernel: PlantKernel | None = None) -> None:
     """Advance p, v, q, w one semi-implicit Euler step, in place."""
     kernel = kernel or PlantKernel(plant)
-    dt_over_mass, dt_over_scale = kernel.scaled(plant, dt_s)
-    v, w, tmp = state.v, state.w, kernel.tmp
-    v += np.einsum("ijn,jn->in", R, force_b * dt_over_mass)
-    v[2] -= dt_s * plant.g_m_s2
-    # Euler's equations, J w' = tau - w x J w, with J = S J0 S.
-    rhs = torque_b.copy()
-    if kernel.diagonal:
-        # (w x J w)_k = (J_{k+2} - J_{k+1}) w_{k+1} w_{k+2}; dt_over_scale is dt / J here
-        w5 = kernel.w5
-        w5[0:3] = w
-        w5[3:5] = w[0:2]
-        gyro = w5[1:4] * w5[2:5]
-        gyro *= kernel.gyro
-        rhs -= gyro
-        rhs *= dt_over_scale
-        w += rhs
-    elif kernel.unit_scale:
-        _sub_cross(rhs, w, plant.inertia_kg_m2 @ w, tmp)
-        rhs *= dt_s
-        w += plant.inertia_inv_kg_m2 @ rhs
-    else:
-        S = plant.inertia_scale_sqrt
-        Jw = plant.inertia_kg_m2 @ (S * w)
-        Jw *= S
-        _sub_cross(rhs, w, Jw, tmp)
-        rhs *= kernel.inv_scale
-        dw = plant.inertia_inv_kg_m2 @ rhs
-        dw *= dt_over_scale
-        w += dw
-    state.p += v * dt_s
-    state.q = integrate_quat(state.q, w, dt_s)
+    N = plant.n_vehicles
+    wrench8 = np.empty((8, N))
+    wrench8[0:3], wrench8[5:8] = force_b, torque_b
+    w5 = rates_buffer(state.w)
+    rigid_body_kernel(plant, kernel, state.p, state.v, state.q, w5,
+                      np.ascontiguousarray(R).reshape(9, -1), wrench8, dt_s)()
+    state.w[...] = w5[0:3]
