@@ -10,6 +10,7 @@ from __future__ import annotations
 import importlib
 import os
 import sys
+import warnings
 
 import click
 
@@ -52,20 +53,38 @@ def cli() -> None:
     """Check, trim and package multirotor models for ROS/Gazebo, without ROS or Gazebo."""
 
 
+def _usage_error_line(exc: click.UsageError) -> str:
+    """A click usage error as one line, like every other reedtool error."""
+    text = " ".join(exc.format_message().split())
+    command = exc.ctx.command_path if exc.ctx is not None else "reedtool"
+    return f"reedtool: error: {text} (see '{command} --help')"
+
+
 def main(argv: list[str] | None = None) -> None:
     """Console-script entry: user errors become one line and exit 2, never a traceback."""
     from .errors import ReedtoolError
 
     try:
-        # Commands return their exit code (0 ok, 1 findings/failed check); --help and
-        # --version return None through click's Exit.
-        exit_code = cli.main(args=argv, prog_name="reedtool", standalone_mode=False)
+        with warnings.catch_warnings():
+            if not os.environ.get("REEDTOOL_DEBUG"):
+                # numpy's "invalid value" chatter on NaN input: the NaN itself is reported
+                # (a finding or an error naming its line); the warning only adds noise.
+                warnings.simplefilter("ignore", RuntimeWarning)
+            # Commands return their exit code (0 ok, 1 findings/failed check); --help and
+            # --version return None through click's Exit.
+            exit_code = cli.main(args=argv, prog_name="reedtool", standalone_mode=False)
     except click.exceptions.Abort:
         click.echo("reedtool: aborted", err=True)
         sys.exit(130)
-    except click.ClickException as exc:
-        exc.show()
+    except click.exceptions.NoArgsIsHelpError as exc:
+        exc.show()   # `reedtool` alone: the help text, not an error line
         sys.exit(2)
+    except click.UsageError as exc:
+        click.echo(_usage_error_line(exc), err=True)
+        sys.exit(2)
+    except click.ClickException as exc:
+        click.echo(f"reedtool: error: {' '.join(exc.format_message().split())}", err=True)
+        sys.exit(exc.exit_code if exc.exit_code else 2)
     except ReedtoolError as exc:
         click.echo(f"reedtool: error: {exc.one_line()}", err=True)
         sys.exit(2)

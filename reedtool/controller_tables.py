@@ -132,15 +132,13 @@ def velocity_control_tables(robot: Robot) -> list[ControllerTable]:
 # ------------------------------------------------------------ RotorS YAML
 
 def load_controller_yaml(path: Path | str) -> ControllerTable:
+    from .fileio import read_text_file
+
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError as exc:
+    if not path.exists() and not path.is_symlink():
         raise ReedtoolError("controller file not found", file=path,
-                            hint="check the --controller path") from exc
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ReedtoolError(f"cannot read controller file: {exc}", file=path) from exc
-    return parse_controller_yaml(text, path)
+                            hint="check the --controller path")
+    return parse_controller_yaml(read_text_file(path, what="controller file"), path)
 
 
 def _find_vehicle_mapping(node, depth: int = 0):

@@ -20,6 +20,7 @@ from __future__ import annotations
 import ast
 import contextlib
 import difflib
+import errno
 import io
 import math
 import functools
@@ -40,6 +41,7 @@ from xacro import substitution_args
 
 from .errors import ReedtoolError
 from .legacy import LegacyScan, LegacyTag, scan_tree
+from .loader import parse_mappings  # noqa: F401 - re-exported for callers
 from .model import SourceLoc
 from .packages import PackageResolver, is_bundled
 
@@ -75,18 +77,6 @@ def _display_path(path: str, cwd: str) -> str:
     except ValueError:
         return path
     return rel if not rel.startswith("..") else path
-
-
-def parse_mappings(args: Sequence[str]) -> dict[str, str]:
-    """`name:=value` command-line arguments, as roslaunch and xacro take them."""
-    mappings: dict[str, str] = {}
-    for arg in args:
-        name, sep, value = arg.partition(":=")
-        if not sep or not name.strip():
-            raise ReedtoolError(f"cannot read argument '{arg}'",
-                                hint="xacro arguments are written name:=value")
-        mappings[name.strip()] = value
-    return mappings
 
 
 # ----------------------------------------------------------------- line tracking
@@ -272,8 +262,31 @@ def _guard_lshift(a, b):
     return a << b
 
 
+def _guard_range(*args):
+    numbers = range(*args)
+    if len(numbers) > MAX_SEQUENCE_LEN:
+        raise RunawayExpression(f"a range of {len(numbers)} numbers")
+    return numbers
+
+
+MAX_COMBINATORIAL_ARG = 100_000   # factorial(10**7) alone runs for minutes inside C
+
+
+def _guarded_combinatorial(function):
+    def guarded(*args):
+        if any(isinstance(a, int) and a > MAX_COMBINATORIAL_ARG for a in args):
+            raise RunawayExpression(f"{function.__name__} of a number above "
+                                    f"{MAX_COMBINATORIAL_ARG}")
+        return function(*args)
+    return guarded
+
+
 _GUARDS = {"_reedtool_pow": _guard_pow, "_reedtool_mul": _guard_mul,
            "_reedtool_lshift": _guard_lshift}
+# xacro's own symbols that can run for hours in one call, replaced while expanding.
+_GUARDED_SYMBOLS = {"range": _guard_range,
+                    **{name: _guarded_combinatorial(getattr(math, name))
+                       for name in ("factorial", "comb", "perm")}}
 _GUARDED_OPS = {ast.Pow: "_reedtool_pow", ast.Mult: "_reedtool_mul",
                 ast.LShift: "_reedtool_lshift"}
 
@@ -394,6 +407,9 @@ def _patched(st: _Tracker):
                                 file=loc.file if loc else None, line=loc.line if loc else None,
                                 hint="remove one of the includes; a file cannot include itself")
         try:
+            if path.exists() and not path.is_file() and not path.is_dir():
+                # /dev/zero or a pipe would be read forever.
+                raise OSError(errno.EINVAL, "not a regular file (a device or pipe?)", filename)
             data = path.read_bytes()
         except OSError as exc:
             xacro.filestack.pop()   # as xacro does: the missing file is not "being processed"
@@ -486,6 +502,12 @@ def _patched(st: _Tracker):
     xacro.print_location = lambda: None
     xacro.safe_eval = _guarded_safe_eval(orig["safe_eval"])
     xacro._global_symbols.update(_GUARDS)   # visible from every scope, comprehensions too
+    namespaces = [xacro._global_symbols, xacro._global_symbols.get("python"),
+                  xacro._global_symbols.get("math")]
+    replaced = [(table, name, table[name]) for table in namespaces if isinstance(table, dict)
+                for name in _GUARDED_SYMBOLS if name in table]
+    for table, name, _ in replaced:
+        dict.__setitem__(table, name, _GUARDED_SYMBOLS[name])
     xml.dom.minidom._clone_node = clone_node
     substitution_args._eval_find = find
     substitution_args._eval_dict["find"] = find
@@ -496,6 +518,8 @@ def _patched(st: _Tracker):
             setattr(xacro, name, value)
         for name in _GUARDS:
             xacro._global_symbols.pop(name, None)
+        for table, name, original in replaced:
+            dict.__setitem__(table, name, original)
         xml.dom.minidom._clone_node = _orig_clone_node
         substitution_args._eval_find = orig_find
         if orig_find_dict is not None:
@@ -556,8 +580,20 @@ def _as_reedtool_error(exc: BaseException) -> ReedtoolError:
         return ReedtoolError("expansion recursed too deeply (runaway macro recursion?)",
                              **where, hint="a macro that calls itself needs an xacro:if that "
                                            "stops it")
-    text = " ".join(str(exc).split()) or type(inner).__name__
-    return ReedtoolError(f"xacro: {text}", **where)
+    return ReedtoolError(f"xacro: {_xacro_message(exc, inner)}", **where)
+
+
+def _xacro_message(exc: BaseException, inner: BaseException) -> str:
+    """xacro's text for `exc` without the class reprs and repeats it adds when wrapping."""
+    text = " ".join(str(exc).split())
+    text = re.sub(r"<class '(?:[\w.]+\.)?(\w+)'>:\s*", "", text)
+    inner_text = " ".join(str(inner).split())
+    if inner is not exc and inner_text:
+        first = text.find(inner_text)
+        if first >= 0:
+            end = first + len(inner_text)
+            text = text[:end] + text[end:].replace(inner_text, "", 1)
+    return " ".join(text.split()) or type(inner).__name__
 
 
 # ----------------------------------------------------------------- api
@@ -616,10 +652,20 @@ def expand_xacro(path: Path, mappings: dict[str, str] | None = None,
             with _patched(st), contextlib.redirect_stderr(captured):
                 _reset_xacro_globals(path)
                 try:
-                    doc = xacro.parse(None, str(path))
-                    xacro.process_doc(doc, mappings=dict(mappings), verbosity=1)
+                    with _alarm(time_budget_s + _ALARM_GRACE_S, st):
+                        doc = xacro.parse(None, str(path))
+                        xacro.process_doc(doc, mappings=dict(mappings), verbosity=1)
                 except ReedtoolError:
                     raise
+                except _Timeout as timeout:
+                    loc = timeout.args[0] if timeout.args else None
+                    raise ReedtoolError(
+                        f"expansion stopped after {time_budget_s:g} s (runaway macro recursion "
+                        "or an expression that keeps growing?)",
+                        file=loc.file if loc else display_path(path),
+                        line=loc.line if loc else None,
+                        hint="check the expressions and macros here for a loop that does not "
+                             "end") from None
                 except Exception as exc:  # noqa: BLE001 - every xacro failure is the user's input
                     raise _as_reedtool_error(exc) from None
                 finally:
@@ -635,6 +681,39 @@ def expand_xacro(path: Path, mappings: dict[str, str] | None = None,
     st.warnings.extend(line for line in captured.getvalue().splitlines() if line.strip())
     element_locs = _with_urdf_lines(urdf_xml, sites, path)
     return Expansion(urdf_xml, element_locs, legacy.tags, resolver, st.warnings, st.files)
+
+
+# The budget is checked between elements; one expression looping in Python
+# (`${[0 for a in range(9999) for b in range(9999)]}`) is stopped by a timer signal.
+_ALARM_GRACE_S = 0.5
+
+
+class _Timeout(BaseException):
+    """Raised by the timer signal; a BaseException so that xacro does not wrap it."""
+
+
+@contextlib.contextmanager
+def _alarm(seconds: float, st: _Tracker):
+    """Raise _Timeout(location being expanded) after `seconds` (main thread only)."""
+    import signal
+
+    if threading.current_thread() is not threading.main_thread() or \
+            not hasattr(signal, "setitimer"):
+        yield
+        return
+
+    def expire(_signum, _frame):
+        raise _Timeout(st.current_loc())
+
+    previous = signal.signal(signal.SIGALRM, expire)
+    previous_timer = signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+        if previous_timer[0] > 0:   # someone else's timer: let it run on
+            signal.setitimer(signal.ITIMER_REAL, *previous_timer)
 
 
 def _add_banner(doc, path: Path) -> None:

@@ -174,6 +174,8 @@ def scan_tree(model: Path, resolve_include: Callable[[str, Path], Path | None],
         path = pending.pop(0)
         if path in texts:
             continue
+        if not path.is_file():
+            continue  # missing, a directory or a device: the expansion reports it
         try:
             texts[path] = path.read_text(encoding="utf-8")
         except (OSError, UnicodeDecodeError):

@@ -215,10 +215,9 @@ def check_package_name(name: str) -> None:
 def read_spec_file(path: Path) -> dict:
     import yaml
 
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ReedtoolError(f"cannot read spec: {exc.strerror}", file=path) from exc
+    from .fileio import read_text_file
+
+    text = read_text_file(Path(path), what="spec file")
     try:
         data = yaml.safe_load(text)
     except yaml.YAMLError as exc:
@@ -249,8 +248,14 @@ def build_spec(name: str, *, frame: str | None = None, ros: int | None = None,
                             f"'{name}'", file=spec_file, hint="drop `name` from the spec or "
                             "use the same name")
     check_package_name(name)
+    _check_text_keys(data, spec_file)
 
-    frame_obj = get_frame(frame or str(data.get("frame", "quad-x")))
+    try:
+        frame_obj = get_frame(frame or str(data.get("frame", "quad-x")))
+    except ReedtoolError as exc:
+        if frame is not None or exc.file is not None:
+            raise
+        raise ReedtoolError(f"frame: {exc.message}", file=spec_file, hint=exc.hint) from None
     ros_value = ros if ros is not None else data.get("ros", 1)
     if str(ros_value) not in ("1", "2"):
         raise ReedtoolError(f"ros: must be 1 or 2, got {ros_value!r}", file=spec_file)
@@ -302,6 +307,26 @@ def build_spec(name: str, *, frame: str | None = None, ros: int | None = None,
     )
     check_geometry(spec)
     return spec
+
+
+# catkin and ament both require a version of three dot-separated integers (REP 149).
+_VERSION = re.compile(r"^\d+\.\d+\.\d+$")
+
+
+def _check_text_keys(data: Mapping[str, object], spec_file: Path | None) -> None:
+    """Text keys are single strings; `version` is X.Y.Z. A list or a map here would be
+    printed into package.xml as Python's repr."""
+    for key in TEXT_KEYS:
+        value = data.get(key)
+        if value is None:
+            continue
+        if isinstance(value, bool) or not isinstance(value, (str, int, float)):
+            raise ReedtoolError(f"{key}: expected a single value, got {type(value).__name__}",
+                                file=spec_file, hint=f"write {key}: on one line")
+    version = data.get("version")
+    if version is not None and not _VERSION.match(str(version)):
+        raise ReedtoolError(f"version: '{version}' is not MAJOR.MINOR.PATCH", file=spec_file,
+                            hint="write it quoted with three numbers, e.g. version: \"0.1.0\"")
 
 
 def _choose_simulator(flag: str | None, from_spec, frame_obj, ros: int,

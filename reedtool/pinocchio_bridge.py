@@ -10,6 +10,11 @@ reedtool.inertia.whole_robot works too. All joints sit at their neutral (zero) p
 
 from __future__ import annotations
 
+import contextlib
+import os
+import sys
+import tempfile
+
 import numpy as np
 
 from .errors import ReedtoolError
@@ -24,13 +29,51 @@ def build_model(robot: Robot):
     if not robot.urdf_xml:
         raise ReedtoolError(f"robot '{robot.name}' has no URDF text to give Pinocchio",
                             file=robot.source_file)
-    try:
-        model = pin.buildModelFromXML(robot.urdf_xml, pin.JointModelFreeFlyer())
-    except Exception as exc:  # noqa: BLE001 - Pinocchio raises bare RuntimeError and others
-        raise ReedtoolError(f"Pinocchio cannot build the model: {' '.join(str(exc).split())}",
-                            file=robot.source_file,
-                            hint="run `reedtool validate` on the model first") from exc
+    hint = "run `reedtool validate` on the model first"
+    with _captured_stderr() as captured:
+        try:
+            model = pin.buildModelFromXML(robot.urdf_xml, pin.JointModelFreeFlyer())
+        except Exception as exc:  # noqa: BLE001 - Pinocchio raises bare RuntimeError and others
+            model, failure = None, exc
+    complaints = _urdfdom_errors(captured.text)
+    if model is None:
+        reason = "; ".join(complaints) or " ".join(str(failure).split())
+        raise ReedtoolError(f"Pinocchio cannot build the model: {reason}",
+                            file=robot.source_file, hint=hint) from failure
+    if complaints:
+        # urdfdom skipped an element it could not read (an <inertial>, a <visual>) and went
+        # on: the model it built is not the one written, so nothing computed from it holds.
+        raise ReedtoolError(f"Pinocchio's URDF parser skipped part of the model: "
+                            f"{'; '.join(complaints)}", file=robot.source_file, hint=hint)
     return model, model.createData()
+
+
+class _Captured:
+    text = ""
+
+
+@contextlib.contextmanager
+def _captured_stderr():
+    """Collect what C++ code writes to file descriptor 2 (urdfdom's console_bridge), so it
+    becomes part of a one-line error instead of raw lines on the user's terminal."""
+    captured = _Captured()
+    sys.stderr.flush()
+    with tempfile.TemporaryFile() as sink:
+        saved = os.dup(2)
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield captured
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            sink.seek(0)
+            captured.text = sink.read().decode("utf-8", "replace")
+
+
+def _urdfdom_errors(text: str) -> list[str]:
+    """urdfdom's 'Error:' lines (without the 'at line N in file.cpp' that follows each)."""
+    return [" ".join(line.split(":", 1)[1].split()) for line in text.splitlines()
+            if line.startswith("Error:")]
 
 
 def whole_robot_pinocchio(robot: Robot) -> MassProperties:

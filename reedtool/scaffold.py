@@ -61,7 +61,11 @@ def _environment(root: Path):
         keep_trailing_newline=True,
         trim_blocks=True,
         lstrip_blocks=True,
-        autoescape=False,
+        # package.xml carries the user's description and maintainer: "&" or "<" there
+        # must be escaped, or the manifest is not XML. Other templates hold only checked
+        # names and numbers, and are not all XML (CMake, Python, Markdown).
+        autoescape=jinja2.select_autoescape(enabled_extensions=("xml.j2",),
+                                            default_for_string=False, default=False),
     )
 
 

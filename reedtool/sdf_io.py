@@ -68,21 +68,19 @@ RESOURCE_PATH_VARS = ("GZ_SIM_RESOURCE_PATH", "IGN_GAZEBO_RESOURCE_PATH", "SDF_P
 
 def load_sdf_file(path: Path | str, *, resolver=None) -> Robot:
     """Read an SDF file (a model.sdf, or a world holding one model) into a Robot."""
+    from .fileio import read_xml_file
+
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError as exc:
-        raise ReedtoolError("file not found", file=path, hint="check the path") from exc
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ReedtoolError(f"cannot read file: {exc}", file=path) from exc
+    text, _encoding = read_xml_file(path, what="SDF file")
     return parse_sdf(text, path, resolver=resolver)
 
 
 def parse_sdf(xml_text: str, file: Path | str, *, resolver=None) -> Robot:
     file = Path(file)
     try:
-        parser = etree.XMLParser(remove_blank_text=False, resolve_entities=False, huge_tree=True)
-        root = etree.fromstring(xml_text.encode("utf-8"), parser)
+        from .urdf_io import xml_parser
+
+        root = etree.fromstring(xml_text.encode("utf-8"), xml_parser())
     except etree.XMLSyntaxError as exc:
         raise ReedtoolError(f"malformed XML: {exc.msg}", file=file, line=exc.lineno,
                             hint="fix the XML syntax at that position") from exc

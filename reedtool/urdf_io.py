@@ -35,8 +35,7 @@ def parse_urdf(xml_text: str, file: Path | str, *, resolver=None,
     """
     file = Path(file)
     try:
-        parser = etree.XMLParser(remove_blank_text=False, resolve_entities=False, huge_tree=True)
-        root = etree.fromstring(xml_text.encode("utf-8"), parser)
+        root = etree.fromstring(xml_text.encode("utf-8"), xml_parser())
     except etree.XMLSyntaxError as exc:
         line = exc.lineno if element_locs is None else None
         raise ReedtoolError(f"malformed XML: {exc.msg}", file=file, line=line,
@@ -51,14 +50,18 @@ def parse_urdf(xml_text: str, file: Path | str, *, resolver=None,
     return _RobotReader(file, locate, resolver).read(root, xml_text)
 
 
+def xml_parser() -> etree.XMLParser:
+    """The parser for model text: no entity expansion, and the text is UTF-8 whatever its
+    declaration says (reedtool.fileio.read_xml_file has already decoded it)."""
+    return etree.XMLParser(remove_blank_text=False, resolve_entities=False, huge_tree=True,
+                           encoding="utf-8")
+
+
 def load_urdf_file(path: Path | str, *, resolver=None) -> Robot:
+    from .fileio import read_xml_file
+
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError as exc:
-        raise ReedtoolError("file not found", file=path, hint="check the path") from exc
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ReedtoolError(f"cannot read file: {exc}", file=path) from exc
+    text, _encoding = read_xml_file(path, what="URDF file")
     return parse_urdf(text, path, resolver=resolver)
 
 
@@ -138,6 +141,9 @@ class _RobotReader:
     def read(self, root: etree._Element, xml_text: str) -> Robot:
         robot = Robot(name=root.get("name", ""), loc=self.locate(root), source_file=self.file,
                       urdf_xml=xml_text)
+        if not root.get("name"):
+            # urdfdom (check_urdf, Pinocchio) refuses a robot without a name.
+            self._issue("missing-attribute", "<robot> has no name= attribute", root, None)
         for el in root:
             if not isinstance(el.tag, str):
                 continue

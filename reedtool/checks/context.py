@@ -71,6 +71,7 @@ class CheckContext:
         self.controllers = list(controllers)
         self._geometry_props: dict[str, Any] = {}
         self._mesh_bounds: dict[str, Any] = {}
+        self._mesh_errors: dict[str, str] = {}     # path -> why it is not a usable mesh
 
     # ------------------------------------------------------------ structure
 
@@ -168,6 +169,29 @@ class CheckContext:
                     result = None
         self._geometry_props[link.name] = result
         return result
+
+    def mesh_error(self, mesh) -> str | None:
+        """Why a resolved STL file holds no usable mesh (empty, truncated, NaN), or None.
+
+        A flat mesh is fine here: a plane is a valid visual, it only has no volume.
+        """
+        if mesh.path is None:
+            return None
+        key = str(mesh.path)
+        if key not in self._mesh_errors:
+            from ..errors import ReedtoolError
+            from ..mesh import check_triangles, read_stl, triangle_areas
+
+            error = ""
+            try:
+                triangles = read_stl(key).triangles
+                if len(triangles) == 0 or not np.isfinite(triangles).all() \
+                        or float(triangle_areas(triangles).sum()) == 0.0:
+                    check_triangles(triangles, key)   # raises with the reason
+            except ReedtoolError as exc:
+                error = exc.message
+            self._mesh_errors[key] = error
+        return self._mesh_errors[key] or None
 
     def mesh_bounds(self, mesh) -> np.ndarray | None:
         """(2, 3) min/max corners of a mesh file in its own frame, scale applied; None if unreadable."""

@@ -248,6 +248,10 @@ def mesh_unresolved(ctx: CheckContext) -> Iterator[Issue]:
     """Every `<mesh filename=>` must resolve to a readable file: `package://PKG/...`
     through the package search path, `file://` and plain paths relative to the model.
     Gazebo shows nothing (or fails to spawn) for a mesh it cannot find.
+
+    An STL file must also hold a mesh: an empty or truncated export, or one with NaN
+    coordinates, is reported with what is wrong with it. (Other formats are read by
+    Gazebo's own loaders and are only checked to exist.)
     """
     for link in ctx.robot.links:
         for shape in [*link.visuals, *link.collisions]:
@@ -264,6 +268,10 @@ def mesh_unresolved(ctx: CheckContext) -> Iterator[Issue]:
                 yield Issue(f"link '{link.name}' {kind} mesh '{mesh.uri}': {mesh.path} "
                             "is not a readable file", shape.loc, link.name,
                             hint="check the file name and its case")
+            elif mesh.path.suffix.lower() == ".stl" and ctx.mesh_error(mesh):
+                yield Issue(f"link '{link.name}' {kind} mesh '{mesh.uri}': "
+                            f"{ctx.mesh_error(mesh)}", shape.loc, link.name,
+                            hint="export the part again as STL")
 
 
 def _geometry_sizes(geometry) -> dict[str, float]:

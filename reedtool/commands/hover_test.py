@@ -17,8 +17,14 @@ from pathlib import Path
 import click
 
 from ..errors import ReedtoolError
+from .params import FiniteFloatRange
 
 SPREAD_HELP = "Half-width of the uniform perturbation"
+# A COM shifted by a metre is another vehicle, not a perturbation of this one.
+MAX_COM_SPREAD_M = 1.0
+# 10^7 fixed steps is 10,000 s at 1 kHz, far beyond any hover test; more is a typo
+# (`--duration 1e9`) that would keep the machine busy for days.
+MAX_STEPS = 10_000_000
 
 
 @click.command(name="hover-test")
@@ -48,17 +54,17 @@ SPREAD_HELP = "Half-width of the uniform perturbation"
               show_default=True, help="Output format.")
 @click.option("--samples", type=click.IntRange(min=1), default=None,
               help="Also fly N perturbed vehicles (robustness batch).")
-@click.option("--seed", type=int, default=0, show_default=True,
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Random seed of the robustness batch.")
-@click.option("--mass-spread", type=click.FloatRange(0.0, 0.9), default=0.10,
+@click.option("--mass-spread", type=FiniteFloatRange(0.0, 0.9), default=0.10,
               show_default=True, help=f"{SPREAD_HELP} of the mass (fraction).")
-@click.option("--com-spread", "com_spread_m", type=click.FloatRange(min=0.0), default=0.01,
+@click.option("--com-spread", "com_spread_m", type=FiniteFloatRange(0.0, MAX_COM_SPREAD_M), default=0.01,
               show_default=True, help=f"{SPREAD_HELP} of the COM on each axis [m].")
-@click.option("--inertia-spread", type=click.FloatRange(0.0, 0.9), default=0.10,
+@click.option("--inertia-spread", type=FiniteFloatRange(0.0, 0.9), default=0.10,
               show_default=True, help=f"{SPREAD_HELP} of each principal moment (fraction).")
-@click.option("--motor-spread", type=click.FloatRange(0.0, 0.9), default=0.05,
+@click.option("--motor-spread", type=FiniteFloatRange(0.0, 0.9), default=0.05,
               show_default=True, help=f"{SPREAD_HELP} of each motor constant (fraction).")
-@click.option("--min-pass-rate", type=click.FloatRange(0.0, 1.0), default=0.95,
+@click.option("--min-pass-rate", type=FiniteFloatRange(0.0, 1.0), default=0.95,
               show_default=True, help="Batch pass rate needed to exit 0.")
 def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
             duration_s: float, rate_hz: float, offset_m: tuple[float, float, float],
@@ -79,6 +85,12 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
         config.validate()
     except ValueError as exc:
         raise ReedtoolError(f"bad option: {exc}", hint="see reedtool hover-test --help") from exc
+    steps = duration_s * rate_hz
+    if steps > MAX_STEPS:
+        raise ReedtoolError(f"bad option: --duration {duration_s:g} s at --rate {rate_hz:g} Hz "
+                            f"is {steps:.3g} steps, more than {MAX_STEPS:.0e}",
+                            hint="a hover test settles in seconds; the defaults are 10 s at "
+                                 "1000 Hz")
     for path in (plot_path, csv_path):
         if path is not None and path.exists() and not force:
             raise ReedtoolError("refusing to overwrite an existing file", file=path,
@@ -87,10 +99,11 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
         raise ReedtoolError("model file not found", file=model,
                             hint="pass the path of a .urdf or .xacro file")
 
-    from ..loader import load_robot
-    from .validate import parse_mappings
+    from ..loader import load_robot, parse_mappings
+    from ..preflight import require_sound_model
 
     robot = load_robot(model, parse_mappings(mappings), list(package_paths))
+    require_sound_model(robot)
     report = hover_test(robot, config, samples=samples, seed=seed,
                         spreads=(mass_spread, com_spread_m, inertia_spread, motor_spread),
                         record=bool(plot_path or csv_path), show_progress=fmt == "text")

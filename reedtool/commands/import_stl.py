@@ -92,7 +92,7 @@ def run_import(mesh: Path, package_dir: Path, *, name: str | None = None, units:
                collision: str = "same", snippet_file: Path | None = None,
                force: bool = False, progress=None) -> ImportOutcome:
     """Import `mesh` into `package_dir`: the whole command without its printing."""
-    from ..fileio import atomic_write_bytes, atomic_write_text, check_writable
+    from ..fileio import atomic_write_many, check_writable
     from ..frames import axis_convention
     from ..mesh import import_mesh, stl_bytes
 
@@ -119,14 +119,16 @@ def run_import(mesh: Path, package_dir: Path, *, name: str | None = None, units:
     if progress:
         progress("writing")
     header = f"reedtool import-stl {mesh.name}: metres, FLU"
-    atomic_write_bytes(mesh_file, stl_bytes(imported.triangles_m, header), force=force)
+    outputs = [(mesh_file, stl_bytes(imported.triangles_m, header))]
     if collision_file is not None and imported.collision_m is not None:
-        atomic_write_bytes(collision_file, stl_bytes(imported.collision_m, header + ", collision"),
-                           force=force)
+        outputs.append((collision_file,
+                        stl_bytes(imported.collision_m, header + ", collision")))
     snippet = snippet_text(imported, package, name,
                            collision_file.stem if collision_file is not None else None)
     if snippet_file is not None:
-        atomic_write_text(snippet_file, snippet, force=force)
+        outputs.append((snippet_file, snippet.encode("utf-8")))
+    # All or nothing: a snippet that cannot be written must not leave the meshes behind.
+    atomic_write_many(outputs, force=force)
     return ImportOutcome(imported, package, mesh_file, collision_file, snippet)
 
 

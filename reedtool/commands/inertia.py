@@ -146,7 +146,7 @@ def fix_urdf_text(text: str, fixes: list[tuple[int, object]]) -> str:
 
 
 def apply_fix_urdf(model: Path, comparisons, force: bool) -> list[str]:
-    from ..fileio import atomic_write_text
+    from ..fileio import atomic_write_text, read_xml_file
     from ..urdf_io import parse_urdf
 
     todo = [(c, c.corrected()) for c in comparisons]
@@ -157,7 +157,7 @@ def apply_fix_urdf(model: Path, comparisons, force: bool) -> list[str]:
     if backup.exists() and not force:
         raise ReedtoolError("refusing to overwrite the existing backup", file=backup,
                             hint="move it away, or pass --force to replace it")
-    text = model.read_text(encoding="utf-8")
+    text, encoding = read_xml_file(model, what="URDF file")
     fixes = []
     for c, props in todo:
         if c.loc.line is None or Path(c.loc.file).resolve() != model.resolve():
@@ -173,7 +173,7 @@ def apply_fix_urdf(model: Path, comparisons, force: bool) -> list[str]:
                                    rtol=1e-8, atol=1e-12 * np.abs(props.inertia_kg_m2).max())):
             raise ReedtoolError(f"internal check failed rewriting link '{c.link}'; "
                                 "the file was left unchanged", file=model)
-    atomic_write_text(model, new_text, force=True, backup=True)
+    atomic_write_text(model, new_text, force=True, backup=True, encoding=encoding)
     return [f"--fix: rewrote <inertial> of {', '.join(c.link for c, _ in todo)} in {model} "
             f"(backup: {backup})"]
 
@@ -217,10 +217,10 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     collision shape, else the first visual, as a uniform solid with the declared mass.
     Exit 0 when no link needs attention, 1 otherwise, 2 on unreadable input.
     """
-    from ..expand import parse_mappings
     from ..inertia import compare_links, whole_robot
-    from ..loader import load_robot
+    from ..loader import load_robot, parse_mappings
     from ..pinocchio_bridge import whole_robot_pinocchio
+    from ..preflight import require_sound_model
 
     robot = load_robot(model, parse_mappings(mappings), list(package_paths))
     if fix and robot.source_format != "urdf":
@@ -230,6 +230,7 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
                                  "SDF <inertial> by hand")
     if not robot.links:
         raise ReedtoolError("the model has no links", file=model)
+    require_sound_model(robot)
     comparisons = compare_links(robot)
     own = whole_robot(robot)
     whole = whole_robot_pinocchio(robot)

@@ -8,7 +8,6 @@ from pathlib import Path, PurePosixPath
 import click
 
 from ..airframes import FRAMES
-from ..errors import ReedtoolError
 
 
 @dataclass
@@ -142,8 +141,6 @@ def command(name, frame, ros, sim, spec_file, mass, arm_length, mesh, mesh_units
     """
     from ..package_spec import build_spec
 
-    if spec_file is not None and not spec_file.is_file():
-        raise ReedtoolError("spec file not found", file=spec_file)
     spec = build_spec(name, frame=frame, ros=int(ros) if ros else None, spec_file=spec_file,
                       flags={"mass": mass, "arm_length": arm_length}, mesh=mesh, sim=sim)
     result = new_package(spec, output_dir, force=force, mesh_units=mesh_units,

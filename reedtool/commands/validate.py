@@ -11,18 +11,6 @@ import click
 from ..errors import ReedtoolError
 
 
-def parse_mappings(items: tuple[str, ...]) -> dict[str, str]:
-    """xacro-style `name:=value` arguments."""
-    mappings: dict[str, str] = {}
-    for item in items:
-        name, sep, value = item.partition(":=")
-        if not sep or not name:
-            raise ReedtoolError(f"expected name:=value, got '{item}'",
-                                hint="pass xacro arguments as name:=value after the model")
-        mappings[name] = value
-    return mappings
-
-
 def explain(code: str) -> int:
     from ..checks.registry import get_rule
 
@@ -82,11 +70,15 @@ def command(model: Path | None, mappings: tuple[str, ...], package_paths: tuple[
 
     from ..checks.runner import Selection, parse_selectors, parse_severity_overrides, run_checks
     from ..config import load_config
-    from ..loader import load_robot
+    from ..loader import load_robot, parse_mappings
     from ..report import render
 
     config = load_config(model)
     origin = str(config.path) if config.path else "config"
+    if select and not parse_selectors(select, origin="--select"):
+        # `--select ""` would run no rule and report a clean model.
+        raise ReedtoolError("--select names no rule", hint="give a code or prefix such as S, "
+                            "I203 or R; ALL selects every rule")
     selection = Selection(
         select=(parse_selectors(select, origin="--select") if select
                 else parse_selectors(config.select, origin=origin) if config.select is not None

@@ -1,0 +1,23 @@
+"""Option types shared by the commands.
+
+click's FloatRange lets `nan` through (every comparison with NaN is false), and `inf`
+through an open upper bound; an option that feeds a computation wants neither.
+"""
+
+from __future__ import annotations
+
+import math
+
+import click
+
+
+class FiniteFloatRange(click.FloatRange):
+    """A FloatRange that refuses NaN and infinities."""
+
+    name = "finite float range"
+
+    def convert(self, value, param, ctx):
+        number = click.FLOAT.convert(value, param, ctx)
+        if not math.isfinite(number):
+            self.fail(f"{value!r} is not a finite number.", param, ctx)
+        return super().convert(number, param, ctx)
