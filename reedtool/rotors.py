@@ -60,9 +60,10 @@ class Rotor:
 class RotorCountDeclaration:
     """A rotor count an autopilot interface plugin (MAVLink/PX4) declares."""
 
-    rotor_count: int
+    rotor_count: int | None         # None: written, but not a whole number (see `text`)
     plugin: Plugin
     loc: SourceLoc
+    text: str = ""                  # as written
 
 
 def motor_plugin_kind(plugin: Plugin) -> str | None:
@@ -128,8 +129,10 @@ def declared_rotor_counts(robot: Robot) -> list[RotorCountDeclaration]:
             continue
         for tag in ("rotorCount", "rotor_count"):
             node = plugin.node.find(tag)
-            if node is not None and node.text and node.text.strip().isdigit():
-                out.append(RotorCountDeclaration(int(node.text.strip()), plugin, node.loc))
+            if node is not None:
+                text = (node.text or "").strip()
+                count = int(text) if text.isdigit() else None
+                out.append(RotorCountDeclaration(count, plugin, node.loc, text))
                 break
         else:
             channels = plugin.node.find("control_channels")

@@ -60,7 +60,14 @@ LAUGHS = ('<?xml version="1.0"?>\n<!DOCTYPE r [\n <!ENTITY a "aaaaaaaaaa">\n'
                     for n, p in zip("bcdefghij", "abcdefghi"))
           + ']>\n<robot name="&j;"><link name="l"/></robot>\n')
 
+# A quad with RotorS motor plugins (tests/fixtures/core); variants break one plugin value.
+QUAD = (Path(__file__).parent / "fixtures" / "core" / "quad_x_rotors.urdf").read_text()
+DRAG_ABC = QUAD.replace("<rotorDragCoefficient>8.06428e-05<", "<rotorDragCoefficient>abc<", 1)
+DRAG_ABC_LINE = DRAG_ABC[:DRAG_ABC.index(">abc<")].count("\n") + 1
+
 FILES: dict[str, str | bytes] = {
+    "drag_abc.urdf": DRAG_ABC,
+    "rotor_count_abc.urdf": QUAD.replace("<rotorCount>6</rotorCount>", "<rotorCount>abc</rotorCount>"),
     "model.urdf": urdf(),
     "empty.urdf": "",
     "garbage.urdf": bytes(range(256)) * 4,
@@ -155,6 +162,8 @@ CASES = [
     ("validate-empty-select", ["validate", "model.urdf", "--select", ""], 2, "--select"),
     ("validate-controller-binary", ["validate", "model.urdf", "--controller", "garbage.urdf"],
      2, "garbage.urdf"),
+    # Written but unreadable drag would otherwise fly as "no drag" and pass.
+    ("hover-drag-unreadable", ["hover-test", "drag_abc.urdf"], 2, f"drag_abc.urdf:{DRAG_ABC_LINE}"),
     ("hover-zero-samples", ["hover-test", "model.urdf", "--samples", "0"], 2, "--samples"),
     ("hover-negative-seed", ["hover-test", "model.urdf", "--samples", "2", "--seed", "-1"],
      2, "--seed"),
@@ -221,6 +230,7 @@ FINDINGS = [
     ("nolinks.urdf", "S104"),
     ("self_parent.urdf", "S109"),
     ("empty_mesh.urdf", "S115"),
+    ("rotor_count_abc.urdf", "R312"),   # not a whole number: was silently dropped
 ]
 
 

@@ -406,14 +406,20 @@ def rotor_axis_tilted(ctx: CheckContext) -> Iterator[Issue]:
 def rotor_count_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     """The autopilot interface plugin forwards one motor command per declared rotor
     (`rotor_count`, or its control channels). More than there are motor plugins and the
-    autopilot mixes for a frame that does not exist; fewer and some rotors never spin.
+    autopilot mixes for a frame that does not exist; fewer and some rotors never spin. A
+    count that is not a whole number is reported too: the plugin cannot use it either.
     """
     if not ctx.tree_ok:
         return
     found = len(ctx.rotors)
     for declaration in ctx.rotor_count_declarations:
-        if declaration.rotor_count != found:
-            plugin = declaration.plugin
+        plugin = declaration.plugin
+        if declaration.rotor_count is None:
+            yield Issue(f"'{plugin.name}' declares rotor count '{declaration.text}', which is not "
+                        f"a whole number; the model has {found} motor plugin"
+                        f"{'s' if found != 1 else ''}", declaration.loc, plugin.name,
+                        hint=f"set rotor_count to {found}")
+        elif declaration.rotor_count != found:
             yield Issue(f"'{plugin.name}' declares {declaration.rotor_count} rotors but the model "
                         f"has {found} motor plugin{'s' if found != 1 else ''}",
                         declaration.loc, plugin.name,

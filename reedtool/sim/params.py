@@ -156,7 +156,8 @@ def check_rotor_dynamics(rotors: Sequence) -> None:
     """Raise ReedtoolError when a rotor lacks what the simulation needs beyond the trim.
 
     The trim needs positions, axes and constants (and reports their absence itself); the
-    speed response needs both time constants. Drag coefficients may be absent (no drag).
+    speed response needs both time constants. Drag coefficients may be absent (no drag),
+    but not present and unreadable.
     """
     from ..errors import ReedtoolError
 
@@ -171,3 +172,16 @@ def check_rotor_dynamics(rotors: Sequence) -> None:
                     f"got {value}", file=loc.file, line=loc.line,
                     hint=f"set <{tag}> in the motor plugin (RotorS models use 0.0125 up, "
                          f"0.025 down)")
+        for attr, tag in (("rotor_drag_coefficient", "rotorDragCoefficient"),
+                          ("rolling_moment_coefficient", "rollingMomentCoefficient")):
+            # Absent means no drag; written but unreadable or negative is a mistake that
+            # would otherwise fly as "no drag" and pass.
+            if rotor.plugin is None or rotor.plugin.param(tag) is None:
+                continue
+            value = getattr(rotor, attr)
+            if not (math.isfinite(value) and value >= 0.0):
+                loc = rotor.plugin.param_loc(tag)
+                raise ReedtoolError(
+                    f"rotor {rotor.name}: <{tag}> must be a number >= 0, got "
+                    f"'{rotor.plugin.param(tag)}'", file=loc.file, line=loc.line,
+                    hint=f"fix <{tag}> in the motor plugin, or remove it for no drag")
