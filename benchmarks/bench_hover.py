@@ -1,6 +1,6 @@
 """Hover-test speed: single vehicle (x real time) and the 1000-vehicle batch (vehicle-steps/s).
 
-Run on demand: /work/venv/bin/python benchmarks/bench_hover.py [--vehicles 1000] [--repeats 5]
+Run on demand: python benchmarks/bench_hover.py [--vehicles 1000] [--repeats 5]
 Targets (issue 6): single vehicle 10 s at 1 kHz >= 200x real time; batch >= 3 M
 vehicle-steps/s. Prints the median of the repeats and its ratio to each target, plus the
 spread, the load average (before and after) and, for the single vehicle, the first (cold) run, which also

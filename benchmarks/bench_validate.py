@@ -1,6 +1,6 @@
 """Wall time of `reedtool validate` on the seed quadrotor, against check_urdf and --help.
 
-    /work/venv/bin/python benchmarks/bench_validate.py [--runs N]
+    python benchmarks/bench_validate.py [--runs N]
 
 Each figure is the median of N end-to-end process runs (interpreter start included), the
 way a user or CI meets them. Targets (issue 3): validate within 3x of check_urdf on the

@@ -28,7 +28,7 @@ LAUNCH_ARGS = {  # what the seed's RotorS-style mav.launch passes
     "enable_mavlink_interface": "true", "enable_ground_truth": "true",
     "enable_logging": "false", "log_file": "reed_quad_x", "wait_to_record_bag": "false",
 }
-CHECK_URDF = Path("/work/venv/bin/check_urdf")
+from oracles import CHECK_URDF
 A = 0.18738
 
 

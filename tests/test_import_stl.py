@@ -1,6 +1,5 @@
 """`reedtool import-stl` end to end: files written, vertices where a hand computation says."""
 
-import shutil
 import subprocess
 from pathlib import Path
 
@@ -12,7 +11,7 @@ from reedtool.cli import main
 
 EXAMPLES = Path(__file__).parents[1] / "meshes"
 FIXTURES = Path(__file__).parent / "fixtures" / "meshes"
-CHECK_URDF = shutil.which("check_urdf") or "/work/venv/bin/check_urdf"
+from oracles import CHECK_URDF
 
 # L-bracket corners as written (mm, NED): profile (x, z) over y in {0, 40}.
 L_PROFILE_XZ_MM = [(0, 0), (60, 0), (60, 5), (5, 5), (5, 30), (0, 30)]

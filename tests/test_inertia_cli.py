@@ -3,7 +3,6 @@
 import io
 import json
 import re
-import shutil
 import subprocess
 from pathlib import Path
 
@@ -13,7 +12,7 @@ import pytest
 from reedtool.cli import main
 
 FIXTURES = Path(__file__).parent / "fixtures" / "inertia"
-CHECK_URDF = shutil.which("check_urdf") or "/work/venv/bin/check_urdf"
+from oracles import CHECK_URDF
 
 # Seed 001's wheel by hand: m = 0.1 kg, r = 0.025 m, length 0.02 m.
 WHEEL_AXIAL = 0.5 * 0.1 * 0.025**2                       # 3.125e-5 kg m^2

@@ -17,7 +17,7 @@ FIXTURES = Path(__file__).parent / "fixtures" / "smartcar"
 LEGACY = FIXTURES / "legacy" / "smartcar_description" / "urdf"
 FIXED = FIXTURES / "fixed" / "smartcar_description" / "urdf"
 MAIN = "smartcar.urdf.xacro"
-CHECK_URDF = "/work/venv/bin/check_urdf"
+from oracles import CHECK_URDF
 
 
 def tag_lines(path: Path, pattern: str) -> list[int]:

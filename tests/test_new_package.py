@@ -18,7 +18,7 @@ from reedtool.airframes import FRAMES, GROUND_FRAMES, MULTIROTOR_FRAMES
 from reedtool.cli import SUBCOMMANDS
 from cli_helpers import run_cli
 
-CHECK_URDF = Path(sys.executable).parent / "check_urdf"
+from oracles import CHECK_URDF
 CASES = [(frame, ros) for frame in FRAMES for ros in (1, 2)]
 
 

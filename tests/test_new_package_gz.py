@@ -21,7 +21,7 @@ from lxml import etree
 from reedtool.cli import SUBCOMMANDS
 from cli_helpers import run_cli
 
-CHECK_URDF = Path(sys.executable).parent / "check_urdf"
+from oracles import CHECK_URDF
 ARM_LENGTH_M = 0.3      # every frame is generated with this --arm-length
 
 # PX4's airframe reference, transcribed independently of reedtool/airframes.py: per motor

@@ -3,18 +3,13 @@
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
 import pytest
 
 from reedtool.checks.runner import run_checks
 from reedtool.loader import load_robot
 
-FIXTURES = Path(__file__).parent / "fixtures" / "validate"
-
-
-def codes(name: str) -> list[str]:
-    return sorted(f.code for f in run_checks(load_robot(FIXTURES / name)))
+from rule_helpers import FIXTURES, codes
 
 
 CASES = [

@@ -5,7 +5,6 @@ Fixtures: tests/fixtures/validate (generate.py writes them: a clean model plus o
 
 from __future__ import annotations
 
-import shutil
 import subprocess
 from pathlib import Path
 
@@ -14,13 +13,9 @@ import pytest
 from reedtool.checks.runner import Selection, run_checks
 from reedtool.loader import load_robot
 
-FIXTURES = Path(__file__).parent / "fixtures" / "validate"
-CHECK_URDF = shutil.which("check_urdf") or "/work/venv/bin/check_urdf"
+from rule_helpers import FIXTURES, codes
 
-
-def codes(name: str, prefix: str = "") -> list[str]:
-    findings = run_checks(load_robot(FIXTURES / name), Selection(select=(prefix,)))
-    return sorted(f.code for f in findings)
+from oracles import CHECK_URDF
 
 
 CASES = [

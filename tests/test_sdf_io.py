@@ -128,7 +128,8 @@ def test_equivalent_urdf_passes_check_urdf_and_pinocchio(tmp_path):
     from reedtool.pinocchio_bridge import whole_robot_pinocchio
 
     robot = load_robot(GZ / "x3_quad.sdf")
-    check_urdf = shutil.which("check_urdf") or str(Path(sys.executable).parent / "check_urdf")
+    from oracles import CHECK_URDF as check_urdf
+
     out = tmp_path / "x3.urdf"
     out.write_text(robot.urdf_xml)
     result = subprocess.run([check_urdf, str(out)], capture_output=True, text=True)
