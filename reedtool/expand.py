@@ -218,6 +218,18 @@ class _Tracker:
                 file=loc.file if loc else None, line=loc.line if loc else None,
                 hint="check the macros called from here for a loop that does not end")
 
+    @contextlib.contextmanager
+    def evaluating(self, node, symbols):
+        """While xacro evaluates `node`: errors escaping it learn where they happened."""
+        self.nodes.append(node)
+        try:
+            yield
+        except Exception as exc:
+            self.annotate(exc, symbols)
+            raise
+        finally:
+            self.nodes.pop()
+
     def annotate(self, exc: BaseException, symbols) -> None:
         if getattr(exc, "_rt_loc", None) is None and not isinstance(exc, ReedtoolError):
             node = self.current_node()
@@ -448,14 +460,8 @@ def _patched(st: _Tracker):
 
     def eval_all(node, macros, symbols):
         st.check_budget(node)
-        st.nodes.append(node)
-        try:
+        with st.evaluating(node, symbols):
             return orig["eval_all"](node, macros, symbols)
-        except Exception as exc:
-            st.annotate(exc, symbols)
-            raise
-        finally:
-            st.nodes.pop()
 
     def handle_macro_call(node, macros, symbols):
         if not node.tagName.startswith("xacro:") or node.tagName == "xacro:call":
@@ -475,14 +481,10 @@ def _patched(st: _Tracker):
         if site is not None:
             context += (_Site(site.file, site.line, node.tagName[len("xacro:"):]),)
         st.calls.append(context)
-        st.nodes.append(node)
         try:
-            return orig["handle_macro_call"](node, macros, symbols)
-        except Exception as exc:
-            st.annotate(exc, symbols)
-            raise
+            with st.evaluating(node, symbols):
+                return orig["handle_macro_call"](node, macros, symbols)
         finally:
-            st.nodes.pop()
             st.calls.pop()
 
     def warning(*args, **kwargs):
