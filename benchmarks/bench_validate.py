@@ -51,7 +51,7 @@ def main() -> int:
     check_urdf = shutil.which("check_urdf", path=str(BIN)) or shutil.which("check_urdf")
 
     sys.path.insert(0, str(ROOT))
-    from reedtool.loader import load_robot
+    from reedtool.io.loader import load_robot
 
     robot = load_robot(SEED, dict(a.split(":=", 1) for a in SEED_ARGS))
     with tempfile.TemporaryDirectory() as tmp:

@@ -14,7 +14,7 @@ import warnings
 
 import click
 
-from . import __version__
+from reedtool import __version__
 
 # name -> (module, one-line summary). Only subcommands that exist are listed here.
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
@@ -62,7 +62,7 @@ def _usage_error_line(exc: click.UsageError) -> str:
 
 def main(argv: list[str] | None = None) -> None:
     """Console-script entry: user errors become one line and exit 2, never a traceback."""
-    from .errors import ReedtoolError
+    from reedtool.errors import ReedtoolError
 
     try:
         with warnings.catch_warnings():

@@ -18,7 +18,7 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .errors import ReedtoolError
+from reedtool.errors import ReedtoolError
 
 KEYS = ("select", "ignore", "severity", "strict")
 

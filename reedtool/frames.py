@@ -19,8 +19,7 @@ from itertools import permutations, product
 
 import numpy as np
 
-from .errors import ReedtoolError
-
+from reedtool.errors import ReedtoolError
 
 # ---------------------------------------------------------------- rotations
 

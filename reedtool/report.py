@@ -14,8 +14,8 @@ from pathlib import Path
 
 import click
 
-from . import __version__
-from .checks.finding import Finding, severity_counts
+from reedtool import __version__
+from reedtool.checks.finding import Finding, severity_counts
 
 FORMATS = ("text", "json", "github")
 

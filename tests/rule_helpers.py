@@ -3,7 +3,7 @@
 from pathlib import Path
 
 from reedtool.checks.runner import Selection, run_checks
-from reedtool.loader import load_robot
+from reedtool.io.loader import load_robot
 
 FIXTURES = Path(__file__).parent / "fixtures" / "validate"
 

@@ -244,7 +244,7 @@ def test_validate_reports_a_finding(workdir, monkeypatch, capsys, model, code):
 
 def test_runaway_expression_is_stopped_by_the_clock(tmp_path):
     from reedtool.errors import ReedtoolError
-    from reedtool.expand import expand_xacro
+    from reedtool.io.xacro_expand import expand_xacro
 
     model = tmp_path / "nested.xacro"
     model.write_text(XACRO.format(
@@ -275,7 +275,7 @@ def test_new_files_get_the_usual_mode(tmp_path, monkeypatch, capsys):
 def test_xml_in_any_declared_encoding_is_read(tmp_path, encoding, declaration):
     from lxml import etree
 
-    from reedtool.loader import load_robot
+    from reedtool.io.loader import load_robot
 
     path = tmp_path / "enc.urdf"
     text = declaration + '<robot name="r\u00e9"><link name="b\u00e4se"/></robot>\n'
@@ -317,7 +317,7 @@ def test_package_xml_escapes_user_text(tmp_path, monkeypatch, capsys):
 
 def test_decoder_names_the_line_of_a_bad_byte(tmp_path):
     from reedtool.errors import ReedtoolError
-    from reedtool.fileio import read_text_file
+    from reedtool.io.fileio import read_text_file
 
     path = tmp_path / "t.yaml"
     path.write_bytes(codecs.BOM_UTF8 + b"a: 1\nb: \xff\n")

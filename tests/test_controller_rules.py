@@ -12,10 +12,13 @@ from pathlib import Path
 import pytest
 
 from reedtool.checks.runner import Selection, run_checks
-from reedtool.controller_tables import (load_controller_yaml, parse_controller_yaml,
-                                        velocity_control_tables)
 from reedtool.errors import ReedtoolError
-from reedtool.loader import load_robot
+from reedtool.flightstack.controller_tables import (
+    load_controller_yaml,
+    parse_controller_yaml,
+    velocity_control_tables,
+)
+from reedtool.io.loader import load_robot
 
 GZ = Path(__file__).parent / "fixtures" / "gz"
 SDF = (GZ / "x3_quad.sdf").read_text()

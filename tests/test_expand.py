@@ -16,8 +16,8 @@ import pytest
 from lxml import etree
 
 from reedtool.errors import ReedtoolError
-from reedtool.expand import expand_xacro
-from reedtool.packages import BUNDLED_PACKAGES_DIR
+from reedtool.io.packages import BUNDLED_PACKAGES_DIR
+from reedtool.io.xacro_expand import expand_xacro
 
 FIXTURES = Path(__file__).parent / "fixtures"
 SEED_URDF_DIR = FIXTURES / "seed000" / "reed_gazebo" / "urdf"
@@ -29,6 +29,7 @@ LAUNCH_ARGS = {  # what the seed's RotorS-style mav.launch passes
     "enable_logging": "false", "log_file": "reed_quad_x", "wait_to_record_bag": "false",
 }
 from oracles import CHECK_URDF
+
 A = 0.18738
 
 
@@ -86,8 +87,8 @@ def test_seed_loads_in_yourdfpy_and_pinocchio(seed, seed_urdf_file):
 
 
 def test_seed_rotors_directions_constants_and_declared_count():
-    from reedtool.loader import load_robot
-    from reedtool.rotors import declared_rotor_counts, discover_rotors
+    from reedtool.io.loader import load_robot
+    from reedtool.physics.rotors import declared_rotor_counts, discover_rotors
 
     robot = load_robot(SEED_MODEL, LAUNCH_ARGS)
     rotors = {r.plugin.name.removesuffix("_motor_model"): r for r in discover_rotors(robot)}

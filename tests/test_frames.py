@@ -2,11 +2,19 @@
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from reedtool.errors import ReedtoolError
-from reedtool.frames import (RIGHT_HANDED_CODES, axis_convention, describe_rotation,
-                             invert_T, make_T, matrix_to_rpy, rpy_to_matrix)
+from reedtool.frames import (
+    RIGHT_HANDED_CODES,
+    axis_convention,
+    describe_rotation,
+    invert_T,
+    make_T,
+    matrix_to_rpy,
+    rpy_to_matrix,
+)
 
 
 def test_rpy_single_axes_match_textbook_matrices():

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from lxml import etree
 
-from reedtool.loader import load_robot
+from reedtool.io.loader import load_robot
 
 TESTS = Path(__file__).parent
 SEED_PACKAGE = TESTS / "fixtures" / "seed000" / "reed_gazebo"

@@ -73,7 +73,7 @@ def test_snippet_is_a_valid_urdf_link_for_check_urdf(package, tmp_path, capsys):
                     + "</robot>\n")
     result = subprocess.run([CHECK_URDF, str(urdf)], capture_output=True, text=True)
     assert result.returncode == 0, result.stdout + result.stderr
-    from lxml import etree            # stricter than check_urdf's parser (e.g. "--" in comments)
+    from lxml import etree  # stricter than check_urdf's parser (e.g. "--" in comments)
     etree.parse(str(urdf))
     assert "package://reed_gazebo/meshes/l_bracket_mm_ned_collision.stl" in snippet_file.read_text()
     hull = trimesh.load(package / "meshes" / "l_bracket_mm_ned_collision.stl")

@@ -5,17 +5,28 @@ from pathlib import Path
 import numpy as np
 import pytest
 import trimesh
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from reedtool.errors import ReedtoolError
 from reedtool.frames import make_T, rpy_to_matrix
-from reedtool.inertia import (MassProperties, box_inertia, combine, compare_link,
-                              cylinder_inertia, declared_mass_properties,
-                              geometry_mass_properties, inertial_xml, mesh_mass_properties,
-                              physically_valid, solid_mass_properties, sphere_inertia,
-                              whole_robot)
-from reedtool.mesh import read_stl
-from reedtool.model import Box, Cylinder, Inertial, Link, Mesh, Sphere, SourceLoc
+from reedtool.io.stl import read_stl
+from reedtool.model import Box, Cylinder, Inertial, Link, Mesh, SourceLoc, Sphere
+from reedtool.physics.inertia import (
+    MassProperties,
+    box_inertia,
+    combine,
+    compare_link,
+    cylinder_inertia,
+    declared_mass_properties,
+    geometry_mass_properties,
+    inertial_xml,
+    mesh_mass_properties,
+    physically_valid,
+    solid_mass_properties,
+    sphere_inertia,
+    whole_robot,
+)
 
 EXAMPLES = Path(__file__).parents[1] / "meshes"
 FIXTURES = Path(__file__).parent / "fixtures"
@@ -252,8 +263,8 @@ def test_compare_link_verdicts():
 
 
 def test_whole_robot_equals_pinocchio_on_multilink_fixture():
-    from reedtool.loader import load_robot
-    from reedtool.pinocchio_bridge import whole_robot_pinocchio
+    from reedtool.io.loader import load_robot
+    from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
 
     robot = load_robot(FIXTURES / "inertia" / "multilink.urdf")
     own = whole_robot(robot)
@@ -267,8 +278,8 @@ def test_whole_robot_equals_pinocchio_on_multilink_fixture():
 
 
 def test_whole_robot_with_a_massless_world_root_matches_pinocchio():
-    from reedtool.pinocchio_bridge import whole_robot_pinocchio
-    from reedtool.urdf_io import parse_urdf
+    from reedtool.io.urdf import parse_urdf
+    from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
 
     xml = """<robot name="w"><link name="world"/>
       <joint name="j" type="fixed"><parent link="world"/><child link="body"/>

@@ -66,7 +66,7 @@ def test_fix_rewrites_a_urdf_with_backup(tmp_path, capsys):
     assert (tmp_path / "smartcar.urdf.bak").read_text() == original
     assert subprocess.run([CHECK_URDF, str(model)], capture_output=True).returncode == 0
 
-    import yourdfpy    # an independent URDF reader
+    import yourdfpy  # an independent URDF reader
 
     urdf = yourdfpy.URDF.load(io.BytesIO(model.read_bytes()), load_meshes=False)
     links = {link.name: link for link in urdf.robot.links}

@@ -10,8 +10,8 @@ from pathlib import Path
 import pytest
 from lxml import etree
 
-from reedtool.expand import expand_xacro, scan_legacy
-from reedtool.legacy import scan_and_fix
+from reedtool.io.legacy_xacro import scan_and_fix
+from reedtool.io.xacro_expand import expand_xacro, scan_legacy
 
 FIXTURES = Path(__file__).parent / "fixtures" / "smartcar"
 LEGACY = FIXTURES / "legacy" / "smartcar_description" / "urdf"
@@ -120,7 +120,7 @@ def test_fix_adds_missing_xacro_namespace():
 def test_gazebo_plugin_parameter_named_like_a_macro_is_not_a_macro_call():
     # gz-sim's <rotorConfiguration><rotor> inside a <gazebo> block, in a file that also
     # defines a macro called `rotor`: only the unprefixed call outside <gazebo> is legacy.
-    from reedtool.legacy import scan_and_fix
+    from reedtool.io.legacy_xacro import scan_and_fix
 
     text = """<robot xmlns:xacro="http://ros.org/wiki/xacro">
   <xacro:macro name="rotor" params="n"><link name="r${n}"/></xacro:macro>

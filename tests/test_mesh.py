@@ -8,9 +8,10 @@ import pytest
 import trimesh
 
 from reedtool.errors import ReedtoolError
-from reedtool.mesh import (CollisionSpec, check_triangles, cluster_decimate, choose_units,
-                           convex_hull_triangles, guess_units, parse_stl, read_stl, stl_bytes,
-                           topology)
+from reedtool.io.meshes import check_triangles
+from reedtool.io.stl import parse_stl, read_stl, stl_bytes
+from reedtool.physics.mesh_import import CollisionSpec, choose_units, guess_units
+from reedtool.physics.mesh_topology import cluster_decimate, convex_hull_triangles, topology
 
 FIXTURES = Path(__file__).parent / "fixtures" / "meshes"
 EXAMPLES = Path(__file__).parents[1] / "meshes"
@@ -179,7 +180,7 @@ def test_cluster_decimate_meets_the_face_budget():
 
 
 def test_merge_vertices_falls_back_when_hashes_collide(monkeypatch):
-    import reedtool.mesh as mesh_module
+    import reedtool.physics.mesh_topology as mesh_module
 
     sphere = trimesh.creation.icosphere(subdivisions=2)
     expected = topology(sphere.triangles)

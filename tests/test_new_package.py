@@ -13,12 +13,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from reedtool.airframes import FRAMES, GROUND_FRAMES, MULTIROTOR_FRAMES
-from reedtool.cli import SUBCOMMANDS
 from cli_helpers import run_cli
-
 from oracles import CHECK_URDF
+
+from reedtool.cli import SUBCOMMANDS
+from reedtool.scaffold.airframes import FRAMES, GROUND_FRAMES, MULTIROTOR_FRAMES
+
 CASES = [(frame, ros) for frame in FRAMES for ros in (1, 2)]
 
 
@@ -213,9 +213,9 @@ def test_multirotor_physics(packages, expanded, frame):
     """Rotor count, spin balance, COM over the rotor centre (Pinocchio), valid inertias."""
     import pinocchio as pin
 
-    from reedtool.inertia import physically_valid
-    from reedtool.loader import load_robot
-    from reedtool.rotors import declared_rotor_counts, discover_rotors
+    from reedtool.io.loader import load_robot
+    from reedtool.physics.inertia import physically_valid
+    from reedtool.physics.rotors import declared_rotor_counts, discover_rotors
 
     pkg = packages[(frame, 1)]
     robot = load_robot(model_file(pkg, frame), {"enable_mavlink_interface": "true"})
@@ -265,9 +265,9 @@ rolling_moment_coefficient: 0.000001
 
 
 def test_reproduces_the_seed_quadrotor(tmp_path):
-    from reedtool.inertia import physically_valid
-    from reedtool.loader import load_robot
-    from reedtool.rotors import declared_rotor_counts, discover_rotors
+    from reedtool.io.loader import load_robot
+    from reedtool.physics.inertia import physically_valid
+    from reedtool.physics.rotors import declared_rotor_counts, discover_rotors
 
     spec = tmp_path / "reed.yaml"
     spec.write_text(SEED_SPEC)
@@ -358,8 +358,8 @@ def test_errors_are_one_line_exit_2(tmp_path):
 
 def test_body_mesh_gives_the_inertia(tmp_path):
     """--mesh: a 0.3 x 0.2 x 0.1 m box STL in mm, off-centre; inertia = the box formula."""
-    from reedtool.loader import load_robot
-    from reedtool.mesh import read_stl, stl_bytes
+    from reedtool.io.loader import load_robot
+    from reedtool.io.stl import read_stl, stl_bytes
 
     lo, hi = np.array([100.0, 50.0, 20.0]), np.array([400.0, 250.0, 120.0])  # mm
     corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])

@@ -16,12 +16,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_helpers import run_cli
 from lxml import etree
+from oracles import CHECK_URDF
 
 from reedtool.cli import SUBCOMMANDS
-from cli_helpers import run_cli
 
-from oracles import CHECK_URDF
 ARM_LENGTH_M = 0.3      # every frame is generated with this --arm-length
 
 # PX4's airframe reference, transcribed independently of reedtool/airframes.py: per motor
@@ -488,7 +488,7 @@ def test_refusals_are_one_line_and_write_nothing(tmp_path, args, spec_text):
 
 
 def test_body_mesh_resolves_through_package_uri(tmp_path):
-    from reedtool.mesh import stl_bytes
+    from reedtool.io.stl import stl_bytes
 
     lo, hi = np.array([0.0, 0.0, 0.0]), np.array([0.25, 0.25, 0.06])
     corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])

@@ -1,4 +1,4 @@
-"""Package search order and URI resolution (reedtool.packages)."""
+"""Package search order and URI resolution (reedtool.io.packages)."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ from pathlib import Path
 import pytest
 
 from reedtool.errors import ReedtoolError
+from reedtool.io.packages import BUNDLED_PACKAGES_DIR, PackageResolver
 from reedtool.model import SourceLoc
-from reedtool.packages import BUNDLED_PACKAGES_DIR, PackageResolver
 
 
 def make_package(directory: Path, name: str) -> Path:

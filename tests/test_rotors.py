@@ -4,9 +4,9 @@ from pathlib import Path
 
 import numpy as np
 
-from reedtool.allocation import allocation_matrix
-from reedtool.rotors import declared_rotor_counts, discover_rotors
-from reedtool.urdf_io import load_urdf_file
+from reedtool.io.urdf import load_urdf_file
+from reedtool.physics.allocation import allocation_matrix
+from reedtool.physics.rotors import declared_rotor_counts, discover_rotors
 
 CORE = Path(__file__).parent / "fixtures" / "core"
 ARM = 0.18738  # seed 000's arm length

@@ -6,7 +6,7 @@ import re
 from pathlib import Path
 
 from reedtool.checks.registry import all_rules
-from reedtool.rules_doc import render
+from reedtool.checks.rules_doc import render
 
 # The checkout's docs, not the installed package's location: CI tests the installed wheel.
 DOCS_RULES_MD = Path(__file__).resolve().parent.parent / "docs" / "rules.md"
@@ -14,7 +14,7 @@ DOCS_RULES_MD = Path(__file__).resolve().parent.parent / "docs" / "rules.md"
 
 def test_rules_md_is_up_to_date():
     assert DOCS_RULES_MD.read_text(encoding="utf-8") == render(), (
-        "docs/rules.md is stale: run `python -m reedtool.rules_doc --write`")
+        "docs/rules.md is stale: run `python -m reedtool.checks.rules_doc --write`")
 
 
 def test_every_rule_is_documented_once():

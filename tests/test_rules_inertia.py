@@ -5,12 +5,10 @@ from __future__ import annotations
 import re
 
 import pytest
-
-from reedtool.checks.runner import run_checks
-from reedtool.loader import load_robot
-
 from rule_helpers import FIXTURES, codes
 
+from reedtool.checks.runner import run_checks
+from reedtool.io.loader import load_robot
 
 CASES = [
     ("I201_bad_negative_mass.urdf", ["I201"]),

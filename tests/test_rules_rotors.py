@@ -10,13 +10,11 @@ import math
 from pathlib import Path
 
 import pytest
+from rule_helpers import FIXTURES, codes
 
 from reedtool.checks.registry import all_rules
 from reedtool.checks.runner import run_checks
-from reedtool.loader import load_robot
-
-from rule_helpers import FIXTURES, codes
-
+from reedtool.io.loader import load_robot
 
 CASES = [
     ("R301_bad_duplicate_number.urdf", ["R301"]),

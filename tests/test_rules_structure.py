@@ -9,14 +9,11 @@ import subprocess
 from pathlib import Path
 
 import pytest
-
-from reedtool.checks.runner import Selection, run_checks
-from reedtool.loader import load_robot
-
+from oracles import CHECK_URDF
 from rule_helpers import FIXTURES, codes
 
-from oracles import CHECK_URDF
-
+from reedtool.checks.runner import Selection, run_checks
+from reedtool.io.loader import load_robot
 
 CASES = [
     ("S101_bad_number.urdf", ["S101"]),

@@ -16,10 +16,10 @@ import numpy as np
 import pytest
 
 from reedtool.errors import ReedtoolError
-from reedtool.kinematics import link_poses
-from reedtool.loader import load_robot
-from reedtool.rotors import discover_rotors
-from reedtool.sdf_io import parse_sdf
+from reedtool.io.loader import load_robot
+from reedtool.io.sdf import parse_sdf
+from reedtool.physics.kinematics import link_poses
+from reedtool.physics.rotors import discover_rotors
 
 GZ = Path(__file__).parent / "fixtures" / "gz"
 S45 = math.sin(math.radians(45))
@@ -125,7 +125,7 @@ def test_sdf_and_urdf_variants_are_the_same_model():
 
 
 def test_equivalent_urdf_passes_check_urdf_and_pinocchio(tmp_path):
-    from reedtool.pinocchio_bridge import whole_robot_pinocchio
+    from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
 
     robot = load_robot(GZ / "x3_quad.sdf")
     from oracles import CHECK_URDF as check_urdf

@@ -9,11 +9,22 @@ import numpy as np
 import pytest
 
 from reedtool.sim import ExitStatus, HoverConfig
-from reedtool.sim.batch import (Spreads, perturbed_plant, robustness_batch,
-                                sample_perturbations, simulate_batch)
+from reedtool.sim.batch import (
+    Spreads,
+    perturbed_plant,
+    robustness_batch,
+    sample_perturbations,
+    simulate_batch,
+)
 from reedtool.sim.controller import ControllerGains, allocate
-from reedtool.sim.dynamics import (Plant, State, body_wrench, quat_from_rpy, rot_matrices,
-                                   step_rigid_body)
+from reedtool.sim.dynamics import (
+    Plant,
+    State,
+    body_wrench,
+    quat_from_rpy,
+    rot_matrices,
+    step_rigid_body,
+)
 from reedtool.sim.motor import drag_matrices, speed_command, speed_filter_factors
 from reedtool.sim.params import VehicleParams, symmetric_multirotor
 from reedtool.sim.run import simulate_hover

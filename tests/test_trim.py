@@ -9,11 +9,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from reedtool.allocation import allocation_matrix
 from reedtool.model import SourceLoc
-from reedtool.rotors import Rotor
+from reedtool.physics.allocation import allocation_matrix
+from reedtool.physics.rotors import Rotor
+from reedtool.physics.trim import TrimCause, solve_trim
 from reedtool.sim.params import VehicleParams
-from reedtool.trim import TrimCause, solve_trim
 
 G = 9.80665
 K = 8.54858e-06

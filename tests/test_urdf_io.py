@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from reedtool.errors import ReedtoolError
-from reedtool.kinematics import link_poses
-from reedtool.urdf_io import load_urdf_file, parse_urdf
+from reedtool.io.urdf import load_urdf_file, parse_urdf
+from reedtool.physics.kinematics import link_poses
 
 CORE = Path(__file__).parent / "fixtures" / "core"
 

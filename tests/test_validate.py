@@ -115,7 +115,7 @@ def test_text_has_no_colour_unless_a_terminal(capsys):
     assert "\x1b[" not in out
     from reedtool import report
     from reedtool.checks.runner import run_checks
-    from reedtool.loader import load_robot
+    from reedtool.io.loader import load_robot
 
     coloured = report.format_text(run_checks(load_robot(TWO_ERRORS)), str(TWO_ERRORS), color=True)
     assert "\x1b[" in coloured

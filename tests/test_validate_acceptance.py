@@ -9,7 +9,7 @@ import pytest
 
 from reedtool.checks.runner import run_checks
 from reedtool.cli import main
-from reedtool.loader import load_robot
+from reedtool.io.loader import load_robot
 
 TESTS = Path(__file__).parent
 SEED_QUAD = TESTS / "fixtures" / "seed000" / "reed_gazebo" / "urdf" / "mav_generic_odometry_sensor.gazebo"

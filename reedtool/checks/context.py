@@ -2,7 +2,7 @@
 
 Rules never recompute physics or re-import heavy modules: kinematics, rotor discovery,
 whole-robot mass properties, allocation and trim are cached properties here, and the
-modules that compute them (reedtool.kinematics, .rotors, .inertia, .allocation, .trim)
+modules that compute them (reedtool.physics.kinematics, .rotors, .inertia, .allocation, .trim)
 are imported inside the property so a run that selects only structure rules stays light.
 
 Physics needs a sound tree. `tree_ok` is decided here from the model alone; rules that
@@ -17,10 +17,10 @@ from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 
-from ..model import Joint, Link, Robot
+from reedtool.model import Joint, Link, Robot
 
 if TYPE_CHECKING:
-    from ..rotors import Rotor
+    from reedtool.physics.rotors import Rotor
 
 
 @dataclass
@@ -67,7 +67,7 @@ def build_tree(robot: Robot) -> Tree:
 class CheckContext:
     def __init__(self, robot: Robot, controllers: Sequence[Any] = ()):
         self.robot = robot
-        # Controller tables read from files (validate --controller), reedtool.controller_tables.
+        # Controller tables read from files (validate --controller), reedtool.flightstack.controller_tables.
         self.controllers = list(controllers)
         self._geometry_props: dict[str, Any] = {}
         self._mesh_bounds: dict[str, Any] = {}
@@ -100,7 +100,7 @@ class CheckContext:
 
     @cached_property
     def link_poses(self) -> dict[str, np.ndarray]:
-        from ..kinematics import link_poses
+        from reedtool.physics.kinematics import link_poses
 
         return link_poses(self.robot) if self.tree_ok else {}
 
@@ -108,40 +108,40 @@ class CheckContext:
     def rotors(self) -> list["Rotor"]:
         if not self.tree_ok:
             return []
-        from ..rotors import discover_rotors
+        from reedtool.physics.rotors import discover_rotors
 
         return discover_rotors(self.robot)
 
     @cached_property
     def controller_tables(self) -> list:
         """Every controller rotor table: velocity-control plugins in the model, then files."""
-        from ..controller_tables import velocity_control_tables
+        from reedtool.flightstack.controller_tables import velocity_control_tables
 
         return velocity_control_tables(self.robot) + self.controllers
 
     @cached_property
     def rotor_count_declarations(self) -> list:
-        from ..rotors import declared_rotor_counts
+        from reedtool.physics.rotors import declared_rotor_counts
 
         return declared_rotor_counts(self.robot)
 
     @cached_property
     def whole_robot(self):
-        """Mass, COM (base frame) and inertia of the whole robot (reedtool.inertia)."""
-        from ..inertia import whole_robot
+        """Mass, COM (base frame) and inertia of the whole robot (reedtool.physics.inertia)."""
+        from reedtool.physics.inertia import whole_robot
 
         return whole_robot(self.robot)
 
     @cached_property
     def allocation(self) -> np.ndarray:
         """(4, n) map from rotor thrusts [N] to [thrust, roll, pitch, yaw] about the COM."""
-        from ..allocation import allocation_matrix
+        from reedtool.physics.allocation import allocation_matrix
 
         return allocation_matrix(self.rotors, self.whole_robot.com_m)
 
     @cached_property
     def trim(self):
-        from ..trim import solve_trim
+        from reedtool.physics.trim import solve_trim
 
         whole = self.whole_robot
         return solve_trim(whole.mass_kg, whole.com_m, self.rotors)
@@ -160,8 +160,8 @@ class CheckContext:
         if shape is not None and mass is not None and np.isfinite(mass) and mass > 0:
             geometry, T_link_geom = shape
             if getattr(geometry, "path", True) is not None:  # meshes must be resolved
-                from ..errors import ReedtoolError
-                from ..inertia import geometry_mass_properties
+                from reedtool.errors import ReedtoolError
+                from reedtool.physics.inertia import geometry_mass_properties
 
                 try:
                     result = geometry_mass_properties(geometry, T_link_geom, mass)
@@ -179,8 +179,9 @@ class CheckContext:
             return None
         key = str(mesh.path)
         if key not in self._mesh_errors:
-            from ..errors import ReedtoolError
-            from ..mesh import check_triangles, read_stl, triangle_areas
+            from reedtool.errors import ReedtoolError
+            from reedtool.io.meshes import check_triangles, triangle_areas
+            from reedtool.io.stl import read_stl
 
             error = ""
             try:
@@ -199,8 +200,8 @@ class CheckContext:
             return None
         key = str(mesh.path)
         if key not in self._mesh_bounds:
-            from ..errors import ReedtoolError
-            from ..mesh import load_triangles
+            from reedtool.errors import ReedtoolError
+            from reedtool.io.meshes import load_triangles
 
             try:
                 vertices = load_triangles(key).reshape(-1, 3)

@@ -3,7 +3,7 @@
 A multirotor's geometry is often written twice: once in the motor plugins (where the
 simulator applies thrust) and once in the controller's rotor table (what the controller
 believes when it allocates thrust). They drift apart silently. These rules compare every
-controller table reedtool can see (reedtool.controller_tables: gz-sim
+controller table reedtool can see (reedtool.flightstack.controller_tables: gz-sim
 MulticopterVelocityControl in the model, RotorS vehicle YAML files from `--controller`)
 with the discovered rotors and the whole-robot mass properties.
 
@@ -23,13 +23,13 @@ from typing import TYPE_CHECKING, Iterator
 
 import numpy as np
 
-from .context import CheckContext
-from .finding import Issue
-from .registry import rule
+from reedtool.checks.context import CheckContext
+from reedtool.checks.finding import Issue
+from reedtool.checks.registry import rule
 
 if TYPE_CHECKING:
-    from ..controller_tables import ControllerRotor, ControllerTable
-    from ..rotors import Rotor
+    from reedtool.flightstack.controller_tables import ControllerRotor, ControllerTable
+    from reedtool.physics.rotors import Rotor
 
 ANGLE_TOL_RAD = math.radians(0.5)
 ARM_LENGTH_ABS_TOL_M = 0.001

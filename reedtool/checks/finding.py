@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..model import SourceLoc
+from reedtool.model import SourceLoc
 
 SEVERITIES = ("error", "warning", "info")
 JSON_FIELDS = ("code", "slug", "severity", "message", "subject", "file", "line", "hint")

@@ -1,6 +1,6 @@
 """Inertia rules (I2xx): each link's mass and inertia are physically possible and plausible.
 
-Physics comes from reedtool.inertia (geometry mass properties, principal moments); this
+Physics comes from reedtool.physics.inertia (geometry mass properties, principal moments); this
 module only compares declared values against it and words the findings.
 """
 
@@ -11,10 +11,10 @@ from typing import Iterator
 
 import numpy as np
 
-from ..model import Box, Cylinder, Link, Mesh, Sphere
-from .context import CheckContext
-from .finding import Issue
-from .registry import rule
+from reedtool.checks.context import CheckContext
+from reedtool.checks.finding import Issue
+from reedtool.checks.registry import rule
+from reedtool.model import Box, Cylinder, Link, Mesh, Sphere
 
 # Principal moments may break A + B >= C by this fraction of the largest moment: hand-rounded
 # values of a thin plate (where A + B = C exactly) stay quiet, real mistakes do not.

@@ -13,10 +13,10 @@ import re
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Callable, Iterable
 
-from .finding import SEVERITIES, Issue
+from reedtool.checks.finding import SEVERITIES, Issue
 
 if TYPE_CHECKING:
-    from .context import CheckContext
+    from reedtool.checks.context import CheckContext
 
 CheckFn = Callable[["CheckContext"], Iterable[Issue]]
 

@@ -1,8 +1,8 @@
 """Rotor rules (R3xx): the motor plugins describe rotors that can hold the robot in hover.
 
 They run only when motor-model plugins (RotorS, PX4 classic, gz-sim) are found. Geometry
-comes from reedtool.rotors, the allocation matrix from reedtool.allocation and the hover
-trim from reedtool.trim; this module interprets them.
+comes from reedtool.physics.rotors, the allocation matrix from reedtool.physics.allocation and the hover
+trim from reedtool.physics.trim; this module interprets them.
 """
 
 from __future__ import annotations
@@ -13,13 +13,13 @@ from typing import TYPE_CHECKING, Iterator
 
 import numpy as np
 
-from ..trim import STANDARD_GRAVITY_M_S2
-from .context import CheckContext
-from .finding import Issue
-from .registry import rule
+from reedtool.checks.context import CheckContext
+from reedtool.checks.finding import Issue
+from reedtool.checks.registry import rule
+from reedtool.physics.trim import STANDARD_GRAVITY_M_S2
 
 if TYPE_CHECKING:
-    from ..rotors import Rotor
+    from reedtool.physics.rotors import Rotor
 
 # Net yaw torque at equal rotor speed, as a fraction of the sum of the rotors' drag
 # torques, above which the directions (or moment constants) do not balance.

@@ -11,11 +11,11 @@ import re
 from dataclasses import dataclass, field
 from typing import Iterable, Mapping, Sequence
 
-from ..errors import ReedtoolError
-from ..model import Robot
-from .context import CheckContext
-from .finding import SEVERITIES, Finding
-from .registry import Rule, all_rules
+from reedtool.checks.context import CheckContext
+from reedtool.checks.finding import SEVERITIES, Finding
+from reedtool.checks.registry import Rule, all_rules
+from reedtool.errors import ReedtoolError
+from reedtool.model import Robot
 
 _SELECTOR = re.compile(r"^[A-Z]\d{0,3}$")
 
@@ -80,7 +80,7 @@ def run_checks(robot: Robot, selection: Selection | None = None, *,
                controllers: Sequence = ()) -> list[Finding]:
     """Every finding of every selected rule, in deterministic order, duplicates removed.
 
-    `controllers`: controller rotor tables read from files (reedtool.controller_tables).
+    `controllers`: controller rotor tables read from files (reedtool.flightstack.controller_tables).
     """
     selection = selection or Selection()
     ctx = CheckContext(robot, controllers)

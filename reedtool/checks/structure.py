@@ -12,10 +12,10 @@ from typing import Iterator
 
 import numpy as np
 
-from ..model import JOINT_TYPES, Box, Cylinder, Mesh, Sphere
-from .context import CheckContext
-from .finding import Issue
-from .registry import rule
+from reedtool.checks.context import CheckContext
+from reedtool.checks.finding import Issue
+from reedtool.checks.registry import rule
+from reedtool.model import JOINT_TYPES, Box, Cylinder, Mesh, Sphere
 
 # Below this mass Gazebo's URDF->SDF conversion treats a link as massless and drops it.
 SDF_MIN_MASS_KG = 1e-6

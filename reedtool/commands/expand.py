@@ -6,13 +6,13 @@ from pathlib import Path
 
 import click
 
-from ..errors import ReedtoolError
+from reedtool.errors import ReedtoolError
 
 
 def _fix_legacy(model: Path, mappings: dict[str, str], package_paths: list[Path]) -> None:
-    from ..expand import display_path, scan_legacy
-    from ..fileio import atomic_write_text
-    from ..packages import is_bundled
+    from reedtool.io.fileio import atomic_write_text
+    from reedtool.io.packages import is_bundled
+    from reedtool.io.xacro_expand import display_path, scan_legacy
 
     scan = scan_legacy(model, mappings, package_paths)
     for path, text in scan.fixed_text.items():
@@ -42,8 +42,9 @@ def command(model: Path, args: tuple[str, ...], output: Path | None,
 
     Arguments NAME:=VALUE set $(arg NAME), as roslaunch and xacro take them.
     """
-    from ..expand import expand_xacro, parse_mappings
-    from ..fileio import atomic_write_text, check_writable
+    from reedtool.io.fileio import atomic_write_text, check_writable
+    from reedtool.io.mappings import parse_mappings
+    from reedtool.io.xacro_expand import expand_xacro
 
     mappings = parse_mappings(args)
     if output is not None:

@@ -16,8 +16,8 @@ from pathlib import Path
 
 import click
 
-from ..errors import ReedtoolError
-from .params import FiniteFloatRange
+from reedtool.commands.params import FiniteFloatRange
+from reedtool.errors import ReedtoolError
 
 SPREAD_HELP = "Half-width of the uniform perturbation"
 # A COM shifted by a metre is another vehicle, not a perturbation of this one.
@@ -77,7 +77,7 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     Starts from a disturbance (default 0.5 m off the setpoint, rolled 0.2 rad) and passes
     when it settles within 5 cm and 2 deg and stays there.
     """
-    from ..sim import HoverConfig
+    from reedtool.sim import HoverConfig
 
     config = HoverConfig(duration_s=duration_s, rate_hz=rate_hz, offset_m=tuple(offset_m),
                          roll_rad=roll_rad, pitch_rad=pitch_rad, yaw_rad=yaw_rad)
@@ -99,8 +99,9 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
         raise ReedtoolError("model file not found", file=model,
                             hint="pass the path of a .urdf or .xacro file")
 
-    from ..loader import load_robot, parse_mappings
-    from ..preflight import require_sound_model
+    from reedtool.checks.preflight import require_sound_model
+    from reedtool.io.loader import load_robot
+    from reedtool.io.mappings import parse_mappings
 
     robot = load_robot(model, parse_mappings(mappings), list(package_paths))
     require_sound_model(robot)
@@ -119,8 +120,8 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     if run is not None and csv_path is not None:
         _write_csv(csv_path, run.series, force)
     if run is not None and plot_path is not None:
-        from ..fileio import atomic_write_bytes
-        from ..sim.plot import render_png
+        from reedtool.io.fileio import atomic_write_bytes
+        from reedtool.sim.plot import render_png
 
         png = render_png(run.series, omega_max, run.initial_omega_rad_s,
                          f"{robot.name}: {run.status.value}")
@@ -143,11 +144,11 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
     """
     import numpy as np
 
-    from ..pinocchio_bridge import whole_robot_pinocchio
-    from ..rotors import discover_rotors
-    from ..sim import ExitStatus
-    from ..sim.params import VehicleParams, check_rotor_dynamics
-    from ..trim import solve_trim
+    from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
+    from reedtool.physics.rotors import discover_rotors
+    from reedtool.physics.trim import solve_trim
+    from reedtool.sim import ExitStatus
+    from reedtool.sim.params import VehicleParams, check_rotor_dynamics
 
     rotors = discover_rotors(robot)
     props = whole_robot_pinocchio(robot)
@@ -175,7 +176,7 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
                             hint="run `reedtool inertia` on the model")
     params = VehicleParams.from_rotors(props.mass_kg, props.com_m, props.inertia_kg_m2, rotors)
 
-    from ..sim.run import simulate_hover
+    from reedtool.sim.run import simulate_hover
 
     run = simulate_hover(params, config, record=record)
     sim = run.to_dict()
@@ -188,7 +189,7 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
     report["passed"] = run.passed
 
     if samples:
-        from ..sim.batch import Spreads, robustness_batch
+        from reedtool.sim.batch import Spreads, robustness_batch
 
         mass_rel, com_m, inertia_rel, motor_rel = spreads
         spread = Spreads(mass_rel=mass_rel, com_m=com_m, inertia_rel=inertia_rel,
@@ -257,7 +258,7 @@ def render_text(report: dict) -> str:
 
 
 def _write_csv(path: Path, series: dict, force: bool) -> None:
-    from ..fileio import atomic_write_text
+    from reedtool.io.fileio import atomic_write_text
 
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import click
 
-from ..errors import ReedtoolError
+from reedtool.errors import ReedtoolError
 
 # A large mesh (about 200,000 binary triangles) gets a progress bar.
 PROGRESS_MIN_BYTES = 10_000_000
@@ -46,7 +46,7 @@ def default_name(mesh_path: Path) -> str:
 
 @dataclass
 class ImportOutcome:
-    imported: object               # reedtool.mesh.ImportedMesh
+    imported: object               # reedtool.physics.mesh_import.ImportedMesh
     package: str
     mesh_file: Path
     collision_file: Path | None
@@ -54,7 +54,7 @@ class ImportOutcome:
 
 
 def snippet_text(imported, package: str, name: str, collision_name: str | None) -> str:
-    from ..inertia import inertial_xml
+    from reedtool.physics.inertia import inertial_xml
 
     visual_uri = f"package://{package}/meshes/{name}.stl"
     collision_uri = (f"package://{package}/meshes/{collision_name}.stl"
@@ -92,9 +92,10 @@ def run_import(mesh: Path, package_dir: Path, *, name: str | None = None, units:
                collision: str = "same", snippet_file: Path | None = None,
                force: bool = False, progress=None) -> ImportOutcome:
     """Import `mesh` into `package_dir`: the whole command without its printing."""
-    from ..fileio import atomic_write_many, check_writable
-    from ..frames import axis_convention
-    from ..mesh import import_mesh, stl_bytes
+    from reedtool.frames import axis_convention
+    from reedtool.io.fileio import atomic_write_many, check_writable
+    from reedtool.io.stl import stl_bytes
+    from reedtool.physics.mesh_import import import_mesh
 
     axis_convention(from_frame)  # an unknown frame is the error to report, not a refusal
     package = package_name(package_dir)
@@ -138,7 +139,7 @@ def _vector(v) -> str:
 
 
 def report_lines(outcome: ImportOutcome) -> list[str]:
-    from ..inertia import clean_tensor
+    from reedtool.physics.inertia import clean_tensor
 
     imp = outcome.imported
     topo, props = imp.topology, imp.mass

@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 import numpy as np
 
-from ..errors import ReedtoolError
+from reedtool.errors import ReedtoolError
 
 
 def _vec(v, fmt: str = ".6g") -> str:
@@ -19,7 +19,7 @@ def _vec(v, fmt: str = ".6g") -> str:
 
 
 def _tensor_line(I) -> str:
-    from ..inertia import clean_tensor
+    from reedtool.physics.inertia import clean_tensor
 
     I = clean_tensor(I)
     return (f"ixx {I[0, 0]:.4g}  iyy {I[1, 1]:.4g}  izz {I[2, 2]:.4g}  "
@@ -43,8 +43,8 @@ def _finite_or_none(value):
 
 
 def format_text(model: Path, robot, comparisons, whole, own) -> str:
-    from ..inertia import clean_tensor
-    from ..report import display_path
+    from reedtool.physics.inertia import clean_tensor
+    from reedtool.report import display_path
 
     lines = [f"{display_path(str(model))}: {len(robot.links)} links, base frame "
              f"'{robot.base_link}'", ""]
@@ -132,7 +132,7 @@ def fix_urdf_text(text: str, fixes: list[tuple[int, object]]) -> str:
 
     Text is spliced, not re-serialised, so everything else in the file stays byte for byte.
     """
-    from ..inertia import inertial_xml
+    from reedtool.physics.inertia import inertial_xml
 
     spans = []
     for line, props in fixes:
@@ -146,8 +146,8 @@ def fix_urdf_text(text: str, fixes: list[tuple[int, object]]) -> str:
 
 
 def apply_fix_urdf(model: Path, comparisons, force: bool) -> list[str]:
-    from ..fileio import atomic_write_text, read_xml_file
-    from ..urdf_io import parse_urdf
+    from reedtool.io.fileio import atomic_write_text, read_xml_file
+    from reedtool.io.urdf import parse_urdf
 
     todo = [(c, c.corrected()) for c in comparisons]
     todo = [(c, props) for c, props in todo if props is not None]
@@ -179,7 +179,7 @@ def apply_fix_urdf(model: Path, comparisons, force: bool) -> list[str]:
 
 
 def print_fix_xacro(comparisons) -> list[str]:
-    from ..inertia import inertial_xml
+    from reedtool.physics.inertia import inertial_xml
 
     lines = []
     for c in comparisons:
@@ -217,10 +217,11 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     collision shape, else the first visual, as a uniform solid with the declared mass.
     Exit 0 when no link needs attention, 1 otherwise, 2 on unreadable input.
     """
-    from ..inertia import compare_links, whole_robot
-    from ..loader import load_robot, parse_mappings
-    from ..pinocchio_bridge import whole_robot_pinocchio
-    from ..preflight import require_sound_model
+    from reedtool.checks.preflight import require_sound_model
+    from reedtool.io.loader import load_robot
+    from reedtool.io.mappings import parse_mappings
+    from reedtool.physics.inertia import compare_links, whole_robot
+    from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
 
     robot = load_robot(model, parse_mappings(mappings), list(package_paths))
     if fix and robot.source_format != "urdf":

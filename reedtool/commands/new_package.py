@@ -7,7 +7,7 @@ from pathlib import Path, PurePosixPath
 
 import click
 
-from ..airframes import FRAMES
+from reedtool.scaffold.airframes import FRAMES
 
 
 @dataclass
@@ -41,8 +41,9 @@ def _import_body_mesh(spec, units: str, from_frame: str):
     """Body mesh in metres and FLU, moved so its COM is the body origin, and its inertia."""
     import numpy as np
 
-    from ..inertia import MassProperties
-    from ..mesh import import_mesh, stl_bytes
+    from reedtool.io.stl import stl_bytes
+    from reedtool.physics.inertia import MassProperties
+    from reedtool.physics.mesh_import import import_mesh
 
     imported = import_mesh(spec.mesh, units=units, from_frame=from_frame,
                            mass_kg=spec["mass"], recenter="com")
@@ -62,14 +63,14 @@ def _import_body_mesh(spec, units: str, from_frame: str):
 def new_package(spec, output_dir: Path, *, force: bool = False, mesh_units: str = "auto",
                 mesh_frame: str = "flu") -> NewPackageResult:
     """Render the package for `spec` into output_dir/spec.name, all or nothing."""
-    from ..scaffold import RenderedFile, check_target, render_tree, write_tree
+    from reedtool.scaffold.render import RenderedFile, check_target, render_tree, write_tree
 
     target = Path(output_dir) / spec.name
     check_target(target.absolute(), force)   # fail before any expensive work
     body_props = mesh_data = None
     if spec.mesh is not None:
         body_props, mesh_data, _ = _import_body_mesh(spec, mesh_units, mesh_frame)
-    from ..package_spec import template_context
+    from reedtool.scaffold.package_spec import template_context
 
     context = template_context(spec, body_props)
     files = render_tree(template_sets(spec.kind, spec.ros, spec.sim), context)
@@ -139,7 +140,7 @@ def command(name, frame, ros, sim, spec_file, mass, arm_length, mesh, mesh_units
     MulticopterMotorModel systems, or the RotorS macro interface with --sim classic) passes
     `reedtool validate` and `hover-test` as generated.
     """
-    from ..package_spec import build_spec
+    from reedtool.scaffold.package_spec import build_spec
 
     spec = build_spec(name, frame=frame, ros=int(ros) if ros else None, spec_file=spec_file,
                       flags={"mass": mass, "arm_length": arm_length}, mesh=mesh, sim=sim)

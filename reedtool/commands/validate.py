@@ -8,11 +8,11 @@ from pathlib import Path
 
 import click
 
-from ..errors import ReedtoolError
+from reedtool.errors import ReedtoolError
 
 
 def explain(code: str) -> int:
-    from ..checks.registry import get_rule
+    from reedtool.checks.registry import get_rule
 
     found = get_rule(code)
     if found is None:
@@ -68,10 +68,16 @@ def command(model: Path | None, mappings: tuple[str, ...], package_paths: tuple[
         # Checked before the config lookup, which walks up from the model's directory.
         raise ReedtoolError("file not found", file=model, hint="check the model path")
 
-    from ..checks.runner import Selection, parse_selectors, parse_severity_overrides, run_checks
-    from ..config import load_config
-    from ..loader import load_robot, parse_mappings
-    from ..report import render
+    from reedtool.checks.runner import (
+        Selection,
+        parse_selectors,
+        parse_severity_overrides,
+        run_checks,
+    )
+    from reedtool.config import load_config
+    from reedtool.io.loader import load_robot
+    from reedtool.io.mappings import parse_mappings
+    from reedtool.report import render
 
     config = load_config(model)
     origin = str(config.path) if config.path else "config"
@@ -90,7 +96,7 @@ def command(model: Path | None, mappings: tuple[str, ...], package_paths: tuple[
     robot = load_robot(model, parse_mappings(mappings), list(package_paths))
     controllers = []
     if controller_files:
-        from ..controller_tables import load_controller_yaml
+        from reedtool.flightstack.controller_tables import load_controller_yaml
 
         controllers = [load_controller_yaml(path) for path in controller_files]
     findings = run_checks(robot, selection, controllers=controllers)

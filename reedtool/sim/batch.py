@@ -17,12 +17,25 @@ from typing import Callable
 
 import numpy as np
 
-from . import STATUS_CODES, STATUS_FROM_CODE, ExitStatus, HoverConfig
-from .controller import ControllerDesign, ControllerGains, allocation_kernel, control_kernel
-from .dynamics import (Plant, PlantKernel, State, body_wrench_kernel, quat_from_rpy,
-                       rates_buffer, rigid_body_kernel, rotation_kernel)
-from .motor import speed_command, speed_filter_factors
-from .params import VehicleParams
+from reedtool.sim import STATUS_CODES, STATUS_FROM_CODE, ExitStatus, HoverConfig
+from reedtool.sim.controller import (
+    ControllerDesign,
+    ControllerGains,
+    allocation_kernel,
+    control_kernel,
+)
+from reedtool.sim.dynamics import (
+    Plant,
+    PlantKernel,
+    State,
+    body_wrench_kernel,
+    quat_from_rpy,
+    rates_buffer,
+    rigid_body_kernel,
+    rotation_kernel,
+)
+from reedtool.sim.motor import speed_command, speed_filter_factors
+from reedtool.sim.params import VehicleParams
 
 # Why a run ended, beyond its ExitStatus (index into REASONS).
 REASONS = ("", "settled", "not-settled", "non-finite", "drifted", "rate", "ground", "flipped",

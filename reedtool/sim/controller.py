@@ -23,7 +23,7 @@ from typing import Callable
 
 import numpy as np
 
-from .params import VehicleParams
+from reedtool.sim.params import VehicleParams
 
 
 @dataclass(frozen=True)

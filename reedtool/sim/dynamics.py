@@ -24,9 +24,8 @@ from typing import Callable
 
 import numpy as np
 
-from .motor import drag_matrices
-from .params import VehicleParams
-
+from reedtool.sim.motor import drag_matrices
+from reedtool.sim.params import VehicleParams
 
 # ----------------------------------------------------------------- rotations
 

@@ -68,7 +68,7 @@ class VehicleParams:
     def allocation(self) -> np.ndarray:
         """(4, n): per-rotor thrust -> [thrust along body z, roll, pitch, yaw torque] about the COM.
 
-        Same convention as reedtool.allocation.allocation_matrix (RotorS yaw reaction
+        Same convention as reedtool.physics.allocation.allocation_matrix (RotorS yaw reaction
         -turning_sign * c_m * thrust along the rotor axis), from these arrays so that the
         batch engine can build one per perturbed vehicle.
         """
@@ -159,7 +159,7 @@ def check_rotor_dynamics(rotors: Sequence) -> None:
     speed response needs both time constants. Drag coefficients may be absent (no drag),
     but not present and unreadable.
     """
-    from ..errors import ReedtoolError
+    from reedtool.errors import ReedtoolError
 
     for rotor in rotors:
         for attr, tag in (("time_constant_up_s", "timeConstantUp"),

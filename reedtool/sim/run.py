@@ -15,12 +15,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import ExitStatus, HoverConfig
-from .batch import describe, hover_speeds
-from .controller import ControllerDesign, ControllerGains
-from .dynamics import quat_from_rpy
-from .params import VehicleParams
-from .scalar import compile_vehicle
+from reedtool.sim import ExitStatus, HoverConfig
+from reedtool.sim.batch import describe, hover_speeds
+from reedtool.sim.controller import ControllerDesign, ControllerGains
+from reedtool.sim.dynamics import quat_from_rpy
+from reedtool.sim.params import VehicleParams
+from reedtool.sim.scalar import compile_vehicle
 
 
 @dataclass

@@ -14,8 +14,10 @@ from typing import Iterable
 
 import numpy as np
 
-from .errors import ReedtoolError
-from .model import Box, Cylinder, Link, Mesh, Robot, Sphere
+from reedtool.errors import ReedtoolError
+from reedtool.io.meshes import load_triangles
+from reedtool.model import Box, Cylinder, Link, Mesh, Robot, Sphere
+from reedtool.physics.mesh_topology import convex_hull_triangles, topology
 
 # ------------------------------------------------------------ the value object
 
@@ -200,12 +202,10 @@ def mesh_mass_properties(triangles_m: np.ndarray, density_kg_m3: float = 1.0,
     `closed` is the caller's topology verdict (watertight and consistently wound); when
     None it is computed here. Raises ReedtoolError when there is no volume to speak of.
     """
-    from . import mesh as meshmod
-
     if closed is None:
-        closed = meshmod.topology(triangles_m).closed
+        closed = topology(triangles_m).closed
     from_hull = not closed
-    solid = meshmod.convex_hull_triangles(triangles_m) if from_hull else triangles_m
+    solid = convex_hull_triangles(triangles_m) if from_hull else triangles_m
     props = solid_mass_properties(solid, density_kg_m3)
     if props.volume_m3 is not None and props.volume_m3 < 0.0:
         # Closed but wound inside-out: the same solid with every normal flipped.
@@ -220,9 +220,7 @@ def mesh_mass_properties(triangles_m: np.ndarray, density_kg_m3: float = 1.0,
 @lru_cache(maxsize=64)
 def _unit_density_mesh_properties(path: str, mtime_ns: int, scale: tuple[float, float, float]
                                   ) -> MassProperties:
-    from . import mesh as meshmod
-
-    triangles = meshmod.load_triangles(path) * np.asarray(scale)
+    triangles = load_triangles(path) * np.asarray(scale)
     try:
         return mesh_mass_properties(triangles)
     except ReedtoolError as exc:
@@ -280,7 +278,7 @@ def whole_robot(robot: Robot) -> MassProperties:
 
     Links not reachable from the root (a broken tree) are left out, as a simulator would.
     """
-    from .kinematics import link_poses
+    from reedtool.physics.kinematics import link_poses
 
     parts = []
     for name, T_base_link in link_poses(robot).items():

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import ReedtoolError
+from reedtool.errors import ReedtoolError
 
 
 @dataclass(frozen=True)

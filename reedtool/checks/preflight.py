@@ -9,8 +9,8 @@ compute stop at the first one, naming its file and line (exit 2).
 
 from __future__ import annotations
 
-from .errors import ReedtoolError
-from .model import Robot
+from reedtool.errors import ReedtoolError
+from reedtool.model import Robot
 
 # Structure rules whose errors leave nothing sound to compute on: unreadable or
 # non-finite numbers, missing attributes, no single root, dangling or duplicated names,
@@ -21,7 +21,7 @@ BLOCKING_RULES = ("S101", "S102", "S104", "S105", "S106", "S107", "S108", "S109"
 
 def require_sound_model(robot: Robot) -> None:
     """Raise a one-line ReedtoolError for the first blocking structure problem, if any."""
-    from .checks.runner import Selection, run_checks
+    from reedtool.checks.runner import Selection, run_checks
 
     findings = [f for f in run_checks(robot, Selection(select=BLOCKING_RULES))
                 if f.severity == "error"]

@@ -5,7 +5,7 @@ root link to its `universe` body, and computeTotalMass, which sums the bodies of
 joints, would leave the root link's mass out. With a free-flyer at its neutral
 configuration (identity pose) the root link frame coincides with the world frame, so
 every world-frame quantity is in the base (root link) frame, which is where
-reedtool.inertia.whole_robot works too. All joints sit at their neutral (zero) position.
+reedtool.physics.inertia.whole_robot works too. All joints sit at their neutral (zero) position.
 """
 
 from __future__ import annotations
@@ -17,9 +17,9 @@ import tempfile
 
 import numpy as np
 
-from .errors import ReedtoolError
-from .inertia import MassProperties, parallel_axis_term
-from .model import Robot
+from reedtool.errors import ReedtoolError
+from reedtool.model import Robot
+from reedtool.physics.inertia import MassProperties, parallel_axis_term
 
 
 def build_model(robot: Robot):

@@ -19,7 +19,7 @@ import tempfile
 from pathlib import Path
 from typing import Sequence
 
-from .errors import ReedtoolError
+from reedtool.errors import ReedtoolError
 
 # ------------------------------------------------------------------ reading
 
@@ -83,7 +83,7 @@ def read_xml_file(path: Path, *, what: str = "file") -> tuple[str, str]:
     """(text, encoding) of an XML file, decoded as its BOM or XML declaration says.
 
     The text still carries its declaration; parse it with an XMLParser told the text is
-    UTF-8 (reedtool.urdf_io does), and write it back with the returned encoding.
+    UTF-8 (reedtool.io.urdf does), and write it back with the returned encoding.
     """
     path = Path(path)
     data = read_bytes(path, what=what)

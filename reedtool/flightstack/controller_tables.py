@@ -29,8 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import ReedtoolError
-from .model import Plugin, Robot, SourceLoc
+from reedtool.errors import ReedtoolError
+from reedtool.model import Plugin, Robot, SourceLoc
 
 VELOCITY_CONTROL_NAMES = {"gz::sim::systems::MulticopterVelocityControl",
                           "ignition::gazebo::systems::MulticopterVelocityControl"}
@@ -132,7 +132,7 @@ def velocity_control_tables(robot: Robot) -> list[ControllerTable]:
 # ------------------------------------------------------------ RotorS YAML
 
 def load_controller_yaml(path: Path | str) -> ControllerTable:
-    from .fileio import read_text_file
+    from reedtool.io.fileio import read_text_file
 
     path = Path(path)
     if not path.exists() and not path.is_symlink():

@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .kinematics import link_poses
-from .model import Plugin, Robot, SourceLoc
+from reedtool.model import Plugin, Robot, SourceLoc
+from reedtool.physics.kinematics import link_poses
 
 # Plugin library (see Plugin.library) -> rotor kind.
 MOTOR_PLUGINS = {

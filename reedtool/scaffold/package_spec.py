@@ -19,8 +19,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Mapping
 
-from .airframes import Airframe, GroundLayout, get_frame
-from .errors import ReedtoolError
+from reedtool.errors import ReedtoolError
+from reedtool.scaffold.airframes import Airframe, GroundLayout, get_frame
 
 # Unit factors to SI, per dimension. A dimension with no units takes plain numbers only.
 UNITS: dict[str, dict[str, float]] = {
@@ -215,7 +215,7 @@ def check_package_name(name: str) -> None:
 def read_spec_file(path: Path) -> dict:
     import yaml
 
-    from .fileio import read_text_file
+    from reedtool.io.fileio import read_text_file
 
     text = read_text_file(Path(path), what="spec file")
     try:
@@ -461,7 +461,7 @@ def _xacro_coeff(coefficient: float, prop: str) -> str:
 
 
 def _inertia_attrs(I) -> dict[str, str]:
-    from .inertia import fmt_number
+    from reedtool.physics.inertia import fmt_number
 
     return {key: fmt_number(I[i][j]) for key, (i, j) in {
         "ixx": (0, 0), "ixy": (0, 1), "ixz": (0, 2),
@@ -471,10 +471,10 @@ def _inertia_attrs(I) -> dict[str, str]:
 def template_context(spec: PackageSpec, body_props=None) -> dict:
     """Everything the templates may use, with numbers already formatted.
 
-    `body_props` (reedtool.inertia.MassProperties about the body origin) replaces the body
+    `body_props` (reedtool.physics.inertia.MassProperties about the body origin) replaces the body
     box when a mesh was imported; its COM must already be at the origin.
     """
-    from .inertia import fmt_number
+    from reedtool.physics.inertia import fmt_number
 
     ctx: dict = {
         "name": spec.name, "ros": spec.ros, "kind": spec.kind, "sim": spec.sim,
@@ -495,7 +495,13 @@ def template_context(spec: PackageSpec, body_props=None) -> dict:
 def _multirotor_context(spec: PackageSpec, body_props) -> dict:
     import numpy as np
 
-    from .inertia import MassProperties, box_inertia, combine, fmt_number, sphere_inertia
+    from reedtool.physics.inertia import (
+        MassProperties,
+        box_inertia,
+        combine,
+        fmt_number,
+        sphere_inertia,
+    )
 
     frame: Airframe = spec.frame
     mass_kg = spec["mass"]
@@ -560,7 +566,13 @@ def _multirotor_context(spec: PackageSpec, body_props) -> dict:
 def _ground_context(spec: PackageSpec, body_props) -> dict:
     import numpy as np
 
-    from .inertia import MassProperties, box_inertia, cylinder_inertia, fmt_number, sphere_inertia
+    from reedtool.physics.inertia import (
+        MassProperties,
+        box_inertia,
+        cylinder_inertia,
+        fmt_number,
+        sphere_inertia,
+    )
 
     layout: GroundLayout = spec.frame
     mass_kg = spec["mass"]

@@ -15,12 +15,29 @@ from typing import Callable, Sequence
 import numpy as np
 from lxml import etree
 
-from .errors import ReedtoolError
-from .frames import make_T, rpy_to_matrix
-from .xml_lines import start_line
-from .model import (INERTIA_KEYS, Box, Collision, Cylinder, GazeboBlock, Inertial, Joint,
-                    JointLimit, Link, Mesh, ParseIssue, Plugin, Robot, SourceLoc, Sphere, Visual,
-                    XmlNode, inertia_tensor)
+from reedtool.errors import ReedtoolError
+from reedtool.frames import make_T, rpy_to_matrix
+from reedtool.io.xml_lines import start_line
+from reedtool.model import (
+    INERTIA_KEYS,
+    Box,
+    Collision,
+    Cylinder,
+    GazeboBlock,
+    Inertial,
+    Joint,
+    JointLimit,
+    Link,
+    Mesh,
+    ParseIssue,
+    Plugin,
+    Robot,
+    SourceLoc,
+    Sphere,
+    Visual,
+    XmlNode,
+    inertia_tensor,
+)
 
 Locator = Callable[[etree._Element], SourceLoc]
 
@@ -31,7 +48,7 @@ def parse_urdf(xml_text: str, file: Path | str, *, resolver=None,
 
     `element_locs`, from an xacro expansion, gives the SourceLoc of each element in
     document order; without it locations are lines of `file` itself. `resolver` resolves
-    mesh URIs (reedtool.packages.PackageResolver); by default one rooted at `file`.
+    mesh URIs (reedtool.io.packages.PackageResolver); by default one rooted at `file`.
     """
     file = Path(file)
     try:
@@ -44,7 +61,7 @@ def parse_urdf(xml_text: str, file: Path | str, *, resolver=None,
         raise ReedtoolError(f"not a URDF: the root element is <{root.tag}>, expected <robot>",
                             file=file, line=root.sourceline)
     if resolver is None:
-        from .packages import PackageResolver
+        from reedtool.io.packages import PackageResolver
         resolver = PackageResolver(model_path=file)
     locate = _make_locator(root, file, element_locs, xml_text.splitlines())
     return _RobotReader(file, locate, resolver).read(root, xml_text)
@@ -52,13 +69,13 @@ def parse_urdf(xml_text: str, file: Path | str, *, resolver=None,
 
 def xml_parser() -> etree.XMLParser:
     """The parser for model text: no entity expansion, and the text is UTF-8 whatever its
-    declaration says (reedtool.fileio.read_xml_file has already decoded it)."""
+    declaration says (reedtool.io.fileio.read_xml_file has already decoded it)."""
     return etree.XMLParser(remove_blank_text=False, resolve_entities=False, huge_tree=True,
                            encoding="utf-8")
 
 
 def load_urdf_file(path: Path | str, *, resolver=None) -> Robot:
-    from .fileio import read_xml_file
+    from reedtool.io.fileio import read_xml_file
 
     path = Path(path)
     text, _encoding = read_xml_file(path, what="URDF file")

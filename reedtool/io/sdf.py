@@ -51,12 +51,29 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 from lxml import etree
 
-from .errors import ReedtoolError
-from .xml_lines import start_line
-from .frames import make_T, matrix_to_rpy, rpy_to_matrix
-from .model import (INERTIA_KEYS, Box, Collision, Cylinder, GazeboBlock, Inertial, Joint,
-                    JointLimit, Link, Mesh, ParseIssue, Plugin, Robot, SourceLoc, Sphere, Visual,
-                    XmlNode, inertia_tensor)
+from reedtool.errors import ReedtoolError
+from reedtool.frames import make_T, matrix_to_rpy, rpy_to_matrix
+from reedtool.io.xml_lines import start_line
+from reedtool.model import (
+    INERTIA_KEYS,
+    Box,
+    Collision,
+    Cylinder,
+    GazeboBlock,
+    Inertial,
+    Joint,
+    JointLimit,
+    Link,
+    Mesh,
+    ParseIssue,
+    Plugin,
+    Robot,
+    SourceLoc,
+    Sphere,
+    Visual,
+    XmlNode,
+    inertia_tensor,
+)
 
 MODEL_FRAME = "__model__"
 # sdformat writes "no limit" as +-1e16; anything beyond this is unbounded.
@@ -68,7 +85,7 @@ RESOURCE_PATH_VARS = ("GZ_SIM_RESOURCE_PATH", "IGN_GAZEBO_RESOURCE_PATH", "SDF_P
 
 def load_sdf_file(path: Path | str, *, resolver=None) -> Robot:
     """Read an SDF file (a model.sdf, or a world holding one model) into a Robot."""
-    from .fileio import read_xml_file
+    from reedtool.io.fileio import read_xml_file
 
     path = Path(path)
     text, _encoding = read_xml_file(path, what="SDF file")
@@ -78,7 +95,7 @@ def load_sdf_file(path: Path | str, *, resolver=None) -> Robot:
 def parse_sdf(xml_text: str, file: Path | str, *, resolver=None) -> Robot:
     file = Path(file)
     try:
-        from .urdf_io import xml_parser
+        from reedtool.io.urdf import xml_parser
 
         root = etree.fromstring(xml_text.encode("utf-8"), xml_parser())
     except etree.XMLSyntaxError as exc:
@@ -89,7 +106,7 @@ def parse_sdf(xml_text: str, file: Path | str, *, resolver=None) -> Robot:
                             file=file, line=root.sourceline)
     model = _pick_model(root, file)
     if resolver is None:
-        from .packages import PackageResolver
+        from reedtool.io.packages import PackageResolver
         resolver = PackageResolver(model_path=file)
     robot = _ModelReader(file, resolver, xml_text).read(model)
     robot.urdf_xml = equivalent_urdf(robot)

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 from typing import Mapping
 
-from .errors import ReedtoolError
+from reedtool.errors import ReedtoolError
 
 TEMPLATE_SUFFIX = ".j2"
 
@@ -37,7 +37,7 @@ def templates_root() -> Path:
     pyproject force-includes `templates/` as `reedtool/_data/templates` in the wheel; an
     editable or source checkout has it at the repository root next to `reedtool/`.
     """
-    package_dir = Path(__file__).resolve().parent
+    package_dir = Path(__file__).resolve().parents[1]
     for candidate in (package_dir / "_data" / "templates", package_dir.parent / "templates"):
         if (candidate / "ros1").is_dir():
             return candidate

@@ -2,11 +2,11 @@
 
 pip's `xacro` does the expansion; reedtool adds what it lacks outside a ROS workspace:
 
-* `$(find pkg)` goes through reedtool.packages (xacro would ask ament_index_python);
+* `$(find pkg)` goes through reedtool.io.packages (xacro would ask ament_index_python);
 * every DOM element remembers (file, line) from the parser, clones keep it, and clones
   of a macro body also remember the chain of macro calls that produced them, so an
   element of the URDF maps to the call site the user wrote (docs/source-mapping.md);
-* legacy xacro is translated in memory and reported (reedtool.legacy);
+* legacy xacro is translated in memory and reported (reedtool.io.legacy_xacro);
 * mistakes become one-line ReedtoolErrors naming file:line (unknown macro parameter with
   a "did you mean", missing include, include cycle, malformed XML, undefined property or
   arg, runaway expansion), and xacro's own stderr chatter is collected as warnings.
@@ -21,9 +21,9 @@ import ast
 import contextlib
 import difflib
 import errno
+import functools
 import io
 import math
-import functools
 import os
 import re
 import sys
@@ -39,11 +39,10 @@ from xml.dom.expatbuilder import ExpatBuilderNS
 import xacro
 from xacro import substitution_args
 
-from .errors import ReedtoolError
-from .legacy import LegacyScan, LegacyTag, scan_tree
-from .loader import parse_mappings  # noqa: F401 - re-exported for callers
-from .model import SourceLoc
-from .packages import PackageResolver, is_bundled
+from reedtool.errors import ReedtoolError
+from reedtool.io.legacy_xacro import LegacyScan, LegacyTag, scan_tree
+from reedtool.io.packages import PackageResolver, is_bundled
+from reedtool.model import SourceLoc
 
 MAX_MACRO_DEPTH = 50            # real models nest < 10 deep; deeper is a runaway recursion
 DEFAULT_TIME_BUDGET_S = 4.0     # issue 2 promises an answer in under 5 s
@@ -626,7 +625,7 @@ def _static_include_resolver(resolver: PackageResolver, mappings: dict[str, str]
 
 def scan_legacy(path: Path, mappings: dict[str, str] | None = None,
                 package_paths: Sequence[Path] = ()) -> LegacyScan:
-    """Legacy xacro tags in `path` and the files it includes (see reedtool.legacy)."""
+    """Legacy xacro tags in `path` and the files it includes (see reedtool.io.legacy_xacro)."""
     resolver = PackageResolver(package_paths, model_path=path)
     return scan_tree(Path(path), _static_include_resolver(resolver, dict(mappings or {})),
                      display=display_path)

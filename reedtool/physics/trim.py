@@ -85,7 +85,7 @@ class TrimResult:
 def solve_trim(mass_kg: float, com_m: np.ndarray, rotors: Sequence,
                g_m_s2: float = STANDARD_GRAVITY_M_S2) -> TrimResult:
     """Hover trim of a robot of `mass_kg` with its COM at `com_m` (base frame) on `rotors`."""
-    from .allocation import allocation_matrix
+    from reedtool.physics.allocation import allocation_matrix
 
     names = tuple(r.name for r in rotors)
     k = np.array([r.motor_constant for r in rotors], dtype=float)

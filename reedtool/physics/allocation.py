@@ -6,7 +6,7 @@ from typing import Sequence
 
 import numpy as np
 
-from .rotors import Rotor
+from reedtool.physics.rotors import Rotor
 
 
 def allocation_matrix(rotors: Sequence[Rotor], com_m: np.ndarray) -> np.ndarray:

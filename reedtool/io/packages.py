@@ -25,10 +25,10 @@ from pathlib import Path
 from typing import Sequence
 from urllib.parse import unquote, urlparse
 
-from .errors import ReedtoolError
-from .model import SourceLoc
+from reedtool.errors import ReedtoolError
+from reedtool.model import SourceLoc
 
-BUNDLED_PACKAGES_DIR = Path(__file__).resolve().parent / "ros_packages"
+BUNDLED_PACKAGES_DIR = Path(__file__).resolve().parents[1] / "ros_packages"
 
 # How deep below a root a package.xml is looked for: root/src/repo/group/pkg is 4.
 MAX_CRAWL_DEPTH = 5

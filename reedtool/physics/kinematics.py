@@ -6,7 +6,7 @@ from collections import deque
 
 import numpy as np
 
-from .model import Robot
+from reedtool.model import Robot
 
 
 def link_poses(robot: Robot) -> dict[str, np.ndarray]:

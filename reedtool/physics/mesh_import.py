@@ -1,0 +1,185 @@
+"""The pipeline behind `reedtool import-stl`.
+
+read -> check -> units -> axes to FLU -> recentre -> mass properties -> collision mesh.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from reedtool.errors import ReedtoolError
+from reedtool.frames import AxisConvention, axis_convention
+from reedtool.io.meshes import MeshCheck, check_triangles
+from reedtool.io.stl import read_stl
+from reedtool.physics.inertia import MassProperties, mesh_mass_properties
+from reedtool.physics.mesh_topology import (
+    Topology,
+    cluster_decimate,
+    convex_hull_triangles,
+    topology,
+)
+
+UNITS_M = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254}
+
+
+# A part of a multirotor is between a screw and a large airframe.
+PLAUSIBLE_SIZE_M = (0.01, 5.0)
+
+
+@dataclass(frozen=True)
+class UnitChoice:
+    unit: str
+    metres_per_unit: float
+    reason: str
+    guessed: bool
+
+
+def guess_units(extent: np.ndarray) -> UnitChoice:
+    """Pick the unit that makes the part's largest extent a plausible multirotor part size."""
+    largest = float(np.max(extent))
+    low, high = PLAUSIBLE_SIZE_M
+    for unit in ("m", "mm", "cm", "in"):
+        size_m = largest * UNITS_M[unit]
+        if low <= size_m <= high:
+            return UnitChoice(unit, UNITS_M[unit],
+                              f"largest extent {largest:g} units; as {unit} that is "
+                              f"{size_m:g} m, within the plausible {low:g}-{high:g} m", True)
+    unit = "mm" if largest > high else "m"
+    return UnitChoice(unit, UNITS_M[unit],
+                      f"largest extent {largest:g} units fits no unit's plausible "
+                      f"{low:g}-{high:g} m; assuming {unit} — pass --units to be sure", True)
+
+
+def choose_units(name: str, extent: np.ndarray) -> UnitChoice:
+    if name == "auto":
+        return guess_units(extent)
+    if name not in UNITS_M:
+        raise ReedtoolError(f"unknown unit '{name}'", hint="use one of: auto, "
+                            + ", ".join(UNITS_M))
+    return UnitChoice(name, UNITS_M[name], "given with --units", False)
+
+
+@dataclass(frozen=True)
+class CollisionSpec:
+    kind: str                        # "same" | "hull" | "simplify"
+    max_faces: int | None = None
+
+    @classmethod
+    def parse(cls, text: str) -> "CollisionSpec":
+        text = text.strip().lower()
+        if text in ("same", "hull"):
+            return cls(text)
+        if text.startswith("simplify:"):
+            number = text.split(":", 1)[1]
+            if number.isdigit() and int(number) >= 4:
+                return cls("simplify", int(number))
+        raise ReedtoolError(f"bad --collision value '{text}'",
+                            hint="use hull, same, or simplify:N with N >= 4 faces")
+
+
+def collision_triangles(triangles: np.ndarray, spec: CollisionSpec) -> np.ndarray | None:
+    """The collision mesh to write, or None when collision uses the visual mesh."""
+    if spec.kind == "same":
+        return None
+    if spec.kind == "hull":
+        return convex_hull_triangles(triangles)
+    return cluster_decimate(triangles, spec.max_faces)
+
+
+@dataclass
+class ImportedMesh:
+    source: Path
+    file_format: str                 # binary | ascii
+    triangles_m: np.ndarray          # (n, 3, 3), metres, FLU, recentred
+    units: UnitChoice
+    frame: AxisConvention
+    offset_m: np.ndarray             # translation applied after rotation (recentring)
+    recenter: str
+    check: MeshCheck
+    topology: Topology
+    mass: MassProperties             # in the written mesh's frame
+    mass_source: str                 # "given mass", "density ... x volume", "DEFAULT density ..."
+    collision_m: np.ndarray | None   # collision triangles, None = use the visual mesh
+    collision: CollisionSpec
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def size_m(self) -> np.ndarray:
+        vertices = self.triangles_m.reshape(-1, 3)
+        return vertices.max(axis=0) - vertices.min(axis=0)
+
+
+DEFAULT_DENSITY_KG_M3 = 1000.0
+
+
+def import_mesh(path: str | Path, *, units: str = "auto", from_frame: str = "flu",
+                mass_kg: float | None = None, density_kg_m3: float | None = None,
+                recenter: str = "none", collision: str = "same", progress=None) -> ImportedMesh:
+    """Read a CAD STL and return it in metres and FLU with its mass properties.
+
+    `progress(stage_name)` is called before each stage, for a progress bar.
+    """
+    step = progress or (lambda _stage: None)
+    path = Path(path)
+    frame = axis_convention(from_frame)
+    spec = CollisionSpec.parse(collision)
+    if recenter not in ("none", "com", "bbox"):
+        raise ReedtoolError(f"bad --recenter value '{recenter}'", hint="use none, com or bbox")
+    if mass_kg is not None and density_kg_m3 is not None:
+        raise ReedtoolError("give --mass or --density, not both")
+    for value, flag in ((mass_kg, "--mass"), (density_kg_m3, "--density")):
+        if value is not None and not (np.isfinite(value) and value > 0):
+            raise ReedtoolError(f"{flag} must be a positive number, not {value}")
+
+    step("reading")
+    stl = read_stl(path)
+    step("checking")
+    check = check_triangles(stl.triangles, path)
+    topo = topology(stl.triangles)
+    choice = choose_units(units, check.extent)
+
+    step("transforming")
+    # Uniform scale and a rotation commute; one matrix does both.
+    M = frame.R_flu_src * choice.metres_per_unit
+    triangles = stl.triangles @ M.T
+
+    step("mass properties")
+    try:
+        unit_props = mesh_mass_properties(triangles, 1.0, closed=topo.closed)
+    except ReedtoolError as exc:
+        raise ReedtoolError(exc.message, file=path, hint=exc.hint) from exc
+    volume = float(unit_props.volume_m3)
+    if mass_kg is not None:
+        props, mass_source = unit_props.scaled_to_mass(mass_kg), "given mass"
+    else:
+        density = density_kg_m3 if density_kg_m3 is not None else DEFAULT_DENSITY_KG_M3
+        props = unit_props.scaled_to_mass(density * volume)
+        mass_source = (f"density {density:g} kg/m^3 x volume" if density_kg_m3 is not None
+                       else f"DEFAULT density {density:g} kg/m^3 x volume")
+
+    if recenter == "com":
+        offset = -props.com_m
+    elif recenter == "bbox":
+        vertices = triangles.reshape(-1, 3)
+        offset = -(vertices.min(axis=0) + vertices.max(axis=0)) / 2.0
+    else:
+        offset = np.zeros(3)
+    if recenter != "none":
+        triangles = triangles + offset
+        props = MassProperties(props.mass_kg, props.com_m + offset, props.inertia_kg_m2,
+                               props.volume_m3, props.from_hull)
+
+    step("collision mesh")
+    collision_m = collision_triangles(triangles, spec)
+
+    notes = list(stl.notes)
+    if check.zero_area_triangles:
+        notes.append(f"{check.zero_area_triangles} zero-area triangles (kept; they add nothing)")
+    if props.from_hull:
+        why = "not watertight" if not topo.watertight else "inconsistently wound"
+        notes.append(f"mesh is {why}: mass properties are those of its convex hull")
+    return ImportedMesh(path, stl.format, triangles, choice, frame, offset, recenter, check,
+                        topo, props, mass_source, collision_m, spec, notes)

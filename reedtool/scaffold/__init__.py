@@ -1,0 +1,1 @@
+"""`new-package`: the frame catalogue, package parameters and template rendering."""
