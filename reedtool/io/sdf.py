@@ -43,7 +43,6 @@ joints) so URDF-only consumers such as the Pinocchio cross-check see the same mo
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
@@ -53,7 +52,9 @@ from lxml import etree
 
 from reedtool.errors import ReedtoolError
 from reedtool.frames import make_T, matrix_to_rpy, rpy_to_matrix
-from reedtool.io.xml_lines import start_line
+from reedtool.io.resources import RESOURCE_PATH_VARS, resolve_model_file_uri
+from reedtool.io.sdf_include import SourceFile, SourceMap, expand_includes
+from reedtool.io.tolerant_xml import local_tag, parse_tolerant
 from reedtool.model import (
     INERTIA_KEYS,
     Box,
@@ -76,39 +77,63 @@ from reedtool.model import (
 )
 
 MODEL_FRAME = "__model__"
+# Plugin parameters that name a joint or link of the plugin's own model: a plugin of a
+# nested (not merged) model reads them in that model's scope.
+_SCOPED_PLUGIN_PARAMS = {"jointName", "linkName", "joint_name", "link_name", "bodyName",
+                         "body_name"}
 # sdformat writes "no limit" as +-1e16; anything beyond this is unbounded.
 UNBOUNDED_LIMIT = 1e15
 SDF_DEFAULT_MASS_KG = 1.0
-RESOURCE_PATH_VARS = ("GZ_SIM_RESOURCE_PATH", "IGN_GAZEBO_RESOURCE_PATH", "SDF_PATH",
-                      "GAZEBO_MODEL_PATH")
 
 
-def load_sdf_file(path: Path | str, *, resolver=None) -> Robot:
-    """Read an SDF file (a model.sdf, or a world holding one model) into a Robot."""
+def load_sdf_file(path: Path | str, *, resolver=None, model_name: str | None = None) -> Robot:
+    """Read an SDF file (a model.sdf, or a world) into the Robot of one model."""
     from reedtool.io.fileio import read_xml_file
 
     path = Path(path)
     text, _encoding = read_xml_file(path, what="SDF file")
-    return parse_sdf(text, path, resolver=resolver)
+    return parse_sdf(text, path, resolver=resolver, model_name=model_name)
 
 
-def parse_sdf(xml_text: str, file: Path | str, *, resolver=None) -> Robot:
+def load_sdf_models(path: Path | str, *, resolver=None) -> list[Robot]:
+    """Every model `validate` checks in an SDF file: the model of a model file; in a world,
+    each model with motor plugins, else each non-static model."""
+    from reedtool.io.fileio import read_xml_file
+
+    path = Path(path)
+    text, _encoding = read_xml_file(path, what="SDF file")
+    root, sources, resolver = _document(text, path, resolver)
+    models = _candidate_models(root, path, sources)
+    with_motors = [m for m in models if _has_motor_plugin(m)]
+    return [_read_model(m, path, resolver, sources) for m in (with_motors or models)]
+
+
+def parse_sdf(xml_text: str, file: Path | str, *, resolver=None,
+              model_name: str | None = None) -> Robot:
     file = Path(file)
-    try:
-        from reedtool.io.urdf import xml_parser
+    root, sources, resolver = _document(xml_text, file, resolver)
+    model = _pick_model(root, file, sources, model_name)
+    return _read_model(model, file, resolver, sources)
 
-        root = etree.fromstring(xml_text.encode("utf-8"), xml_parser())
-    except etree.XMLSyntaxError as exc:
-        raise ReedtoolError(f"malformed XML: {exc.msg}", file=file, line=exc.lineno,
-                            hint="fix the XML syntax at that position") from exc
+
+def _document(xml_text: str, file: Path, resolver):
+    """(root with every <include> expanded, its SourceMap, the resolver)."""
+    root, tolerated = parse_tolerant(xml_text, file)
     if root.tag != "sdf":
         raise ReedtoolError(f"not an SDF file: the root element is <{root.tag}>, expected <sdf>",
                             file=file, line=root.sourceline)
-    model = _pick_model(root, file)
     if resolver is None:
         from reedtool.io.packages import PackageResolver
         resolver = PackageResolver(model_path=file)
-    robot = _ModelReader(file, resolver, xml_text).read(model)
+    top = SourceFile(file, xml_text.splitlines())
+    sources = SourceMap(top)
+    sources.tolerated += [(top, t) for t in tolerated]
+    expand_includes(root, top, sources, getattr(resolver, "package_paths", ()))
+    return root, sources, resolver
+
+
+def _read_model(model: etree._Element, file: Path, resolver, sources: SourceMap) -> Robot:
+    robot = _ModelReader(file, resolver, sources).read(model)
     robot.urdf_xml = equivalent_urdf(robot)
     return robot
 
@@ -128,23 +153,43 @@ def _has_motor_plugin(model: etree._Element) -> bool:
                for p in model.iter("plugin"))
 
 
-def _pick_model(root: etree._Element, file: Path) -> etree._Element:
+def _candidate_models(root: etree._Element, file: Path,
+                      sources: SourceMap) -> list[etree._Element]:
+    """The models a file holds: its top <model>, else the non-static models of its world."""
     models = _children(root, "model")
     if models:
-        return models[0]
-    for world in _children(root, "world"):
-        candidates = [m for m in _children(world, "model") if not _is_static(m)]
-        if candidates:
-            with_motors = [m for m in candidates if _has_motor_plugin(m)]
-            return (with_motors or candidates)[0]
-        if _children(world, "include"):
-            include = _children(world, "include")[0]
-            raise ReedtoolError(
-                "the world only <include>s its models, which reedtool does not fetch",
-                file=file, line=include.sourceline,
-                hint="pass the included model's model.sdf instead")
+        return models[:1]
+    candidates = [m for world in _children(root, "world") for m in _children(world, "model")
+                  if not _is_static(m)]
+    if candidates:
+        return candidates
+    if sources.unresolved:
+        first = sources.unresolved[0]
+        raise ReedtoolError(f"the world's <include> could not be read: {first.reason}",
+                            file=first.file, line=first.line,
+                            hint="set GZ_SIM_RESOURCE_PATH or pass --package-path DIR")
     raise ReedtoolError("no <model> found in the SDF file", file=file, line=root.sourceline,
                         hint="pass an SDF file that contains a <model>")
+
+
+def _pick_model(root: etree._Element, file: Path, sources: SourceMap,
+                model_name: str | None = None) -> etree._Element:
+    if model_name is not None:
+        everything = _children(root, "model") + [
+            m for world in _children(root, "world") for m in _children(world, "model")]
+        for model in everything:
+            if model.get("name") == model_name:
+                return model
+        for include in sources.unresolved:
+            if include.name == model_name or include.uri.rstrip("/").endswith("/" + model_name):
+                raise ReedtoolError(f"model '{model_name}' could not be read: {include.reason}",
+                                    file=include.file, line=include.line)
+        names = ", ".join(repr(m.get("name")) for m in everything) or "none"
+        raise ReedtoolError(f"--model {model_name}: no such model in the file (models: {names})",
+                            file=file, hint="pass one of the model names listed")
+    candidates = _candidate_models(root, file, sources)
+    with_motors = [m for m in candidates if _has_motor_plugin(m)]
+    return (with_motors or candidates)[0]
 
 
 # ------------------------------------------------------------------ frames
@@ -157,21 +202,26 @@ class _FrameEntry:
 
 
 class _ModelReader:
-    def __init__(self, file: Path, resolver, xml_text: str = ""):
+    def __init__(self, file: Path, resolver, sources: SourceMap):
         self.file = file
-        self.lines = xml_text.splitlines()
+        self.sources = sources
         self.resolver = resolver
         self.issues: list[ParseIssue] = []
         self.frames: dict[str, _FrameEntry] = {}
         self._resolved: dict[str, np.ndarray] = {MODEL_FRAME: np.eye(4)}
         self.link_els: list[tuple[str, str, etree._Element]] = []   # (scoped name, scope, el)
         self.joint_els: list[tuple[str, str, etree._Element]] = []
-        self.plugin_els: list[etree._Element] = []
+        self.plugin_els: list[tuple[str, etree._Element]] = []      # (scope, el)
+        self.model_els: dict[str, etree._Element] = {}              # scope "a::" -> <model>
+        self.attached_to: dict[str, str] = {}                       # frame -> what it is on
         self.canonical: str | None = None
 
     # ------------------------------------------------------------ helpers
     def loc(self, el: etree._Element) -> SourceLoc:
-        return SourceLoc(str(self.file), start_line(el.tag, el.sourceline, self.lines))
+        return SourceLoc(str(self.sources.file_of(el).path), self.sources.line_of(el))
+
+    def file_of(self, el: etree._Element) -> Path:
+        return self.sources.file_of(el).path
 
     def _issue(self, kind: str, message: str, el: etree._Element, subject: str | None) -> None:
         self.issues.append(ParseIssue(kind, message, self.loc(el), subject))
@@ -237,6 +287,9 @@ class _ModelReader:
         if name in self._resolved:
             return self._resolved[name]
         entry = self.frames.get(name)
+        if entry is None and name + "::" + MODEL_FRAME in self.frames:
+            # A nested model's name stands for its model frame.
+            return self.T_model(name + "::" + MODEL_FRAME, el, subject, _seen)
         if entry is None or name in _seen:
             what = "is part of a cycle of relative_to frames" if name in _seen else \
                 "names no link, joint, frame or model"
@@ -248,10 +301,44 @@ class _ModelReader:
         self._resolved[name] = T
         return T
 
-    def _node(self, el: etree._Element) -> XmlNode:
-        children = [self._node(c) for c in el if isinstance(c.tag, str)]
-        return XmlNode(tag=el.tag, attrib=dict(el.attrib), text=el.text, children=children,
-                       loc=self.loc(el))
+    def _node(self, el: etree._Element, scope: str = "") -> XmlNode:
+        children = [self._node(c, scope) for c in el if isinstance(c.tag, str)]
+        tag = local_tag(el)
+        text = el.text
+        if scope and tag in _SCOPED_PLUGIN_PARAMS and text and text.strip() \
+                and not text.strip().startswith(scope):
+            # A plugin of a nested model names the joints and links of that model.
+            text = scope + text.strip()
+        attrib = {local_tag(etree.Element(k)) if k.startswith("{") else k: v
+                  for k, v in el.attrib.items()}
+        return XmlNode(tag=tag, attrib=attrib, text=text, children=children, loc=self.loc(el))
+
+    def canonical_link(self, scoped_model: str) -> str | None:
+        """The link a nested model's name resolves to (SDF 1.8+ joint parent/child)."""
+        model = self.model_els.get(scoped_model + "::")
+        if model is None:
+            return None
+        scope = scoped_model + "::"
+        if model.get("canonical_link"):
+            return self._scoped(scope, model.get("canonical_link"))
+        for name, link_scope, _el in self.link_els:
+            if link_scope == scope:
+                return name
+        for nested_scope in self.model_els:
+            if nested_scope.startswith(scope) and nested_scope.count("::") == scope.count("::") + 1:
+                return self.canonical_link(nested_scope[:-2])
+        return None
+
+    def body_of(self, name: str | None, _seen: tuple[str, ...] = ()) -> str | None:
+        """A joint's parent/child as a link: a nested model -> its canonical link, a frame
+        -> the link it is attached to; links and unknown names stay as written."""
+        if name is None or name == "world" or name in _seen:
+            return name
+        if name + "::" + MODEL_FRAME in self.frames:
+            return self.canonical_link(name) or name
+        if name in self.attached_to:
+            return self.body_of(self.attached_to[name], _seen + (name,))
+        return name
 
     # ------------------------------------------------------------ collect
     def _collect(self, model: etree._Element, scope: str) -> None:
@@ -274,17 +361,15 @@ class _ModelReader:
                 T, rel = self._pose(el.find("pose"), name)
                 self.frames[scope + name] = _FrameEntry(
                     self._scoped(scope, rel or el.get("attached_to")), T, el)
+                self.attached_to[scope + name] = self._scoped(scope, el.get("attached_to"))
             elif el.tag == "model":
                 T, rel = self._pose(el.find("pose"), name)
                 nested = scope + name + "::"
                 self.frames[nested + MODEL_FRAME] = _FrameEntry(self._scoped(scope, rel), T, el)
+                self.model_els[nested] = el
                 self._collect(el, nested)
             elif el.tag == "plugin":
-                self.plugin_els.append(el)
-            elif el.tag == "include":
-                uri = (el.findtext("uri") or "").strip()
-                self._issue("sdf-include", f"<include> of '{uri}' is not read; its links, joints "
-                            "and plugins are missing from the model reedtool checks", el, uri)
+                self.plugin_els.append((scope, el))
 
     # ------------------------------------------------------------ elements
     def read(self, model: etree._Element) -> Robot:
@@ -302,14 +387,27 @@ class _ModelReader:
             robot.links.sort(key=lambda link: link.name != canonical)
             robot.__dict__.pop("link_map", None)
         if self.plugin_els:
-            block = GazeboBlock(reference=None, loc=self.loc(self.plugin_els[0]))
-            for el in self.plugin_els:
-                node = self._node(el)
+            block = GazeboBlock(reference=None, loc=self.loc(self.plugin_els[0][1]))
+            for scope, el in self.plugin_els:
+                node = self._node(el, scope)
                 block.plugins.append(Plugin(name=el.get("name"), filename=el.get("filename"),
                                             node=node, loc=node.loc))
             robot.gazebo.append(block)
+        self._tolerated_issues()
         robot.parse_issues = self.issues
         return robot
+
+    def _tolerated_issues(self) -> None:
+        """One information issue per file read with TinyXML2's tolerance."""
+        by_file: dict[Path, list] = {}
+        for source, tolerated in self.sources.tolerated:
+            by_file.setdefault(source.path, []).append(tolerated)
+        for path, items in by_file.items():
+            what = "; ".join(f"line {t.line}: {t.what}" for t in items)
+            self.issues.append(ParseIssue(
+                "xml-tolerated", f"Gazebo (TinyXML2) reads this file, but strict XML tools "
+                f"(xmllint, lxml, XML editors) reject it: {what}",
+                SourceLoc(str(path), items[0].line), path.name))
 
     def _T_link_X(self, link_scoped: str, scope: str, pose_el: etree._Element | None,
                   subject: str) -> np.ndarray:
@@ -390,34 +488,23 @@ class _ModelReader:
             self._issue("missing-element", "<mesh> has no <uri>", el, link)
             return Mesh(uri="", path=None, scale=scale, resolve_error="no uri")
         try:
-            return Mesh(uri=uri, path=self._resolve_uri(uri), scale=scale)
+            return Mesh(uri=uri, path=self._resolve_uri(uri, el), scale=scale)
         except ReedtoolError as exc:
             return Mesh(uri=uri, path=None, scale=scale, resolve_error=exc.message)
 
-    def _resolve_uri(self, uri: str) -> Path:
+    def _resolve_uri(self, uri: str, el: etree._Element) -> Path:
+        file = self.file_of(el)   # the file that names the URI, which may be an included one
         if uri.startswith("model://"):
-            name, _, rel = uri[len("model://"):].partition("/")
-            model_dir = self.file.parent
-            roots = [Path(p) for var in RESOURCE_PATH_VARS
-                     for p in os.environ.get(var, "").split(os.pathsep) if p]
-            candidates = [root / name for root in roots]
-            if model_dir.name == name:
-                candidates.append(model_dir)
-            candidates.append(model_dir.parent / name)
-            for candidate in candidates:
-                if candidate.is_dir():
-                    return candidate / rel
-            raise ReedtoolError(f"model '{name}' not found in {', '.join(RESOURCE_PATH_VARS)} "
-                                "or next to the model")
+            return resolve_model_file_uri(uri, file, getattr(self.resolver, "package_paths", ()))
         if uri.startswith(("http://", "https://")):
             raise ReedtoolError("Fuel/HTTP URIs are not fetched")
-        return Path(self.resolver.resolve_uri(uri, self.file.parent))
+        return Path(self.resolver.resolve_uri(uri, file.parent))
 
     def _joint(self, scoped: str, scope: str, el: etree._Element) -> Joint:
         sdf_type = el.get("type", "")
         parent_text, child_text = el.findtext("parent"), el.findtext("child")
-        parent = self._scoped(scope, parent_text.strip()) if parent_text else None
-        child = self._scoped(scope, child_text.strip()) if child_text else None
+        parent = self.body_of(self._scoped(scope, parent_text.strip())) if parent_text else None
+        child = self.body_of(self._scoped(scope, child_text.strip())) if child_text else None
         if parent is None:
             self._issue("missing-element", f"joint '{scoped}' has no <parent>", el, scoped)
         if child is None:

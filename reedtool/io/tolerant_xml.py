@@ -1,0 +1,123 @@
+"""Parse SDF text the way libsdformat (TinyXML2) does: what TinyXML2 reads, reedtool reads.
+
+TinyXML2 is not a validating XML parser. Gazebo therefore loads files that libxml2 (lxml,
+xmllint) refuses; two kinds occur in files people fly today:
+
+* `--` inside a comment (gz-sim's own `examples/worlds/quadcopter.sdf`), which XML 1.0
+  forbids;
+* a namespace prefix used without its `xmlns:` declaration (PX4's optical-flow sensor
+  writes `gz:` attributes), which the Namespaces in XML spec forbids.
+
+The strict parse is tried first. Only when it fails are these two patterns cleaned in a
+copy of the text that keeps every character offset and line number (a `-` becomes a
+space; the missing declarations go inside the root start tag, on its own line), and the
+copy is parsed. Anything else that is malformed stays a one-line error, as it is in
+Gazebo. The caller turns the returned notes into one information finding per file.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from lxml import etree
+
+from reedtool.errors import ReedtoolError
+
+# URN the undeclared prefixes are bound to; never written to a user file.
+UNDECLARED_NS = "urn:reedtool:undeclared:"
+
+_COMMENT = re.compile(r"<!--(.*?)-->", re.DOTALL)
+_PREFIXED_TAG = re.compile(r"</?([A-Za-z_][\w.-]*):[A-Za-z_][\w.-]*")
+_PREFIXED_ATTR = re.compile(r"\s([A-Za-z_][\w.-]*):[A-Za-z_][\w.-]*\s*=")
+_DECLARED = re.compile(r"xmlns:([A-Za-z_][\w.-]*)\s*=")
+_ROOT_START = re.compile(r"<(?![?!])[A-Za-z_][\w.:-]*")
+_RESERVED = {"xml", "xmlns"}
+
+
+@dataclass(frozen=True)
+class Tolerated:
+    """A construct TinyXML2 accepts and strict XML tools refuse."""
+
+    line: int
+    what: str          # what the construct is, for the message
+
+
+def _parser() -> etree.XMLParser:
+    return etree.XMLParser(remove_blank_text=False, resolve_entities=False, huge_tree=True,
+                           encoding="utf-8")
+
+
+def _line_of(text: str, offset: int) -> int:
+    return text.count("\n", 0, offset) + 1
+
+
+def _clean_comments(text: str) -> tuple[str, list[Tolerated]]:
+    found: list[Tolerated] = []
+
+    def fix(match: re.Match) -> str:
+        body = match.group(1)
+        if "--" not in body and not body.endswith("-"):
+            return match.group(0)
+        found.append(Tolerated(_line_of(text, match.start()), "'--' inside a comment"))
+        body = re.sub(r"-(?=-)", " ", body)
+        if body.endswith("-"):
+            body = body[:-1] + " "
+        return f"<!--{body}-->"
+
+    return _COMMENT.sub(fix, text), found
+
+
+def _undeclared_prefixes(text: str) -> dict[str, int]:
+    """Prefix -> first line it is used on, for prefixes no xmlns: declares."""
+    no_comments = _COMMENT.sub(lambda m: " " * len(m.group(0)), text)
+    declared = set(_DECLARED.findall(no_comments)) | _RESERVED
+    used: dict[str, int] = {}
+    for pattern in (_PREFIXED_TAG, _PREFIXED_ATTR):
+        for match in pattern.finditer(no_comments):
+            prefix = match.group(1)
+            if prefix not in declared:
+                line = _line_of(no_comments, match.start(1))
+                used[prefix] = min(line, used.get(prefix, line))
+    return used
+
+
+def _declare(text: str, prefixes: dict[str, int]) -> str:
+    no_comments = _COMMENT.sub(lambda m: " " * len(m.group(0)), text)
+    root = _ROOT_START.search(no_comments)
+    if root is None or not prefixes:
+        return text
+    declarations = "".join(f' xmlns:{p}="{UNDECLARED_NS}{p}"' for p in sorted(prefixes))
+    return text[:root.end()] + declarations + text[root.end():]
+
+
+def parse_tolerant(text: str, file: Path | str) -> tuple[etree._Element, list[Tolerated]]:
+    """(root element, what was tolerated) of XML text, or a one-line ReedtoolError."""
+    data = text.encode("utf-8")
+    try:
+        return etree.fromstring(data, _parser()), []
+    except etree.XMLSyntaxError as strict_error:
+        cleaned, tolerated = _clean_comments(text)
+        prefixes = _undeclared_prefixes(cleaned)
+        tolerated += [Tolerated(line, f"namespace prefix '{p}:' used without an xmlns:{p} "
+                                      "declaration") for p, line in sorted(prefixes.items())]
+        if not tolerated:
+            raise ReedtoolError(f"malformed XML: {strict_error.msg}", file=file,
+                                line=strict_error.lineno,
+                                hint="fix the XML syntax at that position") from None
+        try:
+            root = etree.fromstring(_declare(cleaned, prefixes).encode("utf-8"), _parser())
+        except etree.XMLSyntaxError as exc:
+            raise ReedtoolError(f"malformed XML: {exc.msg}", file=file, line=exc.lineno,
+                                hint="fix the XML syntax at that position") from None
+        return root, sorted(tolerated, key=lambda t: t.line)
+
+
+def local_tag(el: etree._Element) -> str:
+    """The tag without a namespace that only reedtool's tolerant parse attached."""
+    tag = el.tag
+    if isinstance(tag, str) and tag.startswith("{" + UNDECLARED_NS):
+        prefix, _, name = tag[len(UNDECLARED_NS) + 1:].partition("}")
+        return f"{prefix}:{name}"
+    return tag
