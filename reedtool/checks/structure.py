@@ -23,6 +23,7 @@ SDF_MIN_MASS_KG = 1e-6
 # Parse-issue kinds that have a rule of their own; every other kind is S101.
 _NON_FINITE_KINDS = {"non-finite"}
 _LEGACY_KINDS = {"legacy-xacro"}
+_TOLERATED_KINDS = {"xml-tolerated"}
 _PER_AXIS_JOINTS = {"revolute", "continuous", "prismatic", "planar"}
 _LIMITED_JOINTS = {"revolute", "prismatic"}
 
@@ -42,7 +43,7 @@ def urdf_parse_error(ctx: CheckContext) -> Iterator[Issue]:
     Fix the element at the reported line.
     """
     for issue in ctx.robot.parse_issues:
-        if issue.kind not in _NON_FINITE_KINDS | _LEGACY_KINDS:
+        if issue.kind not in _NON_FINITE_KINDS | _LEGACY_KINDS | _TOLERATED_KINDS:
             yield Issue(issue.message, issue.loc, issue.subject)
 
 
@@ -332,6 +333,10 @@ def link_dropped_by_sdf(ctx: CheckContext) -> Iterator[Issue]:
 
 # Plugin parameters that name a link Gazebo must find at run time.
 _PLUGIN_LINK_PARAMS = ("linkName", "bodyName", "link_name", "body_name")
+# sdformat's URDF->SDF conversion (parser_urdf.cc, ReduceSDFExtensionPluginFrameReplace)
+# rewrites exactly these two elements of a <plugin> directly inside a <gazebo> block when
+# it lumps the link they name, and adds the lumped offset as <xyzOffset>/<rpyOffset>.
+_REWRITTEN_BY_LUMPING = ("bodyName", "frameName")
 _KEEP_FIXED_JOINT = ("disableFixedJointLumping", "preserveFixedJoint")
 
 
@@ -349,7 +354,12 @@ def _keeps_fixed_joint(ctx: CheckContext, joint_name: str) -> bool:
 def plugin_link_merged(ctx: CheckContext) -> Iterator[Issue]:
     """Gazebo merges every link attached by a fixed joint into its parent when it converts
     URDF to SDF, so the link's name no longer exists in the simulation. A plugin told to
-    use that link (`<linkName>`, `<bodyName>`) then fails to load or attaches to nothing.
+    use that link by `<linkName>` (or `<link_name>`, `<body_name>`) then fails to load or
+    attaches to nothing.
+
+    `<bodyName>` and `<frameName>` are the exception: the conversion rewrites them to the
+    parent link and records the lumped link's offset in `<xyzOffset>`/`<rpyOffset>`, so a
+    plugin naming a lumped link there (gazebo_ros IMU, P3D) works and is not reported.
 
     Keep the joint with `<gazebo reference="JOINT"><preserveFixedJoint>true</preserveFixedJoint>
     </gazebo>` (`disableFixedJointLumping` on older Gazebo), or make it a revolute joint
@@ -360,6 +370,8 @@ def plugin_link_merged(ctx: CheckContext) -> Iterator[Issue]:
         return
     for _block, plugin in ctx.robot.plugins():
         for tag in _PLUGIN_LINK_PARAMS:
+            if tag in _REWRITTEN_BY_LUMPING:
+                continue
             name = plugin.param(tag)
             joint = ctx.parent_joint(name) if name else None
             if joint is None or joint.moves or _keeps_fixed_joint(ctx, joint.name):
@@ -369,3 +381,20 @@ def plugin_link_merged(ctx: CheckContext) -> Iterator[Issue]:
                         plugin.param_loc(tag), plugin.name or name,
                         hint=f"add <gazebo reference=\"{joint.name}\"><preserveFixedJoint>true"
                              "</preserveFixedJoint></gazebo>")
+
+
+@rule("S119", "xml-tolerated", "info",
+      "The file uses XML that Gazebo reads but strict XML tools reject.")
+def xml_tolerated(ctx: CheckContext) -> Iterator[Issue]:
+    """libsdformat parses with TinyXML2, which accepts `--` inside a comment and a
+    namespace prefix (such as `gz:`) used without its `xmlns:` declaration. Gazebo loads
+    such a file and reedtool reads it the same way, but XML 1.0 forbids both: xmllint,
+    lxml, check_urdf-style tools and XML editors refuse the file or flag it.
+
+    Nothing breaks in simulation. To keep other tools happy, write single hyphens in
+    comments and declare the prefix on the root element (`<sdf xmlns:gz="...">`).
+    """
+    for issue in ctx.robot.parse_issues:
+        if issue.kind in _TOLERATED_KINDS:
+            yield Issue(issue.message, issue.loc, issue.subject,
+                        hint="single hyphens in comments; declare xmlns:PREFIX on the root")

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import click
 
-from reedtool.commands.params import FiniteFloatRange
+from reedtool.commands.params import FiniteFloatRange, model_option
 from reedtool.errors import ReedtoolError
 
 SPREAD_HELP = "Half-width of the uniform perturbation"
@@ -33,6 +33,7 @@ MAX_STEPS = 10_000_000
 @click.option("--package-path", "package_paths", multiple=True, metavar="DIR",
               type=click.Path(path_type=Path, file_okay=False),
               help="Directory to search for ROS packages first (repeatable).")
+@model_option
 @click.option("--duration", "duration_s", type=float, default=10.0, show_default=True,
               help="Simulated time [s].")
 @click.option("--rate", "rate_hz", type=float, default=1000.0, show_default=True,
@@ -67,6 +68,7 @@ MAX_STEPS = 10_000_000
 @click.option("--min-pass-rate", type=FiniteFloatRange(0.0, 1.0), default=0.95,
               show_default=True, help="Batch pass rate needed to exit 0.")
 def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
+            model_name: str | None,
             duration_s: float, rate_hz: float, offset_m: tuple[float, float, float],
             roll_rad: float, pitch_rad: float, yaw_rad: float, plot_path: Path | None,
             csv_path: Path | None, force: bool, fmt: str, samples: int | None, seed: int,
@@ -103,7 +105,8 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     from reedtool.io.loader import load_robot
     from reedtool.io.mappings import parse_mappings
 
-    robot = load_robot(model, parse_mappings(mappings), list(package_paths))
+    robot = load_robot(model, parse_mappings(mappings), list(package_paths),
+                       model_name=model_name)
     require_sound_model(robot)
     report = hover_test(robot, config, samples=samples, seed=seed,
                         spreads=(mass_spread, com_spread_m, inertia_spread, motor_spread),

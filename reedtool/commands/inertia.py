@@ -9,6 +9,7 @@ from pathlib import Path
 import click
 import numpy as np
 
+from reedtool.commands.params import model_option
 from reedtool.errors import ReedtoolError
 
 
@@ -203,13 +204,15 @@ def print_fix_xacro(comparisons) -> list[str]:
 @click.option("--package-path", "package_paths", multiple=True, metavar="DIR",
               type=click.Path(path_type=Path, file_okay=False),
               help="Directory to search for ROS packages first (repeatable).")
+@model_option
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
               show_default=True, help="Output format.")
 @click.option("--fix", is_flag=True,
               help="Write the geometry's inertia into a .urdf (with a .bak backup); for a "
                    ".xacro, print the blocks to paste and where.")
 @click.option("--force", is_flag=True, help="With --fix, replace an existing .bak backup.")
-def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...], fmt: str,
+def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
+            model_name: str | None, fmt: str,
             fix: bool, force: bool) -> int:
     """Compare each link's declared inertia with its geometry's; whole-robot mass properties.
 
@@ -223,7 +226,8 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     from reedtool.physics.inertia import compare_links, whole_robot
     from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
 
-    robot = load_robot(model, parse_mappings(mappings), list(package_paths))
+    robot = load_robot(model, parse_mappings(mappings), list(package_paths),
+                       model_name=model_name)
     if fix and robot.source_format != "urdf":
         # The blocks --fix writes or prints are URDF <inertial>; SDF spells them differently.
         raise ReedtoolError("--fix edits URDF and xacro models only", file=model,

@@ -21,3 +21,11 @@ class FiniteFloatRange(click.FloatRange):
         if not math.isfinite(number):
             self.fail(f"{value!r} is not a finite number.", param, ctx)
         return super().convert(number, param, ctx)
+
+
+def model_option(command):
+    """`--model NAME`: the model of an SDF world (or any SDF file) a command reads."""
+    return click.option(
+        "--model", "model_name", metavar="NAME", default=None,
+        help="In an SDF world holding several models, the one to read (by its name).",
+    )(command)

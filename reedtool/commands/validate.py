@@ -8,6 +8,7 @@ from pathlib import Path
 
 import click
 
+from reedtool.commands.params import model_option
 from reedtool.errors import ReedtoolError
 
 
@@ -36,6 +37,7 @@ def _use_color(no_color: bool) -> bool:
 @click.option("--package-path", "package_paths", multiple=True, metavar="DIR",
               type=click.Path(path_type=Path, file_okay=False),
               help="Directory to search for ROS packages first (repeatable).")
+@model_option
 @click.option("--format", "fmt", type=click.Choice(["text", "json", "github"]),
               default="text", show_default=True, help="Output format.")
 @click.option("--select", multiple=True, metavar="PREFIX,...",
@@ -52,7 +54,7 @@ def _use_color(no_color: bool) -> bool:
               help="RotorS-style vehicle parameter YAML to cross-check against the model "
                    "(repeatable).")
 def command(model: Path | None, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
-            fmt: str, select: tuple[str, ...], ignore: tuple[str, ...],
+            model_name: str | None, fmt: str, select: tuple[str, ...], ignore: tuple[str, ...],
             explain_code: str | None, strict: bool | None, no_color: bool,
             controller_files: tuple[Path, ...] = ()) -> int:
     """Check MODEL (.urdf, .xacro or .sdf, with xacro NAME:=VALUE arguments) for mistakes.
@@ -75,7 +77,7 @@ def command(model: Path | None, mappings: tuple[str, ...], package_paths: tuple[
         run_checks,
     )
     from reedtool.config import load_config
-    from reedtool.io.loader import load_robot
+    from reedtool.io.loader import load_robots
     from reedtool.io.mappings import parse_mappings
     from reedtool.report import render
 
@@ -93,16 +95,26 @@ def command(model: Path | None, mappings: tuple[str, ...], package_paths: tuple[
                 + parse_selectors(ignore, origin="--ignore")),
         severity=parse_severity_overrides(config.severity, origin=origin),
     )
-    robot = load_robot(model, parse_mappings(mappings), list(package_paths))
+    robots = load_robots(model, parse_mappings(mappings), list(package_paths),
+                         model_name=model_name)
     controllers = []
     if controller_files:
         from reedtool.flightstack.controller_tables import load_controller_yaml
 
         controllers = [load_controller_yaml(path) for path in controller_files]
-    findings = run_checks(robot, selection, controllers=controllers)
-
-    click.echo(render(findings, str(model), fmt, color=_use_color(no_color)), nl=False,
-               color=_use_color(no_color))
+    findings = []
+    outputs = []
+    for robot in robots:
+        robot_findings = run_checks(robot, selection, controllers=controllers)
+        findings += robot_findings
+        # A world checked model by model reports each under its name.
+        label = str(model) if len(robots) == 1 else f"{model} [model {robot.name}]"
+        outputs.append(render(robot_findings, label, fmt, color=_use_color(no_color)))
+    if fmt == "json" and len(outputs) > 1:
+        text = "[\n" + ",\n".join(out.rstrip("\n") for out in outputs) + "\n]\n"
+    else:
+        text = ("\n" if fmt == "text" else "").join(outputs)
+    click.echo(text, nl=False, color=_use_color(no_color))
     strict = config.strict if strict is None else strict
     failing = {"error", "warning"} if strict else {"error"}
     return 1 if any(f.severity in failing for f in findings) else 0

@@ -12,8 +12,28 @@ URDF_SUFFIXES = {".urdf"}
 SDF_SUFFIXES = {".sdf", ".world"}
 
 
+def load_robots(path: Path | str, mappings: Mapping[str, str] | None = None,
+                package_paths: Sequence[Path] = (), model_name: str | None = None) -> list[Robot]:
+    """The models `validate` checks: one for URDF/xacro, a model file or `model_name`; for
+    an SDF world, each multirotor model (each model when none has motor plugins)."""
+    path = Path(path)
+    if model_name is None and _sdf_path(path) is not None:
+        from reedtool.io.packages import PackageResolver
+        from reedtool.io.sdf import load_sdf_models
+
+        sdf = _sdf_path(path)
+        return load_sdf_models(sdf, resolver=PackageResolver(package_paths, model_path=sdf))
+    return [load_robot(path, mappings, package_paths, model_name=model_name)]
+
+
+def _sdf_path(path: Path) -> Path | None:
+    if path.is_dir() and (path / "model.sdf").is_file():
+        return path / "model.sdf"
+    return path if path.suffix.lower() in SDF_SUFFIXES else None
+
+
 def load_robot(path: Path | str, mappings: Mapping[str, str] | None = None,
-               package_paths: Sequence[Path] = ()) -> Robot:
+               package_paths: Sequence[Path] = (), model_name: str | None = None) -> Robot:
     """Load a model, with source locations pointing at the files the user edits.
 
     Legacy xacro tags found during expansion are kept as ParseIssues ("legacy-xacro")
@@ -33,7 +53,11 @@ def load_robot(path: Path | str, mappings: Mapping[str, str] | None = None,
     if path.suffix.lower() in SDF_SUFFIXES:
         from reedtool.io.sdf import load_sdf_file
 
-        return load_sdf_file(path, resolver=PackageResolver(package_paths, model_path=path))
+        return load_sdf_file(path, resolver=PackageResolver(package_paths, model_path=path),
+                             model_name=model_name)
+    if model_name is not None:
+        raise ReedtoolError("--model picks a model of an SDF file; this file is not SDF",
+                            file=path, hint="drop --model")
     if path.suffix.lower() in URDF_SUFFIXES:
         return load_urdf_file(path, resolver=PackageResolver(package_paths, model_path=path))
 
