@@ -110,11 +110,16 @@ def _merge_into(parent: etree._Element, include: etree._Element, model: etree._E
         frame.set("attached_to", canonical)
     pose = model.find("pose")
     sources.roots[frame] = including
-    if pose is not None:
-        sources.roots.setdefault(pose, sources.file_of(pose))
-        if pose.get("relative_to") is None and pose.get("frame") is None:
-            pose.set("relative_to", MODEL_FRAME)
-        frame.append(pose)
+    if pose is None:
+        # The merged frame is posed in the including model's frame, never in attached_to.
+        pose = etree.SubElement(model, "pose")
+        pose.text = "0 0 0 0 0 0"
+        pose.sourceline = include.sourceline
+        sources.roots[pose] = including
+    sources.roots.setdefault(pose, sources.file_of(pose))
+    if pose.get("relative_to") is None and pose.get("frame") is None:
+        pose.set("relative_to", MODEL_FRAME)
+    frame.append(pose)
     moved = [frame]
     for child in list(model):
         if not isinstance(child.tag, str) or child.tag in _MODEL_PROPERTIES:
