@@ -2,10 +2,18 @@
 
 Supported subset (SDF 1.6 to 1.11, the shape of Gazebo's own multirotor models):
 
-* The model read is the `<model>` directly under `<sdf>`, else the one model of a `<world>`
-  that is not `<static>` (if a world holds several, the one with a motor-model plugin,
-  else the first). `<include>`d models are not fetched; each one is a parse issue.
-  Nested `<model>`s are flattened with scoped names (`arm::rotor_0`).
+* `<include>`s are expanded first (reedtool.io.sdf_include): `model://NAME`, relative and
+  absolute URIs, model.config, `<name>`/`<pose>`/`<static>` overrides and SDF 1.9
+  `merge="true"`; every element keeps the file and line it was read from. Text that
+  TinyXML2 accepts and strict XML does not is read (reedtool.io.tolerant_xml), with an
+  "xml-tolerated" parse issue.
+* The model read is the `<model>` directly under `<sdf>`, else a model of a `<world>`:
+  the one named by `model_name` (`--model`), else the first non-static one with a
+  motor-model plugin, else the first non-static one (`load_sdf_models` returns them all).
+  Nested `<model>`s are flattened with scoped names (`arm::rotor_0`); a plugin of a nested
+  model names that model's joints and links, so its jointName/linkName are scoped too. A
+  joint's `<parent>`/`<child>` naming a nested model is that model's canonical link (its
+  `canonical_link=`, else its first link); naming a `<frame>`, the link it is attached to.
 * Frames (SDF 1.7 semantics, which 1.6 files also follow when they use no `frame=`):
   a link's `<pose>` is relative to the model frame; a joint's `<pose>` is relative to its
   CHILD link; a `<frame>`'s pose is relative to its `attached_to` (default the model);
@@ -28,11 +36,12 @@ Supported subset (SDF 1.6 to 1.11, the shape of Gazebo's own multirotor models):
   sdformat's defaults (1 kg, 1 kg*m^2 on the diagonal), as Gazebo simulates it, and a
   parse issue. `<inertial auto="true">` (SDF 1.11) is not computed: a parse issue.
 * Geometry: box, cylinder, sphere and mesh (uri, scale). `model://NAME/...` resolves
-  through GZ_SIM_RESOURCE_PATH, IGN_GAZEBO_RESOURCE_PATH, SDF_PATH, GAZEBO_MODEL_PATH and
-  the directory holding the model; `package://` through the package resolver; Fuel
+  as includes do (reedtool.io.resources: the naming file's directory and its parent,
+  --package-path, GZ_SIM_RESOURCE_PATH, IGN_GAZEBO_RESOURCE_PATH, SDF_PATH,
+  GAZEBO_MODEL_PATH); `package://` through the package resolver; Fuel
   (http/https) URIs are not fetched. Planes, capsules, ellipsoids, heightmaps and
   polylines are kept as "no geometry".
-* `<plugin>` elements directly under a `<model>` become one GazeboBlock(reference=None), so
+* `<plugin>` elements under a `<model>` (or a nested one) become one GazeboBlock(reference=None), so
   rotor discovery reads gz-sim MulticopterMotorModel systems exactly as it reads URDF
   `<gazebo>` plugins.
 

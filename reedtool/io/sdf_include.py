@@ -77,6 +77,14 @@ class SourceMap:
             else el.sourceline
 
 
+def _shown(path: Path) -> str:
+    """A path as the user would type it: relative to the working directory when inside it."""
+    try:
+        return str(path.relative_to(Path.cwd().resolve()))
+    except ValueError:
+        return str(path)
+
+
 def _is_true(text: str | None) -> bool:
     return (text or "").strip().lower() in ("true", "1")
 
@@ -206,7 +214,7 @@ def expand_includes(root: etree._Element, source: SourceFile, sources: SourceMap
         resolved = path.resolve()
         if resolved in chain:
             links = [*chain[chain.index(resolved):], resolved]
-            raise ReedtoolError("<include> cycle: " + " -> ".join(str(p) for p in links),
+            raise ReedtoolError("<include> cycle: " + " -> ".join(_shown(p) for p in links),
                                 file=source.path, line=line,
                                 hint="a model cannot include itself")
         included_root, included = _read(path, sources)
