@@ -41,6 +41,8 @@ CASES = [
     ("S117_bad_tiny_mass.urdf", ["I204", "S117"]),
     ("S118_bad_merged_link.urdf", ["S118"]),
     ("S118_good_body_name_lumped.urdf", []),
+    ("S119_bad_tinyxml_only.sdf", ["S119"]),
+    ("S119_good_strict.sdf", []),
     # Good fixtures: the arm has a zero-mass fixed tool frame (fine), a plugin on a fixed
     # link kept by preserveFixedJoint, a limited revolute joint; the car a mesh in metres.
     ("clean_arm.urdf", []),

@@ -190,7 +190,8 @@ def test_bad_include_pose_points_at_the_include_line(tmp_path):
                      "</model>\n</sdf>\n")
     robot = load_robot(outer)
     issues = [i for i in robot.parse_issues if i.kind == "bad-number"]
-    assert [(Path(i.loc.file).name, i.loc.line) for i in issues] == [("outer.sdf", 5)]
+    # The issue is with the inclusion: it points at the <include> line of the outer file.
+    assert [(Path(i.loc.file).name, i.loc.line) for i in issues] == [("outer.sdf", 3)]
 
 
 def test_merge_inside_a_world_is_refused(tmp_path):
@@ -284,3 +285,38 @@ def test_quadcopter_world_reads_with_one_info():
     assert len(discover_rotors(robot)) == 4
     findings = run_checks(robot, Selection(select=("",)))
     assert [(f.code, f.severity, f.line) for f in findings] == [("S119", "info", 2)]
+
+
+def test_frames_and_relative_to_through_included_models(tmp_path):
+    """A frame of a nested include, named from outside with its scope, and a frame of the
+    outer model posed relative to a merged link."""
+    (tmp_path / "sensor").mkdir()
+    (tmp_path / "sensor" / "model.sdf").write_text(
+        '<sdf version="1.9"><model name="sensor">' + _box_link("lens", "0 0 0.02 0 0 0")
+        + '<frame name="optical" attached_to="lens"><pose>0 0 0.01 0 0 0</pose></frame>'
+        "</model></sdf>")
+    outer = tmp_path / "outer.sdf"
+    outer.write_text(
+        '<sdf version="1.9"><model name="rig">'
+        f"<include merge='true'><uri>{MODELS / 'x500'}</uri></include>"
+        '<frame name="mount" attached_to="rotor_2"><pose relative_to="rotor_2">'
+        "0 0 0.1 0 0 0</pose></frame>"
+        "<include><uri>model://sensor</uri><name>cam</name>"
+        '<pose relative_to="mount">0.01 0 0 0 0 0</pose></include>'
+        '<link name="marker"><pose relative_to="cam::optical">0 0 0 0 0 0</pose>'
+        "<inertial><mass>0.01</mass><inertia><ixx>1e-6</ixx><iyy>1e-6</iyy><izz>1e-6</izz>"
+        "</inertia></inertial></link>"
+        '<joint name="cam_joint" type="fixed"><parent>mount</parent><child>cam</child></joint>'
+        '<joint name="marker_joint" type="fixed"><parent>cam::optical</parent>'
+        "<child>marker</child></joint></model></sdf>")
+    robot = load_robot(outer)
+    poses = link_poses(robot)
+    # rotor_2 at (0.18, 0.18, 0.055); mount 0.1 above; cam model 0.01 along x; lens 0.02
+    # above the cam frame; optical 0.01 above the lens.
+    np.testing.assert_allclose(poses["cam::lens"][:3, 3], [0.19, 0.18, 0.175], atol=1e-12)
+    np.testing.assert_allclose(poses["marker"][:3, 3], [0.19, 0.18, 0.185], atol=1e-12)
+    # Joint ends naming a frame are the link it is attached to; a model, its canonical link.
+    assert (robot.joint_map["cam_joint"].parent, robot.joint_map["cam_joint"].child) == \
+        ("rotor_2", "cam::lens")
+    assert robot.joint_map["marker_joint"].parent == "cam::lens"
+    assert not [i for i in robot.parse_issues if i.kind == "unknown-frame"]

@@ -59,6 +59,9 @@ class SourceMap:
 
     top: SourceFile
     roots: dict = field(default_factory=dict)
+    # Elements an <include> writes for the included model (<pose>, <static>): an issue
+    # with them is an issue with the inclusion, so it points at the <include> line.
+    lines: dict = field(default_factory=dict)
     tolerated: list[tuple[SourceFile, Tolerated]] = field(default_factory=list)
     unresolved: list[UnresolvedInclude] = field(default_factory=list)
 
@@ -72,6 +75,11 @@ class SourceMap:
         return self.top
 
     def line_of(self, el: etree._Element) -> int | None:
+        node = el
+        while node is not None:
+            if node in self.lines:
+                return self.lines[node]
+            node = node.getparent()
         source = self.file_of(el)
         return start_line(el.tag, el.sourceline, source.lines) if isinstance(el.tag, str) \
             else el.sourceline
@@ -109,10 +117,11 @@ def _retarget(el: etree._Element | None, attr: str, frame: str, *, if_missing: b
 
 
 def _merge_into(parent: etree._Element, include: etree._Element, model: etree._Element,
-                name: str, sources: SourceMap, including: SourceFile) -> None:
+                name: str, sources: SourceMap, including: SourceFile,
+                include_line: int | None) -> None:
     frame_name = f"_merged__{name}__model__"
     frame = etree.Element("frame", name=frame_name)
-    frame.sourceline = include.sourceline
+    sources.lines[frame] = include_line
     canonical = model.get("canonical_link") or _first_link(model)
     if canonical:
         frame.set("attached_to", canonical)
@@ -122,7 +131,6 @@ def _merge_into(parent: etree._Element, include: etree._Element, model: etree._E
         # The merged frame is posed in the including model's frame, never in attached_to.
         pose = etree.SubElement(model, "pose")
         pose.text = "0 0 0 0 0 0"
-        pose.sourceline = include.sourceline
         sources.roots[pose] = including
     sources.roots.setdefault(pose, sources.file_of(pose))
     if pose.get("relative_to") is None and pose.get("frame") is None:
@@ -137,7 +145,7 @@ def _merge_into(parent: etree._Element, include: etree._Element, model: etree._E
             if child_pose is None:
                 child_pose = etree.SubElement(child, "pose", relative_to=frame_name)
                 child_pose.text = "0 0 0 0 0 0"
-                child_pose.sourceline = child.sourceline
+                sources.lines[child_pose] = sources.line_of(child)
             elif child_pose.get("frame") is None:
                 _retarget(child_pose, "relative_to", frame_name, if_missing=True)
         elif child.tag == "frame":
@@ -156,7 +164,7 @@ def _merge_into(parent: etree._Element, include: etree._Element, model: etree._E
 
 
 def _apply_overrides(include: etree._Element, model: etree._Element, sources: SourceMap,
-                     including: SourceFile) -> str:
+                     including: SourceFile, include_line: int | None) -> str:
     name = (include.findtext("name") or "").strip() or model.get("name") or ""
     model.set("name", name)
     pose = include.find("pose")
@@ -165,12 +173,14 @@ def _apply_overrides(include: etree._Element, model: etree._Element, sources: So
             model.remove(old)
         model.insert(0, pose)
         sources.roots[pose] = including
+        sources.lines[pose] = include_line
     static = include.find("static")
     if static is not None:
         for old in model.findall("static"):
             model.remove(old)
         model.append(static)
         sources.roots[static] = including
+        sources.lines[static] = include_line
     for plugin in include.findall("plugin"):
         model.append(plugin)
         sources.roots[plugin] = including
@@ -224,11 +234,11 @@ def expand_includes(root: etree._Element, source: SourceFile, sources: SourceMap
             raise ReedtoolError(f"included file {path} holds no <model>", file=source.path,
                                 line=line)
         sources.roots.setdefault(model, included)
-        name = _apply_overrides(include, model, sources, source)
+        name = _apply_overrides(include, model, sources, source, line)
         if _is_true(include.get("merge")) or _is_true(include.findtext("merge")):
             if parent is None or parent.tag != "model":
                 raise ReedtoolError("<include merge=\"true\"> is only allowed inside a <model>",
                                     file=source.path, line=line)
-            _merge_into(parent, include, model, name, sources, source)
+            _merge_into(parent, include, model, name, sources, source, line)
         else:
             parent.replace(include, model)
