@@ -194,13 +194,12 @@ def test_bad_include_pose_points_at_the_include_line(tmp_path):
     assert [(Path(i.loc.file).name, i.loc.line) for i in issues] == [("outer.sdf", 3)]
 
 
-def test_merge_inside_a_world_is_refused(tmp_path):
+def test_merge_include_in_a_world_is_read_as_that_model(tmp_path):
     world = tmp_path / "w.sdf"
-    world.write_text('<sdf version="1.9"><world name="w">\n<include merge="true">'
+    world.write_text('<sdf version="1.10"><world name="w">\n<include merge="true">'
                      f"<uri>{MODELS / 'x500'}</uri></include></world></sdf>")
-    with pytest.raises(ReedtoolError) as info:
-        load_robot(world)
-    assert info.value.line == 2 and "merge" in info.value.message
+    robot = load_robot(world)
+    assert robot.name == "x500" and len(discover_rotors(robot)) == 4
 
 
 # ------------------------------------------------------------------ resource lookup

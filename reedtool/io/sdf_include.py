@@ -4,12 +4,14 @@
   `<name>` (else the included model's name), posed by the include's `<pose>` (with its
   `relative_to`), made static by its `<static>`. The model reader scopes its names
   (`camera::link`).
-* With `merge="true"` (SDF 1.9, inside a `<model>` only), the included model's links,
+* With `merge="true"` (SDF 1.9) inside a `<model>`, the included model's links,
   joints, frames, nested models and plugins are moved into the including model under
   their own names, and a frame `_merged__NAME__model__` takes the place of the included
   model's frame: it carries the include's pose and is attached to the included model's
   canonical link, and every pose, `attached_to` and `expressed_in` that meant the
   included `__model__` (explicitly or by default) now names it.
+* A merge-include directly in a `<world>` (an SDF 1.10 draft amendment) is read as a plain
+  include: the model is checked on its own, which is what matters for validation.
 * Includes are expanded innermost first; a file already on the include chain is a cycle
   and refused with the chain.
 
@@ -235,10 +237,8 @@ def expand_includes(root: etree._Element, source: SourceFile, sources: SourceMap
                                 line=line)
         sources.roots.setdefault(model, included)
         name = _apply_overrides(include, model, sources, source, line)
-        if _is_true(include.get("merge")) or _is_true(include.findtext("merge")):
-            if parent is None or parent.tag != "model":
-                raise ReedtoolError("<include merge=\"true\"> is only allowed inside a <model>",
-                                    file=source.path, line=line)
+        merge = _is_true(include.get("merge")) or _is_true(include.findtext("merge"))
+        if merge and parent is not None and parent.tag == "model":
             _merge_into(parent, include, model, name, sources, source, line)
         else:
             parent.replace(include, model)
