@@ -319,3 +319,13 @@ def test_frames_and_relative_to_through_included_models(tmp_path):
         ("rotor_2", "cam::lens")
     assert robot.joint_map["marker_joint"].parent == "cam::lens"
     assert not [i for i in robot.parse_issues if i.kind == "unknown-frame"]
+
+
+def test_world_includes_reedtool_cannot_fetch_are_skipped_unless_asked_for():
+    world = WORLDS / "several_models.sdf"
+    sun_line = next(n for n, line in enumerate(world.read_text().splitlines(), 1)
+                    if "<include>" in line)
+    with pytest.raises(ReedtoolError) as info:
+        load_robot(world, package_paths=[MODELS], model_name="Sun")
+    assert (Path(info.value.file).name, info.value.line) == ("several_models.sdf", sun_line)
+    assert "Fuel" in info.value.message
