@@ -204,3 +204,75 @@ def test_omni_without_reversible_and_spread_is_not_omni(tmp_path):
     rotors = discover_rotors(load_robot(path))
     # Axes still span every direction (cube corners, tangential lean): omnidirectional.
     assert is_omnidirectional(rotors) and not any(r.reversible for r in rotors)
+
+
+# ------------------------------------------------------------- odd inputs
+
+ODD_EDITS = [
+    ("<multiplier>838</multiplier>", "<multiplier>fast</multiplier>"),
+    ('<control channel="1">', '<control channel="one">'),
+    ("<cp>0.084 0 0</cp>", "<cp>0.084 0</cp>"),
+    ("<forward>0 1 0</forward>", "<forward>0 0 0</forward>"),
+    ("<upward>0 0 1</upward>", "<upward>nan nan nan</upward>"),
+    ("<a0>0.3</a0>", "<a0>x</a0>"),
+    ("<jointName>rotor_1_joint</jointName>", ""),
+    ("<jointName>rotor_1_joint</jointName>", "<jointName>nope</jointName>"),
+    ("<type>VELOCITY</type>", "<type>weird</type>"),
+    ("<offset>0</offset>", "<offset>-1</offset>"),
+    ("<link_name>rotor_0</link_name>", "<link_name>missing</link_name>"),
+    ('<control channel="0">', '<control channel="0"><rotorVelocitySlowdownSim>0'
+                              '</rotorVelocitySlowdownSim>'),
+]
+
+
+@pytest.mark.parametrize("old,new", ODD_EDITS, ids=[e[1][:30] or "removed" for e in ODD_EDITS])
+def test_odd_ardupilot_input_never_raises(tmp_path, old, new):
+    text = (FIXTURES / "ardupilot/iris_lift_drag.sdf").read_text()
+    assert old in text
+    path = tmp_path / "odd.sdf"
+    path.write_text(text.replace(old, new))
+    robot = load_robot(path)
+    rotors = discover_rotors(robot)
+    assert 3 <= len(rotors) <= 4
+    run_checks(robot)
+
+
+def test_missing_ardupilot_joint_is_reported(tmp_path):
+    text = (FIXTURES / "ardupilot/iris_lift_drag.sdf").read_text()
+    path = tmp_path / "odd.sdf"
+    path.write_text(text.replace("<jointName>rotor_1_joint</jointName>",
+                                 "<jointName>rotor_9_joint</jointName>"))
+    codes = [f.code for f in run_checks(load_robot(path)) if f.severity == "error"]
+    assert codes == ["R314"]
+
+
+def test_scoped_ardupilot_names_resolve(tmp_path):
+    """Classic models write `iris::rotor_0_joint` / `iris::rotor_0`; Gazebo resolves them."""
+    text = (FIXTURES / "ardupilot/iris_lift_drag.sdf").read_text()
+    for i in range(4):
+        text = text.replace(f"<jointName>rotor_{i}_joint</jointName>",
+                            f"<jointName>iris::rotor_{i}_joint</jointName>")
+        text = text.replace(f"<link_name>rotor_{i}</link_name>",
+                            f"<link_name>iris::rotor_{i}</link_name>")
+    path = tmp_path / "scoped.sdf"
+    path.write_text(text)
+    robot = load_robot(path)
+    rotors = discover_rotors(robot)
+    assert [r.joint for r in rotors] == [f"rotor_{i}_joint" for i in range(4)]
+    assert all(len(r.blades) == 2 for r in rotors)
+    assert [f.code for f in run_checks(robot) if f.severity != "info"] == []
+
+
+@pytest.mark.parametrize("old,new", [
+    ("<reversible>true</reversible>", "<reversible>maybe</reversible>"),
+    ("<actuator_number>3</actuator_number>", "<actuator_number>three</actuator_number>"),
+    ("<motorType>velocity</motorType>", "<motorType>POSITION</motorType>"),
+])
+def test_odd_gz_input_never_raises(tmp_path, old, new):
+    for fixture in ("omni/omni_reversible.sdf", "vtol/vtol_pusher.sdf"):
+        text = (FIXTURES / fixture).read_text()
+        path = tmp_path / "odd.sdf"
+        path.write_text(text.replace(old, new))
+        robot = load_robot(path)
+        discover_rotors(robot)
+        run_checks(robot)

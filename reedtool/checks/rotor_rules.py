@@ -91,6 +91,13 @@ def _direction_loc(rotor: "Rotor"):
 
 # --------------------------------------------------------------- plugin wiring
 
+def _number_or_nan(text: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        return math.nan
+
+
 def _number_what(rotor: "Rotor") -> str:
     return {"actuator_number": "actuator_number", "channel": "channel"}.get(
         rotor.number_tag, "motor number")
@@ -160,7 +167,8 @@ def rotor_direction_invalid(ctx: CheckContext) -> Iterator[Issue]:
     """
     for rotor in _rotors(ctx):
         if rotor.kind == "ardupilot":
-            if rotor.turning_sign == 0:
+            multiplier = _number_or_nan(rotor.param("multiplier") or "1")
+            if not (math.isfinite(multiplier) and multiplier != 0):
                 yield Issue(f"rotor '{rotor.name}': <multiplier> '{rotor.param('multiplier')}' "
                             "gives no spin direction", _direction_loc(rotor), rotor.name,
                             hint="a positive multiplier spins the joint along its axis, a "

@@ -214,7 +214,7 @@ def discover_rotors(robot: Robot) -> list[Rotor]:
             if rotor is not None:
                 rotors.append(rotor)
         elif is_ardupilot_plugin(plugin):
-            rotors.extend(_ardupilot_rotors(robot, plugin, poses, blades, len(rotors)))
+            rotors.extend(_ardupilot_rotors(robot, plugin, poses, blades))
     assign_roles(rotors, has_wing=_has_wing(robot, rotors, blades))
     return rotors
 
@@ -273,12 +273,14 @@ def _blades_by_link(robot: Robot) -> dict[str, list[Blade]]:
     return out
 
 
-def _ardupilot_rotors(robot: Robot, plugin: Plugin, poses, blades, index: int) -> list[Rotor]:
+def _ardupilot_rotors(robot: Robot, plugin: Plugin, poses, blades) -> list[Rotor]:
     """The VELOCITY controls of an ArduPilotPlugin that spin a rotor."""
     out = []
     controls = plugin.node.findall("control") or plugin.node.findall("rotor")
     for order, control in enumerate(controls):
-        control_type = (control.findtext("type") or "VELOCITY").strip().upper()
+        control_type = (control.findtext("type") or "VELOCITY").strip()
+        if control_type not in ("POSITION", "EFFORT", "COMMAND"):
+            control_type = "VELOCITY"  # the plugin's default, also for a type it does not know
         if control_type != "VELOCITY":
             continue  # POSITION/EFFORT/COMMAND: a servo or a relayed command
         channel_text = control.attrib.get("channel", control.attrib.get("id"))
@@ -288,20 +290,28 @@ def _ardupilot_rotors(robot: Robot, plugin: Plugin, poses, blades, index: int) -
         link = joint.child if joint is not None else None
         link_blades = blades.get(link or "", [])
         T_base_link = poses.get(link or "")
-        axis_link = _unit(np.asarray(joint.axis, dtype=float)) if joint is not None             else np.full(3, math.nan)
-        if not link_blades and not _vertical(T_base_link, axis_link):
+        axis_link = _unit(np.asarray(joint.axis, dtype=float)) if joint is not None \
+            else np.full(3, math.nan)
+        if joint is not None and not link_blades and not _vertical(T_base_link, axis_link):
             continue  # a wheel or another spinning joint: no blades, not a lift axis
-        thrust_link = _unit(np.mean([b.upward for b in link_blades], axis=0)) if link_blades             else np.array([0.0, 0.0, 1.0])
+        thrust_link = _unit(np.mean([b.upward for b in link_blades], axis=0)) if link_blades \
+            else np.array([0.0, 0.0, 1.0])
+        if not np.all(np.isfinite(thrust_link)):
+            thrust_link = np.array([0.0, 0.0, 1.0])  # blades without a usable <upward>
         if T_base_link is None:
             position, axis = np.full(3, math.nan), np.full(3, math.nan)
         else:
             position, axis = T_base_link[:3, 3].copy(), T_base_link[:3, :3] @ thrust_link
-        multiplier = _float(control.findtext("multiplier"))             if control.find("multiplier") is not None else 1.0  # the plugin's default
+        multiplier = _float(control.findtext("multiplier")) \
+            if control.find("multiplier") is not None else 1.0  # the plugin's default
         along = float(np.dot(axis_link, thrust_link))
-        sign = int(np.sign(multiplier) * np.sign(along)) if np.isfinite(multiplier)             and np.isfinite(along) else 0
+        sign = int(np.sign(multiplier) * np.sign(along)) if math.isfinite(multiplier) \
+            and math.isfinite(along) else 0
         offset = _float(control.findtext("offset")) if control.find("offset") is not None else 0.0
         slowdown = _float(control.findtext("rotorVelocitySlowdownSim")
-                          or control.findtext("controlVelocitySlowdownSim") or "1") or 1.0
+                          or control.findtext("controlVelocitySlowdownSim") or "1")
+        if not (math.isfinite(slowdown) and slowdown > 0):
+            slowdown = 1.0  # the plugin ignores a zero slowdown too
         # Commands arrive normalised to [0, 1]; the joint target is multiplier*(cmd+offset).
         omega_max = abs(multiplier) * max(abs(offset), abs(1.0 + offset)) / slowdown
         k_f, k_m, blade_sign = lift_drag_constants(link_blades, axis_link, thrust_link)
@@ -317,7 +327,6 @@ def _ardupilot_rotors(robot: Robot, plugin: Plugin, poses, blades, index: int) -
             loc=control.loc, node=control, number_tag="channel", direction_tag="multiplier",
             channel=channel, constants_estimated=bool(link_blades), blades=link_blades,
             blade_turning_sign=blade_sign))
-        index += 1
     return out
 
 
@@ -349,10 +358,10 @@ def lift_drag_constants(blades: list[Blade], spin_axis: np.ndarray,
     for blade in blades:
         tangent = np.cross(spin_axis, blade.cp_m)       # velocity direction of +spin
         r_m = float(np.linalg.norm(tangent))
-        forward = _unit(blade.forward)
-        if r_m == 0 or not np.all(np.isfinite(forward)):
+        along_forward = float(np.dot(tangent, _unit(blade.forward)))
+        if not (math.isfinite(r_m) and r_m > 0 and math.isfinite(along_forward)):
             return math.nan, math.nan, 0
-        signs.add(int(np.sign(np.dot(tangent, forward))))
+        signs.add(int(np.sign(along_forward)))
         alpha = blade.a0_rad
         cl = blade.cla * alpha if abs(alpha) <= blade.alpha_stall_rad else math.nan
         q_per_w2 = 0.5 * blade.air_density_kg_m3 * r_m ** 2 * blade.area_m2
@@ -360,7 +369,7 @@ def lift_drag_constants(blades: list[Blade], spin_axis: np.ndarray,
         k_drag += q_per_w2 * abs(blade.cda * alpha) * r_m
     about_joint = signs.pop() if len(signs) == 1 else 0
     along = float(np.dot(spin_axis, thrust_axis))
-    sign = int(about_joint * np.sign(along)) if np.isfinite(along) else 0
+    sign = int(about_joint * np.sign(along)) if math.isfinite(along) else 0
     return k_f, (k_drag / k_f if k_f > 0 else math.nan), sign
 
 
