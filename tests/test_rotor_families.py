@@ -276,3 +276,14 @@ def test_odd_gz_input_never_raises(tmp_path, old, new):
         robot = load_robot(path)
         discover_rotors(robot)
         run_checks(robot)
+
+
+def test_hover_test_refuses_ardupilot_rotors_in_one_line(capsys):
+    from reedtool.cli import main
+
+    with pytest.raises(SystemExit) as info:
+        main(["hover-test", str(FIXTURES / "ardupilot/iris_lift_drag.sdf")])
+    err = capsys.readouterr().err
+    assert info.value.code == 2
+    assert "ArduPilotPlugin rotors have no motor time constants" in err
+    assert "Traceback" not in err

@@ -170,6 +170,13 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
         report["message"] = f"no hover trim: {trim.message}"
         return report
 
+    estimated = [r for r in rotors if r.kind == "ardupilot"]
+    if estimated:
+        loc = estimated[0].loc
+        raise ReedtoolError(
+            f"rotor {estimated[0].name}: ArduPilotPlugin rotors have no motor time constants, "
+            "and hover-test simulates the motor response", file=loc.file, line=loc.line,
+            hint="`reedtool validate` checks their hover trim from the LiftDrag estimate")
     check_rotor_dynamics(rotors)
     if props.mass_kg <= 0 or not np.all(np.linalg.eigvalsh(props.inertia_kg_m2) > 0):
         raise ReedtoolError("the whole-robot inertia is not positive definite, nothing can "
