@@ -148,6 +148,9 @@ def test_vtol_hover_test_uses_lift_rotors(capsys):
         main(["hover-test", str(FIXTURES / "vtol/vtol_pusher.sdf"), "--format", "json"])
     report = json.loads(capsys.readouterr().out)
     assert info.value.code == 0 and report["passed"] is True
+    table = report["model"]["rotor_table"]
+    assert [(r["name"], r["role"]) for r in table][-1] == ("rotor_puller", "propulsion")
+    assert [r["role"] for r in table[:4]] == ["lift"] * 4
     trim = report["trim"]
     assert trim["feasible"] and len(trim["rotors"]) == 4
     # Symmetric quad about the COM: each rotor carries a quarter of the weight.

@@ -415,6 +415,23 @@ def _has_wing(robot: Robot, rotors: list[Rotor], blades: dict[str, list[Blade]])
     return any(link not in rotor_links for link in blades)
 
 
+def rotor_table(rotors: list[Rotor]) -> list[dict]:
+    """Every rotor as a JSON-ready row: number, role, geometry, constants (and whether
+    they are estimated), in discovery order."""
+    def number(v):
+        return float(v) if math.isfinite(v) else None
+
+    return [{"name": r.name, "kind": r.kind, "role": r.role, "motor_number": r.motor_number,
+             "number_from": r.number_tag, "channel": r.channel, "direction": r.direction,
+             "reversible": r.reversible,
+             "position_m": [number(v) for v in r.position_m],
+             "axis": [number(v) for v in r.axis],
+             "motor_constant": number(r.motor_constant),
+             "moment_constant": number(r.moment_constant),
+             "max_rot_velocity_rad_s": number(r.max_rot_velocity_rad_s),
+             "constants_estimated": r.constants_estimated} for r in rotors]
+
+
 def declared_rotor_counts(robot: Robot) -> list[RotorCountDeclaration]:
     """Rotor counts declared by MAVLink/PX4 interface plugins.
 
