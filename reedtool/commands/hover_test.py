@@ -148,19 +148,21 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
     import numpy as np
 
     from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
-    from reedtool.physics.rotors import discover_rotors
+    from reedtool.physics.rotors import discover_rotors, lift_rotors, rotor_table
     from reedtool.physics.trim import solve_trim
     from reedtool.sim import ExitStatus
     from reedtool.sim.params import VehicleParams, check_rotor_dynamics
 
-    rotors = discover_rotors(robot)
+    # Hover is held by the lift rotors: a VTOL's pusher or a plane's puller stays off.
+    every_rotor = discover_rotors(robot)
+    rotors = lift_rotors(every_rotor)
     props = whole_robot_pinocchio(robot)
     trim = solve_trim(props.mass_kg, props.com_m, rotors)
     report: dict = {
         "model": {"name": robot.name, "file": str(robot.source_file or ""),
                   "mass_kg": props.mass_kg, "com_m": [float(v) for v in props.com_m],
                   "inertia_kg_m2": [[float(v) for v in row] for row in props.inertia_kg_m2],
-                  "rotors": len(rotors)},
+                  "rotors": len(rotors), "rotor_table": rotor_table(every_rotor)},
         "trim": trim.to_dict(),
         "sim": None,
         "batch": None,
@@ -172,6 +174,13 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
         report["message"] = f"no hover trim: {trim.message}"
         return report
 
+    estimated = [r for r in rotors if r.kind == "ardupilot"]
+    if estimated:
+        loc = estimated[0].loc
+        raise ReedtoolError(
+            f"rotor {estimated[0].name}: ArduPilotPlugin rotors have no motor time constants, "
+            "and hover-test simulates the motor response", file=loc.file, line=loc.line,
+            hint="`reedtool validate` checks their hover trim from the LiftDrag estimate")
     check_rotor_dynamics(rotors)
     if props.mass_kg <= 0 or not np.all(np.linalg.eigvalsh(props.inertia_kg_m2) > 0):
         raise ReedtoolError("the whole-robot inertia is not positive definite, nothing can "
@@ -214,6 +223,10 @@ def render_text(report: dict) -> str:
     model, trim, sim, batch = report["model"], report["trim"], report["sim"], report["batch"]
     lines = [f"hover-test {model['name']}: {model['rotors']} rotors, "
              f"mass {model['mass_kg']:.4g} kg, COM ({', '.join(f'{v:.4g}' for v in model['com_m'])}) m"]
+    others = [r for r in model.get("rotor_table", ()) if r["role"] != "lift"]
+    if others:
+        lines.append("not used for hover: " + ", ".join(f"{r['name']} ({r['role']})"
+                                                         for r in others))
     if trim["feasible"]:
         lines.append(f"trim: {trim['message']}")
     else:
