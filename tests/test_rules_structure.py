@@ -38,7 +38,7 @@ CASES = [
     ("S116_bad_zero_size.urdf", ["S116"]),
     ("S117_bad_no_inertial.urdf", ["S117"]),
     # 1e-7 kg with the 0.5 kg link's inertia is also implausible for its geometry.
-    ("S117_bad_tiny_mass.urdf", ["I204", "S117"]),
+    ("S117_bad_tiny_mass.urdf", ["I209", "S117"]),
     ("S118_bad_merged_link.urdf", ["S118"]),
     # Good fixtures: the arm has a zero-mass fixed tool frame (fine), a plugin on a fixed
     # link kept by preserveFixedJoint, a limited revolute joint; the car a mesh in metres.

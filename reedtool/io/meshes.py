@@ -1,11 +1,12 @@
 """Any mesh file as triangles, refused when nothing sensible can be computed from it.
 
-STL is read here; other formats go through trimesh.
+STL, COLLADA and OBJ are read here with light readers (numpy, lxml): `validate` needs their
+extents and units and must not pay for trimesh/scipy. Other formats go through trimesh.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -13,14 +14,50 @@ import numpy as np
 from reedtool.errors import ReedtoolError
 from reedtool.io.stl import read_stl
 
+# What each simulator's mesh loader reads (gazebo classic: common::MeshManager; gz-sim:
+# gz-common's MeshManager, which adds glTF/GLB and FBX through assimp).
+CLASSIC_MESH_SUFFIXES = (".stl", ".dae", ".obj")
+GZ_MESH_SUFFIXES = CLASSIC_MESH_SUFFIXES + (".glb", ".gltf", ".fbx")
+LIGHT_SUFFIXES = (".stl", ".dae", ".obj")
+
+
+@dataclass
+class MeshFile:
+    triangles: np.ndarray           # (n, 3, 3) in the file's units
+    metres_per_unit: float          # what Gazebo multiplies them by (COLLADA <unit>), else 1
+    format: str                     # stl-binary | stl-ascii | dae | obj | other
+    unit_declared: bool = False     # the file states its unit (COLLADA)
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def triangles_m(self) -> np.ndarray:
+        return self.triangles * self.metres_per_unit if self.metres_per_unit != 1.0 \
+            else self.triangles
+
+
+def read_mesh(path: str | Path) -> MeshFile:
+    """A mesh file as Gazebo reads it, without the `<mesh scale>`; unreadable -> ReedtoolError."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".stl":
+        stl = read_stl(path)
+        return MeshFile(stl.triangles, 1.0, f"stl-{stl.format}", notes=list(stl.notes))
+    if suffix == ".dae":
+        from reedtool.io.dae import read_dae
+
+        dae = read_dae(path)
+        return MeshFile(dae.triangles, dae.metres_per_unit, "dae", dae.unit_declared, dae.notes)
+    if suffix == ".obj":
+        from reedtool.io.obj import read_obj
+
+        return MeshFile(read_obj(path), 1.0, "obj")
+    return MeshFile(_load_with_trimesh(path), 1.0, "other")
+
 
 def load_triangles(path: str | Path) -> np.ndarray:
-    """Any mesh file as (n, 3, 3) triangles in its own units: STL here, others via trimesh."""
-    path = Path(path)
-    if path.suffix.lower() == ".stl":
-        triangles = read_stl(path).triangles
-    else:
-        triangles = _load_with_trimesh(path)
+    """Any mesh file as (n, 3, 3) triangles in metres as Gazebo reads it (COLLADA <unit>
+    applied, `<mesh scale>` not), checked for content mass properties can be computed from."""
+    triangles = read_mesh(path).triangles_m
     check_triangles(triangles, path)
     return triangles
 
