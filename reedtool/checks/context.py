@@ -148,6 +148,21 @@ class CheckContext:
         return solve_trim(whole.mass_kg, whole.com_m, self.rotors)
 
     @cached_property
+    def simulator(self) -> str:
+        """"classic" when the model's plugins are Gazebo classic ones (lib*.so: gazebo_ros,
+        RotorS, PX4 classic) and none is a gz-sim system; else "gz" (the more permissive
+        mesh loader, so an undecided model is not held to classic's formats)."""
+        classic = False
+        for _block, plugin in self.robot.plugins():
+            text = f"{plugin.filename or ''} {plugin.name or ''}".lower()
+            if any(mark in text for mark in ("gz-sim", "gz::sim", "ignition-gazebo",
+                                             "ignition::gazebo", "gz_sim", "ign_gazebo")):
+                return "gz"
+            filename = (plugin.filename or "").rsplit("/", 1)[-1]
+            classic = classic or (filename.startswith("lib") and filename.endswith(".so"))
+        return "classic" if classic else "gz"
+
+    @cached_property
     def link_comparisons(self) -> list:
         """physics.inertia.compare_links: one verdict per link (parallel to robot.links),
         the same `reedtool inertia` prints."""
@@ -187,9 +202,10 @@ class CheckContext:
         key = str(mesh.path)
         if key not in self._mesh_files:
             from reedtool.errors import ReedtoolError
-            from reedtool.io.meshes import LIGHT_SUFFIXES, read_mesh
+            from reedtool.io.meshes import LIGHT_SUFFIXES, read_mesh, uri_problem
 
-            if mesh.path.suffix.lower() not in LIGHT_SUFFIXES or not mesh.path.is_file():
+            if mesh.path.suffix.lower() not in LIGHT_SUFFIXES or not mesh.path.is_file() \
+                    or uri_problem(mesh.uri, mesh.path):
                 self._mesh_files[key] = None   # only the light readers run in validate
             else:
                 try:

@@ -116,3 +116,59 @@ def check_triangles(triangles: np.ndarray, source: str | Path) -> MeshCheck:
                             file=source, hint="a flat surface has no volume, so no mass "
                                               "properties; export the solid body")
     return MeshCheck(len(triangles), zero_area, total_area, extent)
+
+
+# ------------------------------------------------------------ mesh references
+
+# Where no model's mesh belongs: reading them is a leak (a model shared as a package that
+# makes the simulator open /etc/passwd), and they hold no mesh anyway.
+SYSTEM_DIRS = ("/etc", "/proc", "/sys", "/dev", "/boot", "/root", "/var", "/run",
+               "/bin", "/sbin", "/usr/bin", "/usr/sbin", "/lib", "/usr/lib")
+
+
+def uri_problem(uri: str, path: Path | None = None) -> str | None:
+    """Why a mesh reference must not be followed, or None.
+
+    A `package://` or `model://` path that climbs out of its package with `..`, and any
+    reference (`file://`, absolute, or what a package path resolves to) inside a system
+    directory.
+    """
+    import posixpath
+    from urllib.parse import unquote, urlparse
+
+    text = unquote(uri.strip())
+    for scheme in ("package://", "model://"):
+        if text.startswith(scheme):
+            _name, _, rel = text[len(scheme):].partition("/")
+            normal = posixpath.normpath(rel) if rel else ""
+            if normal == ".." or normal.startswith("../") or rel.startswith("/"):
+                return f"the path climbs out of its package ('{rel}')"
+    if text.startswith("file://"):
+        text = urlparse(text).path
+    candidates = [posixpath.normpath(text)] if text.startswith("/") else []
+    if path is not None:
+        candidates.append(posixpath.normpath(str(path)))
+    for candidate in candidates:
+        for system in SYSTEM_DIRS:
+            if candidate == system or candidate.startswith(system + "/"):
+                return f"it points into the system directory {system}"
+    return None
+
+
+def format_problem(uri: str, simulator: str) -> str | None:
+    """Why Gazebo cannot load this mesh file format, or None.
+
+    `simulator`: "classic" (STL, COLLADA, OBJ) or "gz" (also glTF/GLB and FBX).
+    """
+    name = uri.rsplit("/", 1)[-1]
+    suffix = Path(name).suffix.lower()
+    allowed = GZ_MESH_SUFFIXES if simulator == "gz" else CLASSIC_MESH_SUFFIXES
+    if suffix in allowed:
+        return None
+    which = "gz-sim" if simulator == "gz" else "Gazebo classic"
+    if not suffix:
+        return f"'{name}' has no file extension; {which} picks its mesh loader by extension"
+    if suffix in GZ_MESH_SUFFIXES:
+        return f"{which} does not load {suffix} meshes (gz-sim does)"
+    return (f"{which} does not load {suffix} files (it loads "
+            f"{', '.join(s.lstrip('.').upper() for s in allowed)})")
