@@ -532,13 +532,20 @@ def compare_link(link: Link, *, moving: bool = False,
                                  f"A + B < C principal moments); the {label}{hull} gives one",
                       *args)
     if rel > OK_REL_DIFF and slowdown and _plausible(ratio / slowdown):
-        return result("slowdown-scaled", f"declared inertia is {_times(ratio)} the {label}'s: "
-                                         f"the rotor's rotorVelocitySlowdownSim {slowdown:g} "
-                                         "times it (RotorS convention, not a mistake)", *args)
-    if not _plausible(ratio, ORDERS_OFF_TRACE_RATIO):
+        return result("slowdown-scaled", f"declared inertia is {_times(ratio)} the {label}'s, "
+                                         "plausible once divided by the motor's "
+                                         f"rotorVelocitySlowdownSim {slowdown:g} (RotorS "
+                                         "convention, not a mistake)", *args)
+    # A rotor with a slowdown is expected anywhere between its geometry and s times it:
+    # judge it against whichever of the two it is closer to.
+    judged = ratio
+    if slowdown and np.isfinite(ratio) and ratio > 0 \
+            and abs(math.log(ratio / slowdown)) < abs(math.log(ratio)):
+        judged = ratio / slowdown
+    if not _plausible(judged, ORDERS_OFF_TRACE_RATIO):
         return result("way-off", f"declared inertia is {_times(ratio)} the {label}'s{hull}",
                       *args)
-    if not _plausible(ratio, PLAUSIBLE_TRACE_RATIO):
+    if not _plausible(judged, PLAUSIBLE_TRACE_RATIO):
         return result("implausible", f"declared inertia is {_times(ratio)} the {label}'s{hull}",
                       *args)
     if rel > OK_REL_DIFF:
