@@ -110,3 +110,19 @@ def test_validate_never_imports_trimesh_or_scipy(tmp_path):
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           cwd=ROOT, env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
     assert done.stdout.strip().splitlines()[-2:] == ["exit 0", "[]"], done.stdout + done.stderr
+
+
+def test_import_honours_the_dae_unit_and_guesses_only_without_one(tmp_path):
+    from reedtool.physics.mesh_import import import_mesh
+
+    # 300 x 200 x 100 with meter="0.01": centimetres declared, so 3 m x 2 m x 1 m, even
+    # though a guess from the size alone would call 300 units millimetres.
+    declared = import_mesh(write_dae(tmp_path / "cm.dae", box_triangles((300, 200, 100)),
+                                     meter=0.01), units="auto")
+    assert (declared.units.unit, declared.units.guessed) == ("cm", False)
+    assert declared.size_m == pytest.approx([3.0, 2.0, 1.0])
+    assert declared.mass.volume_m3 == pytest.approx(6.0)
+    unitless = import_mesh(write_obj(tmp_path / "mm.obj", box_triangles((300, 200, 100))),
+                           units="auto")
+    assert (unitless.units.unit, unitless.units.guessed) == ("mm", True)
+    assert unitless.size_m == pytest.approx([0.3, 0.2, 0.1])
