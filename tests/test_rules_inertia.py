@@ -17,6 +17,8 @@ CASES = [
     ("I202_bad_products.urdf", ["I202"]),
     ("I203_bad_triangle.urdf", ["I203"]),
     ("I204_bad_twenty_times.urdf", ["I204"]),
+    ("I206_bad_large_mat.urdf", ["I206"]),
+    ("I207_bad_zero_total_mass.urdf", ["I207"]),
     ("I208_bad_massless_inertia.urdf", ["I208"]),
     ("I209_bad_placeholder.urdf", ["I209"]),
     ("I209_bad_too_small.urdf", ["I209"]),
