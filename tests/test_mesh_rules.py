@@ -216,3 +216,36 @@ def test_seed_001_inertias_exit_1_from_validate_and_inertia():
     assert {w for w in wheels if w.endswith("_wheel")} == {
         "left_front_wheel", "right_front_wheel", "left_back_wheel", "right_back_wheel"}
     assert run_cli("inertia", SMARTCAR)[0] == 1
+
+
+def test_workspace_dirs_are_not_system_dirs():
+    from reedtool.io.meshes import uri_problem
+
+    for uri in ("file:///root/ws/src/pkg/meshes/a.stl", "/var/lib/jenkins/ws/meshes/a.dae",
+                "file:///opt/ros/noetic/share/pkg/meshes/a.dae", "/usr/share/pkg/a.obj"):
+        assert uri_problem(uri) is None, uri
+    assert uri_problem("file:///etc/../etc/passwd") is not None
+    assert uri_problem("package://pkg/meshes/a.stl", Path("/etc/passwd")) is not None
+
+
+def test_x500_shaped_sdf_two_visuals_one_mesh(tmp_path):
+    """PX4 x500_base: base_link with two visuals naming the same COLLADA file (in mm with
+    its unit), SDF with gz-sim systems; quiet, no crash."""
+    write_dae(tmp_path / "base.dae", box_triangles((470, 470, 120)), meter=0.001)
+    ixx = 2.0 * (0.47 ** 2 + 0.12 ** 2) / 12
+    izz = 2.0 * (0.47 ** 2 + 0.47 ** 2) / 12
+    (tmp_path / "model.sdf").write_text(f"""<?xml version="1.0"?>
+<sdf version="1.9"><model name="x500_like">
+  <link name="base_link">
+    <inertial><mass>2.0</mass><inertia><ixx>{ixx}</ixx><iyy>{ixx}</iyy><izz>{izz}</izz>
+      <ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>
+    <visual name="body"><geometry><mesh><uri>base.dae</uri><scale>1 1 1</scale></mesh></geometry></visual>
+    <visual name="body_shadow"><pose>0 0 0.001 0 0 0</pose>
+      <geometry><mesh><uri>base.dae</uri><scale>1 1 1</scale></mesh></geometry></visual>
+    <collision name="c"><geometry><box><size>0.47 0.47 0.12</size></box></geometry></collision>
+  </link>
+  <plugin filename="gz-sim-joint-state-publisher-system"
+          name="gz::sim::systems::JointStatePublisher"/>
+</model></sdf>
+""")
+    assert codes(tmp_path / "model.sdf") == []

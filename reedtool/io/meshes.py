@@ -121,9 +121,10 @@ def check_triangles(triangles: np.ndarray, source: str | Path) -> MeshCheck:
 # ------------------------------------------------------------ mesh references
 
 # Where no model's mesh belongs: reading them is a leak (a model shared as a package that
-# makes the simulator open /etc/passwd), and they hold no mesh anyway.
-SYSTEM_DIRS = ("/etc", "/proc", "/sys", "/dev", "/boot", "/root", "/var", "/run",
-               "/bin", "/sbin", "/usr/bin", "/usr/sbin", "/lib", "/usr/lib")
+# makes the simulator open /etc/passwd), and they hold no mesh anyway. Deliberately short:
+# workspaces do live under /root, /var/lib/jenkins, /opt or /usr/share.
+SYSTEM_DIRS = ("/etc", "/proc", "/sys", "/dev", "/boot", "/bin", "/sbin", "/usr/bin",
+               "/usr/sbin")
 
 
 def uri_problem(uri: str, path: Path | None = None) -> str | None:
