@@ -4,7 +4,10 @@
 
 Each figure is the median of N end-to-end process runs (interpreter start included), the
 way a user or CI meets them. Targets (issue 3): validate within 3x of check_urdf on the
-same expanded URDF; `reedtool --help` under 0.15 s.
+same expanded URDF; `reedtool --help` under 0.15 s. Issue 10: on a RotorS-style
+hexacopter with resolvable COLLADA meshes (benchmarks/rotors_hexa_case.py), `reedtool
+validate` on the xacro within 1.0x of the `xacro` + `check_urdf` pipeline on the same file
+(reedtool also reads every .dae for its extent and unit; check_urdf reads none).
 """
 
 from __future__ import annotations
@@ -41,6 +44,46 @@ def median_s(argv: list[str], runs: int) -> float:
                        env=USER_ENV)
         times.append(time.perf_counter() - start)
     return statistics.median(times)
+
+
+def median_pipeline_s(commands: list[tuple[list[str], dict]], runs: int) -> float:
+    """Median wall time of several processes run one after the other (a shell pipeline)."""
+    def once():
+        for argv, env in commands:
+            subprocess.run(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                           check=False, env=env)
+    once()
+    times = []
+    for _ in range(runs):
+        start = time.perf_counter()
+        once()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times)
+
+
+def rotors_case(tmp: Path, runs: int, reedtool: str, check_urdf: str | None) -> None:
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from rotors_hexa_case import write_ament_index_shim, write_case
+
+    model, package_dirs = write_case(tmp)
+    shim = write_ament_index_shim(tmp, package_dirs)
+    ours_s = median_s([reedtool, "validate", str(model),
+                       *[f"--package-path={d}" for d in package_dirs]], runs)
+    print(f"\nRotorS-style hexacopter, 3 COLLADA meshes (median of {runs} runs)")
+    print(f"  reedtool validate xacro              {ours_s * 1000:7.1f} ms")
+    xacro = shutil.which("xacro", path=str(BIN)) or shutil.which("xacro")
+    if not (xacro and check_urdf):
+        print("  xacro or check_urdf not found: no comparison")
+        return
+    urdf = tmp / "bench_hexa.urdf"
+    env = {**USER_ENV, "PYTHONPATH": str(shim)}
+    # `xacro -o FILE` then check_urdf FILE: the pipeline a ROS user runs by hand.
+    base_s = median_pipeline_s([([xacro, str(model), "-o", str(urdf)], env),
+                                ([check_urdf, str(urdf)], USER_ENV)], runs)
+    ratio = ours_s / base_s
+    print(f"  xacro + check_urdf                   {base_s * 1000:7.1f} ms")
+    print(f"  reedtool / (xacro + check_urdf): {ratio:.2f}x "
+          f"(target <= 1.0x: {'ok' if ratio <= 1.0 else 'MISSED'})")
 
 
 def main() -> int:
@@ -81,6 +124,8 @@ def main() -> int:
                   f"(target <= 3x: {'ok' if ratio <= 3 else 'MISSED'})")
     else:
         print("  check_urdf not found: no comparison")
+    with tempfile.TemporaryDirectory() as tmp:
+        rotors_case(Path(tmp), runs, reedtool, check_urdf)
     return 0
 
 

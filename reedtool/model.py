@@ -48,7 +48,7 @@ UNKNOWN_LOC = SourceLoc(file="<unknown>")
 
 # ---------------------------------------------------------------- geometry
 
-@dataclass
+@dataclass(eq=False)  # identity: fields hold numpy arrays
 class Box:
     size_m: np.ndarray  # (3,) full edge lengths along x, y, z of the geometry frame
 
@@ -64,7 +64,7 @@ class Sphere:
     radius_m: float
 
 
-@dataclass
+@dataclass(eq=False)  # identity: fields hold numpy arrays
 class Mesh:
     uri: str                       # as written: package://, file://, relative or absolute
     path: Path | None              # resolved file, None when it could not be resolved
@@ -75,7 +75,7 @@ class Mesh:
 Geometry = Union[Box, Cylinder, Sphere, Mesh]
 
 
-@dataclass
+@dataclass(eq=False)  # identity: fields hold numpy arrays
 class Visual:
     geometry: Geometry | None
     T_link_geom: np.ndarray
@@ -84,7 +84,7 @@ class Visual:
     material: str | None = None
 
 
-@dataclass
+@dataclass(eq=False)  # identity: fields hold numpy arrays
 class Collision:
     geometry: Geometry | None
     T_link_geom: np.ndarray
@@ -102,7 +102,7 @@ def inertia_tensor(values: dict[str, float]) -> np.ndarray:
                      [values["ixz"], values["iyz"], values["izz"]]], dtype=float)
 
 
-@dataclass
+@dataclass(eq=False)  # identity: fields hold numpy arrays
 class Inertial:
     mass_kg: float
     T_link_com: np.ndarray         # pose of the inertial (COM) frame in the link frame
@@ -121,7 +121,7 @@ class Inertial:
         return R @ self.inertia_kg_m2 @ R.T
 
 
-@dataclass
+@dataclass(eq=False)  # identity: fields hold numpy arrays
 class Link:
     name: str
     loc: SourceLoc
@@ -152,7 +152,7 @@ class JointLimit:
     loc: SourceLoc
 
 
-@dataclass
+@dataclass(eq=False)  # identity: fields hold numpy arrays
 class Joint:
     name: str
     type: str

@@ -252,10 +252,18 @@ def test_compare_link_verdicts():
     good = box_inertia(2.0, size)
     assert compare_link(_link(2.0, good, Box(size))).verdict == "ok"
     assert compare_link(_link(2.0, good * 1.8, Box(size))).verdict == "differs"
-    assert compare_link(_link(2.0, np.eye(3), Box(size))).verdict == "way-off"
+    # trace ratio 3 / trace(box): 100x and beyond is way-off (error), 10x-100x implausible.
+    trace_box = float(np.trace(good))
+    assert compare_link(_link(2.0, np.eye(3) * 200 * trace_box / 3, Box(size))).verdict == "way-off"
+    assert compare_link(_link(2.0, good * 20, Box(size))).verdict == "implausible"
+    assert compare_link(_link(2.0, good / 200, Box(size))).verdict == "way-off"
     assert compare_link(_link(2.0, np.diag([1.0, 1.0, 3.0]), Box(size))).verdict == "invalid"
     assert compare_link(_link(2.0, good, Box(size), com=(0.5, 0, 0))).verdict == "com-off"
-    assert compare_link(_link(0.0, good, Box(size))).verdict == "massless"
+    assert compare_link(_link(0.0, good, Box(size))).verdict == "massless-inertia"
+    assert compare_link(_link(0.0, np.zeros((3, 3)), Box(size))).verdict == "massless"
+    assert compare_link(_link(0.0, np.zeros((3, 3)), Box(size)),
+                        moving=True).verdict == "massless-moving"
+    assert compare_link(_link(-1.0, good, Box(size))).verdict == "negative-mass"
     assert compare_link(_link(2.0, good)).verdict == "no-geometry"
     assert compare_link(Link("frame", LOC)).verdict == "no-inertial"
     broken = compare_link(_link(2.0, good, Mesh("package://nope/x.stl", None, resolve_error="gone")))

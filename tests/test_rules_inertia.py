@@ -16,10 +16,14 @@ CASES = [
     ("I202_bad_zero_moment.urdf", ["I202"]),
     ("I202_bad_products.urdf", ["I202"]),
     ("I203_bad_triangle.urdf", ["I203"]),
-    ("I204_bad_placeholder.urdf", ["I204"]),
-    ("I204_bad_too_small.urdf", ["I204"]),
+    ("I204_bad_twenty_times.urdf", ["I204"]),
+    ("I206_bad_large_mat.urdf", ["I206"]),
+    ("I207_bad_zero_total_mass.urdf", ["I207"]),
+    ("I208_bad_massless_inertia.urdf", ["I208"]),
+    ("I209_bad_placeholder.urdf", ["I209"]),
+    ("I209_bad_too_small.urdf", ["I209"]),
     ("I205_bad_com.urdf", ["I205"]),
-    ("I206_bad_mm_mesh.urdf", ["I206"]),
+    ("I210_bad_mm_mesh.urdf", ["I210"]),
     # Good: zero mass on a fixed frame, a thin but valid cylinder, a mesh in metres.
     ("clean_arm.urdf", []),
     ("clean_car.urdf", []),
@@ -36,7 +40,7 @@ def _attrs(text: str) -> dict[str, float]:
 
 
 def test_placeholder_hint_gives_the_cylinder_tensor():
-    (finding,) = run_checks(load_robot(FIXTURES / "I204_bad_placeholder.urdf"))
+    (finding,) = run_checks(load_robot(FIXTURES / "I209_bad_placeholder.urdf"))
     m, r, h = 0.5, 0.05, 0.3  # link1: solid cylinder along z
     expected = {"ixx": m * (3 * r * r + h * h) / 12, "iyy": m * (3 * r * r + h * h) / 12,
                 "izz": m * r * r / 2, "ixy": 0.0, "ixz": 0.0, "iyz": 0.0}
@@ -53,6 +57,6 @@ def test_triangle_threshold_is_relative_to_the_largest_moment():
 
 
 def test_mm_mesh_hint_suggests_millimetre_scale():
-    (finding,) = run_checks(load_robot(FIXTURES / "I206_bad_mm_mesh.urdf"))
+    (finding,) = run_checks(load_robot(FIXTURES / "I210_bad_mm_mesh.urdf"))
     assert 'scale="0.001 0.001 0.001"' in finding.hint
     assert "60 m" in finding.message  # the 60 mm camera read as metres

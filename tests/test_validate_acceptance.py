@@ -52,7 +52,9 @@ def test_seed_quad_rotors_are_numbered_and_turning_correctly(seed_findings):
 def test_smartcar_missing_reference_and_wheel_inertia():
     findings = run_checks(load_robot(SMARTCAR))
     assert {f.subject for f in findings if f.code == "S114"} == {"regular"}
-    wheels = [f for f in findings if f.code == "I204" and f.subject.endswith("_wheel")]
+    # 1.0 kg m^2 on 0.1 kg wheels: orders of magnitude off the geometry, an error (I209).
+    wheels = [f for f in findings if f.code == "I209" and f.subject.endswith("_wheel")]
+    assert all(f.severity == "error" for f in wheels)
     assert len(wheels) == 4
     m, r, length = 0.1, 0.025, 0.02
     transverse, axial = m * (3 * r * r + length * length) / 12, m * r * r / 2

@@ -72,6 +72,7 @@ class CheckContext:
         self._geometry_props: dict[str, Any] = {}
         self._mesh_bounds: dict[str, Any] = {}
         self._mesh_errors: dict[str, str] = {}     # path -> why it is not a usable mesh
+        self._mesh_files: dict[str, Any] = {}      # path -> MeshFile | ReedtoolError | None
 
     # ------------------------------------------------------------ structure
 
@@ -166,6 +167,29 @@ class CheckContext:
         solve = solve_trim_6dof if self.omnidirectional else solve_trim
         return solve(whole.mass_kg, whole.com_m, self.lift_rotors)
 
+    @cached_property
+    def simulator(self) -> str:
+        """"classic" when the model's plugins are Gazebo classic ones (lib*.so: gazebo_ros,
+        RotorS, PX4 classic) and none is a gz-sim system; else "gz" (the more permissive
+        mesh loader, so an undecided model is not held to classic's formats)."""
+        classic = False
+        for _block, plugin in self.robot.plugins():
+            text = f"{plugin.filename or ''} {plugin.name or ''}".lower()
+            if any(mark in text for mark in ("gz-sim", "gz::sim", "ignition-gazebo",
+                                             "ignition::gazebo", "gz_sim", "ign_gazebo")):
+                return "gz"
+            filename = (plugin.filename or "").rsplit("/", 1)[-1]
+            classic = classic or (filename.startswith("lib") and filename.endswith(".so"))
+        return "classic" if classic else "gz"
+
+    @cached_property
+    def link_comparisons(self) -> list:
+        """physics.inertia.compare_links: one verdict per link (parallel to robot.links),
+        the same `reedtool inertia` prints."""
+        from reedtool.physics.inertia import compare_links
+
+        return compare_links(self.robot)
+
     def geometry_mass_properties(self, link: Link):
         """Mass properties of the link's own geometry at its declared mass, in the link frame.
 
@@ -190,22 +214,45 @@ class CheckContext:
         self._geometry_props[link.name] = result
         return result
 
-    def mesh_error(self, mesh) -> str | None:
-        """Why a resolved STL file holds no usable mesh (empty, truncated, NaN), or None.
-
-        A flat mesh is fine here: a plane is a valid visual, it only has no volume.
-        """
+    def mesh_file(self, mesh):
+        """The resolved mesh file read once per run (reedtool.io.meshes.MeshFile), or the
+        ReedtoolError saying why it cannot be read; None when unresolved or not a file."""
         if mesh.path is None:
             return None
         key = str(mesh.path)
-        if key not in self._mesh_errors:
+        if key not in self._mesh_files:
             from reedtool.errors import ReedtoolError
+            from reedtool.io.meshes import LIGHT_SUFFIXES, read_mesh, uri_problem
+
+            if mesh.path.suffix.lower() not in LIGHT_SUFFIXES or not mesh.path.is_file() \
+                    or uri_problem(mesh.uri, mesh.path):
+                self._mesh_files[key] = None   # only the light readers run in validate
+            else:
+                try:
+                    self._mesh_files[key] = read_mesh(key)
+                except ReedtoolError as exc:
+                    self._mesh_files[key] = exc
+        return self._mesh_files[key]
+
+    def mesh_error(self, mesh) -> str | None:
+        """Why a resolved STL/DAE/OBJ file holds no usable mesh (damaged, empty, NaN), or None.
+
+        A flat mesh is fine here: a plane is a valid visual, it only has no volume.
+        """
+        from reedtool.errors import ReedtoolError
+
+        read = self.mesh_file(mesh)
+        if read is None:
+            return None
+        if isinstance(read, ReedtoolError):
+            return read.message
+        key = str(mesh.path)
+        if key not in self._mesh_errors:
             from reedtool.io.meshes import check_triangles, triangle_areas
-            from reedtool.io.stl import read_stl
 
             error = ""
+            triangles = read.triangles
             try:
-                triangles = read_stl(key).triangles
                 if len(triangles) == 0 or not np.isfinite(triangles).all() \
                         or float(triangle_areas(triangles).sum()) == 0.0:
                     check_triangles(triangles, key)   # raises with the reason
@@ -215,20 +262,19 @@ class CheckContext:
         return self._mesh_errors[key] or None
 
     def mesh_bounds(self, mesh) -> np.ndarray | None:
-        """(2, 3) min/max corners of a mesh file in its own frame, scale applied; None if unreadable."""
-        if mesh.path is None:
+        """(2, 3) min/max corners of a mesh in metres in its own frame, as Gazebo sizes it:
+        the file's unit (COLLADA <unit>) and the `<mesh scale>` applied; None if unreadable."""
+        if mesh.path is None or self.mesh_error(mesh):
             return None
         key = str(mesh.path)
         if key not in self._mesh_bounds:
-            from reedtool.errors import ReedtoolError
-            from reedtool.io.meshes import load_triangles
-
-            try:
-                vertices = load_triangles(key).reshape(-1, 3)
+            read = self.mesh_file(mesh)
+            if read is None:        # a format only trimesh reads: not measured in validate
+                bounds = None
+            else:
+                vertices = read.triangles_m.reshape(-1, 3)
                 bounds = np.vstack([vertices.min(axis=0), vertices.max(axis=0)]) \
                     if len(vertices) else None
-            except ReedtoolError:  # unreadable: S115 reports it
-                bounds = None
             self._mesh_bounds[key] = bounds
         bounds = self._mesh_bounds[key]
         if bounds is None:

@@ -15,19 +15,22 @@ from reedtool.checks.context import CheckContext
 from reedtool.checks.finding import Issue
 from reedtool.checks.registry import rule
 from reedtool.model import Box, Cylinder, Link, Mesh, Sphere
+from reedtool.physics.inertia import (
+    TRIANGLE_REL_TOL,  # noqa: F401 - re-exported: the I203 tolerance
+    robot_mass_problem,
+    tensor_problem,
+)
 
-# Principal moments may break A + B >= C by this fraction of the largest moment: hand-rounded
-# values of a thin plate (where A + B = C exactly) stay quiet, real mistakes do not.
-TRIANGLE_REL_TOL = 1e-3
-# Declared vs geometry-derived tensor trace: outside this factor the inertia is implausible.
-# A body's mass can sit at most ~3x further out than a solid of the same outline (all mass
-# in the corners), so 10x in inertia is beyond any real mass distribution.
-PLAUSIBLE_TRACE_RATIO = 10.0
 # How far outside its geometry's bounding box a COM may lie, as a fraction of the box size.
 COM_MARGIN_FRACTION = 0.1
 COM_MARGIN_MIN_M = 0.002
-# Mesh extents (after scale) outside this range are almost always a unit mistake.
+# Mesh extents (after unit and scale) outside this range are almost always a unit mistake.
 MESH_EXTENT_RANGE_M = (0.001, 20.0)
+# ... and certainly one (I210, error) this many times outside the range, or this many times
+# the robot's own size (its link spread and primitive shapes), or, when the robot gives no
+# size, when exactly one unit (mm, or m read as mm) turns it into a plausible part.
+MESH_UNIT_CERTAIN_FACTOR = 50.0
+PLAUSIBLE_PART_M = (0.01, 5.0)
 
 
 def _fmt(value: float) -> str:
@@ -67,9 +70,7 @@ def _tensor_ok(I: np.ndarray) -> bool:
 
 
 def _positive_definite(I: np.ndarray) -> bool:
-    moments = np.linalg.eigvalsh((I + I.T) / 2)
-    return bool(np.allclose(I, I.T, rtol=0, atol=1e-12 * max(np.max(np.abs(I)), 1e-300))
-                and moments[0] > 1e-12 * max(moments[2], 1e-300) and moments[0] > 0)
+    return tensor_problem(I) not in ("not-positive-definite", "non-finite")
 
 
 def _geometry_hint(ctx: CheckContext, link: Link) -> tuple[str, np.ndarray] | None:
@@ -151,7 +152,7 @@ def inertia_triangle_inequality(ctx: CheckContext) -> Iterator[Issue]:
         if not _tensor_ok(I) or not _positive_definite(I):
             continue  # I202
         a, b, c = np.linalg.eigvalsh((I + I.T) / 2)
-        if a + b < c - TRIANGLE_REL_TOL * c:
+        if tensor_problem(I) == "triangle":
             yield Issue(f"link '{link.name}': principal moments break the triangle inequality: "
                         f"{_fmt(a)} + {_fmt(b)} = {_fmt(a + b)} < {_fmt(c)} kg·m²",
                         link.inertial.inertia_loc or link.inertial.loc, link.name,
@@ -159,41 +160,97 @@ def inertia_triangle_inequality(ctx: CheckContext) -> Iterator[Issue]:
                                                        f"{_fmt(a + b)} kg·m²"))
 
 
-@rule("I204", "inertia-implausible-for-geometry", "warning",
-      "A link's inertia is far from what its own geometry and mass give.")
-def inertia_implausible_for_geometry(ctx: CheckContext) -> Iterator[Issue]:
-    """Compares the declared tensor with that of the link's geometry (first collision,
-    else first visual) filled uniformly with the declared mass, through the trace (twice
-    the mass times the squared radius of gyration). More than 10x off either way is no
-    real mass distribution: all mass in the corners of a box gives only 3x the solid
-    box's inertia. The typical cause is a placeholder `1.0` copied into every link; a
-    wheel with 1 kg·m² spins up like a flywheel a thousand times its size.
-
-    The hint gives the geometry-derived tensor in the frame of the `<inertial>`.
-    """
-    for link in ctx.robot.links:
-        if not _massive(link):
+def _trace_findings(ctx: CheckContext, verdict: str) -> Iterator[Issue]:
+    """Links whose shared verdict (physics.inertia.compare_link) is `verdict`."""
+    for link, comparison in zip(ctx.robot.links, ctx.link_comparisons):
+        if comparison.verdict != verdict or not _massive(link):
             continue
-        I = np.asarray(link.inertial.inertia_kg_m2, dtype=float)
-        if not _tensor_ok(I) or not _positive_definite(I):
-            continue
+        if _mesh_extent_implausible(ctx, link):
+            continue  # I206/I210 explain a mis-scaled mesh better
         found = _geometry_hint(ctx, link)
-        if found is None or _mesh_extent_implausible(ctx, link):
-            continue  # I206 explains a mis-scaled mesh better
+        if found is None:
+            continue
         described, I_geom = found
+        I = np.asarray(link.inertial.inertia_kg_m2, dtype=float)
         declared, expected = float(np.trace(I)), float(np.trace(I_geom))
         if expected <= 0:
             continue
         ratio = declared / expected
-        if ratio > PLAUSIBLE_TRACE_RATIO or ratio < 1 / PLAUSIBLE_TRACE_RATIO:
-            r_decl = math.sqrt(declared / (2 * link.inertial.mass_kg))
-            r_geom = math.sqrt(expected / (2 * link.inertial.mass_kg))
-            way = "larger" if ratio > 1 else "smaller"
-            factor = ratio if ratio > 1 else 1 / ratio
-            yield Issue(f"link '{link.name}': inertia is {factor:.3g}x {way} than "
-                        f"{described} (radius of gyration {_fmt(r_decl)} m vs {_fmt(r_geom)} m)",
-                        link.inertial.inertia_loc or link.inertial.loc, link.name,
-                        hint=f"{described} gives {_inertia_xml(I_geom)}")
+        r_decl = math.sqrt(declared / (2 * link.inertial.mass_kg))
+        r_geom = math.sqrt(expected / (2 * link.inertial.mass_kg))
+        way = "larger" if ratio > 1 else "smaller"
+        factor = ratio if ratio > 1 else 1 / ratio
+        yield Issue(f"link '{link.name}': inertia is {factor:,.3g}x {way} than "
+                    f"{described} (radius of gyration {_fmt(r_decl)} m vs {_fmt(r_geom)} m)",
+                    link.inertial.inertia_loc or link.inertial.loc, link.name,
+                    hint=f"{described} gives {_inertia_xml(I_geom)}")
+
+
+@rule("I204", "inertia-implausible-for-geometry", "warning",
+      "A link's inertia is 10x to 100x from what its own geometry and mass give.")
+def inertia_implausible_for_geometry(ctx: CheckContext) -> Iterator[Issue]:
+    """Compares the declared tensor with that of the link's geometry (first collision,
+    else first visual) filled uniformly with the declared mass, through the trace (twice
+    the mass times the squared radius of gyration). Between 10x and 100x off either way is
+    no real mass distribution (all mass in the corners of a box gives only 3x the solid
+    box's inertia), but a body built of a light shell and heavy parts far out may come
+    close, so it is a warning; 100x and beyond is I209, an error.
+
+    A rotor link driven by a motor plugin with `rotorVelocitySlowdownSim` s (RotorS, PX4
+    classic, gz MulticopterMotorModel) may declare s times its geometry's inertia: RotorS
+    simulates the rotor s times slower and scales its inertia to keep its momentum. Such a
+    link is reported by neither rule while the declared inertia divided by s is plausible.
+
+    The verdict is `reedtool inertia`'s (one function), so both name the same links.
+    The hint gives the geometry-derived tensor in the frame of the `<inertial>`.
+    """
+    yield from _trace_findings(ctx, "implausible")
+
+
+@rule("I209", "inertia-orders-off-geometry", "error",
+      "A link's inertia is 100x or more from what its own geometry and mass give.")
+def inertia_orders_off_geometry(ctx: CheckContext) -> Iterator[Issue]:
+    """The declared tensor's trace is at least 100x larger or smaller than that of the
+    link's geometry filled uniformly with the declared mass. No mass distribution comes
+    within an order of magnitude of that: it is a placeholder (`1.0` copied into every
+    link: 43,000x for a 0.1 kg wheel of 6 cm radius) or a unit mistake (g·mm² or kg·mm²
+    for kg·m²), and the body spins up like a flywheel a thousand times its size (or,
+    too small, the solver becomes stiff and explodes). The RotorS slowdown convention is
+    recognised as for I204. `reedtool inertia` calls such a link "way-off" and exits 1.
+    """
+    yield from _trace_findings(ctx, "way-off")
+
+
+@rule("I207", "robot-mass-not-positive", "error", "The whole robot's mass is zero or negative.")
+def robot_mass_not_positive(ctx: CheckContext) -> Iterator[Issue]:
+    """The links' declared masses add up to zero or less (one link with `mass 0` or
+    `-0.0`, or negative masses cancelling positive ones). Gazebo cannot integrate a body
+    without mass, and every thrust and hover figure divides by it.
+    """
+    problem = robot_mass_problem(ctx.robot)
+    if problem:
+        first = next((link for link in ctx.robot.links if link.inertial is not None), None)
+        loc = (first.inertial.mass_loc or first.inertial.loc) if first else None
+        yield Issue(problem, loc, first.name if first else None,
+                    hint="give each link its real mass in kg")
+
+
+@rule("I208", "massless-link-with-inertia", "error",
+      "A link has zero mass but a non-zero inertia.")
+def massless_link_with_inertia(ctx: CheckContext) -> Iterator[Issue]:
+    """Inertia is mass times squared distance: a body with no mass has none. A zero mass
+    with a non-zero tensor is a mass that was forgotten (or set to 0 to "switch the link
+    off"): the physics engines either reject the link or treat it as a body with
+    rotational inertia but no translational one. A massless link with a zero tensor on a
+    fixed joint is a frame and stays quiet. (On a moving link I201 already reports the
+    zero mass.)
+    """
+    for link, comparison in zip(ctx.robot.links, ctx.link_comparisons):
+        if comparison.verdict == "massless-inertia" and not ctx.is_moving(link):
+            yield Issue(f"link '{link.name}' has mass 0 kg but a non-zero inertia",
+                        link.inertial.mass_loc or link.inertial.loc, link.name,
+                        hint="give the link its real mass, or zero the inertia of a frame-only "
+                             "link")
 
 
 def _local_bounds(ctx: CheckContext, geometry) -> np.ndarray | None:
@@ -275,25 +332,92 @@ def _mesh_extent_implausible(ctx: CheckContext, link: Link) -> bool:
     return any(not low <= extent <= high for _s, _m, extent in _mesh_extents(ctx, link))
 
 
-@rule("I206", "mesh-scale-implausible", "warning",
-      "A mesh is implausibly large or small: probably the wrong unit.")
-def mesh_scale_implausible(ctx: CheckContext) -> Iterator[Issue]:
-    """CAD tools export STL in millimetres by default, URDF reads metres: a 470 mm frame
-    becomes 470 m. A mesh larger than 20 m or smaller than 1 mm across (after its
-    `scale`) is reported, with the scale that brings it into range.
-    """
+def robot_size_m(ctx: CheckContext) -> float | None:
+    """The robot's size from everything but its meshes: the spread of its link origins and
+    its primitive shapes. None when that says nothing (one link, meshes only)."""
+    sizes = []
+    poses = ctx.link_poses
+    if len(poses) > 1:
+        origins = np.array([T[:3, 3] for T in poses.values()])
+        sizes.append(float(np.max(origins.max(axis=0) - origins.min(axis=0))))
+    for link in ctx.robot.links:
+        for shape in [*link.visuals, *link.collisions]:
+            if not isinstance(shape.geometry, Mesh):
+                bounds = _local_bounds(ctx, shape.geometry)
+                if bounds is not None and np.all(np.isfinite(bounds)):
+                    sizes.append(float(np.max(bounds[1] - bounds[0])))
+    size = max(sizes, default=0.0)
+    return size if size > 0 else None
+
+
+def _unit_certainly_wrong(ctx: CheckContext, extent_m: float) -> bool:
+    """I210 rather than I206: see the thresholds in mesh_unit_wrong's docstring."""
+    low, high = MESH_EXTENT_RANGE_M
+    factor = MESH_UNIT_CERTAIN_FACTOR
+    if extent_m > high * factor or extent_m < low / factor:
+        return True
+    reference = robot_size_m(ctx)
+    if reference is not None:
+        return extent_m >= factor * reference if extent_m > high else \
+            extent_m <= reference / factor
+    part_low, part_high = PLAUSIBLE_PART_M
+    guess = extent_m * (0.001 if extent_m > high else 1000.0)
+    return part_low <= guess <= part_high
+
+
+def _mesh_scale_findings(ctx: CheckContext, certain: bool) -> Iterator[Issue]:
     low, high = MESH_EXTENT_RANGE_M
     for link in ctx.robot.links:
         for shape, mesh, extent in _mesh_extents(ctx, link):
-            if low <= extent <= high or extent <= 0:
+            if low <= extent <= high or extent <= 0 or not math.isfinite(extent):
+                continue
+            if _unit_certainly_wrong(ctx, extent) != certain:
                 continue
             scale = np.asarray(mesh.scale, dtype=float)
             if extent > high:
                 factor, why = 0.001, "looks like millimetres read as metres"
             else:
                 factor, why = 1000.0, "looks scaled down twice"
+            read = ctx.mesh_file(mesh)
+            unit = getattr(read, "metres_per_unit", 1.0)
+            declared = (f"; the file declares <unit meter=\"{unit:g}\">"
+                        if getattr(read, "unit_declared", False) else "")
             fixed = " ".join(_fmt(s * factor) for s in scale)
             yield Issue(f"link '{link.name}': mesh '{mesh.uri}' is {_fmt(extent)} m across "
-                        f"({why})", shape.loc, link.name,
+                        f"({why}{declared})", shape.loc, link.name,
                         hint=f"use <mesh filename=\"{mesh.uri}\" scale=\"{fixed}\"/>, or "
                              "convert the file (reedtool import-stl)")
+
+
+@rule("I206", "mesh-scale-implausible", "warning",
+      "A mesh is implausibly large or small: perhaps the wrong unit.")
+def mesh_scale_implausible(ctx: CheckContext) -> Iterator[Issue]:
+    """CAD tools export STL in millimetres by default, URDF reads metres: a 470 mm frame
+    becomes 470 m. The size is the mesh as Gazebo loads it: its coordinates times the
+    COLLADA `<asset><unit meter=>` (a .dae exported in mm with meter="0.001" is right),
+    times the `<mesh scale>`; STL and OBJ have no unit and are read as metres.
+
+    A mesh larger than 20 m or smaller than 1 mm across is reported with the scale that
+    brings it into range: as this warning when the rest of the robot leaves room for it
+    being intended (a large ground plane, a tiny marker), as I210 (error) when the unit is
+    certainly wrong.
+    """
+    yield from _mesh_scale_findings(ctx, certain=False)
+
+
+@rule("I210", "mesh-unit-wrong", "error",
+      "A mesh is about 1000x too large or too small: certainly the wrong unit.")
+def mesh_unit_wrong(ctx: CheckContext) -> Iterator[Issue]:
+    """The mesh, sized as Gazebo loads it (see I206), is outside 1 mm - 20 m and the unit
+    is certainly wrong, which is the case when any of these holds:
+
+    - it is more than 50x outside that range (over 1 km, or under 20 µm across);
+    - it is at least 50x larger (or 50x smaller) than the robot's own size, taken from the
+      spread of its link origins and its box, cylinder and sphere shapes;
+    - the robot gives no size (meshes only) and reading the coordinates as the other unit
+      (mm for a too large mesh, m for a too small one) makes it a plausible 1 cm - 5 m part.
+
+    Gazebo shows and collides with a body a thousand times its size (or invisible), and
+    a mesh used for inertia gives a tensor a million times off.
+    """
+    yield from _mesh_scale_findings(ctx, certain=True)

@@ -244,35 +244,96 @@ def gazebo_reference_missing(ctx: CheckContext) -> Iterator[Issue]:
                         hint=_closest_hint(block.reference, names))
 
 
+def _mesh_shapes(ctx: CheckContext) -> Iterator[tuple]:
+    """(link, kind, shape, mesh) for every mesh reference, each shape once.
+
+    Shapes are compared by identity: two visuals naming the same mesh file are two shapes.
+    """
+    for link in ctx.robot.links:
+        for kind, shapes in (("visual", link.visuals), ("collision", link.collisions)):
+            for shape in shapes:
+                if isinstance(shape.geometry, Mesh) and shape.geometry.uri:
+                    yield link, kind, shape, shape.geometry
+
+
+def _refused(ctx: CheckContext, mesh: Mesh) -> bool:
+    """Reported by S131 or S130: no point saying it is also missing or unreadable."""
+    from reedtool.io.meshes import format_problem, uri_problem
+
+    return bool(uri_problem(mesh.uri, mesh.path) or format_problem(mesh.uri, ctx.simulator))
+
+
 @rule("S115", "mesh-unresolved", "error", "A mesh file cannot be found or read.")
 def mesh_unresolved(ctx: CheckContext) -> Iterator[Issue]:
     """Every `<mesh filename=>` must resolve to a readable file: `package://PKG/...`
     through the package search path, `file://` and plain paths relative to the model.
     Gazebo shows nothing (or fails to spawn) for a mesh it cannot find.
 
-    An STL file must also hold a mesh: an empty or truncated export, or one with NaN
-    coordinates, is reported with what is wrong with it. (Other formats are read by
-    Gazebo's own loaders and are only checked to exist.)
+    An STL, COLLADA (.dae) or OBJ file must also hold a mesh Gazebo can read: a damaged
+    or truncated file (not XML, a `<triangles>` index past the positions, an STL whose
+    size does not match its facet count), an empty export, or one with NaN coordinates
+    is reported with what is wrong with it. (glTF/GLB/FBX are only checked to exist.)
     """
-    for link in ctx.robot.links:
-        for shape in [*link.visuals, *link.collisions]:
-            mesh = shape.geometry
-            if not isinstance(mesh, Mesh) or not mesh.uri:
-                continue
-            kind = "visual" if shape in link.visuals else "collision"
-            if mesh.path is None:
-                reason = mesh.resolve_error or "cannot be resolved"
-                yield Issue(f"link '{link.name}' {kind} mesh '{mesh.uri}': {reason}",
-                            shape.loc, link.name,
-                            hint="pass --package-path DIR for the package that holds it")
-            elif not mesh.path.is_file() or not os.access(mesh.path, os.R_OK):
-                yield Issue(f"link '{link.name}' {kind} mesh '{mesh.uri}': {mesh.path} "
-                            "is not a readable file", shape.loc, link.name,
-                            hint="check the file name and its case")
-            elif mesh.path.suffix.lower() == ".stl" and ctx.mesh_error(mesh):
-                yield Issue(f"link '{link.name}' {kind} mesh '{mesh.uri}': "
-                            f"{ctx.mesh_error(mesh)}", shape.loc, link.name,
-                            hint="export the part again as STL")
+    for link, kind, shape, mesh in _mesh_shapes(ctx):
+        if _refused(ctx, mesh):
+            continue
+        if mesh.path is None:
+            reason = mesh.resolve_error or "cannot be resolved"
+            yield Issue(f"link '{link.name}' {kind} mesh '{mesh.uri}': {reason}",
+                        shape.loc, link.name,
+                        hint="pass --package-path DIR for the package that holds it")
+        elif not mesh.path.is_file() or not os.access(mesh.path, os.R_OK):
+            yield Issue(f"link '{link.name}' {kind} mesh '{mesh.uri}': {mesh.path} "
+                        "is not a readable file", shape.loc, link.name,
+                        hint="check the file name and its case")
+        elif ctx.mesh_error(mesh):
+            yield Issue(f"link '{link.name}' {kind} mesh '{mesh.uri}': "
+                        f"{ctx.mesh_error(mesh)}", shape.loc, link.name,
+                        hint=f"export the part again as {mesh.path.suffix.lstrip('.').upper()}")
+
+
+@rule("S130", "mesh-format-unsupported", "error",
+      "A mesh file is in a format the simulator cannot load.")
+def mesh_format_unsupported(ctx: CheckContext) -> Iterator[Issue]:
+    """Gazebo picks its mesh loader by file extension. Gazebo classic loads STL, COLLADA
+    (.dae) and Wavefront OBJ; gz-sim (gz-common) also loads glTF (.gltf, .glb) and FBX.
+    CAD formats (`body.STEP`, `.SLDPRT`, `.IGES`) and an extensionless file load nothing:
+    the link is invisible and, as a collision, falls through the world.
+
+    The simulator is read from the model: gz-sim system plugins mean gz-sim; Gazebo
+    classic plugins (`lib*.so`: gazebo_ros, RotorS, PX4 classic) and no gz system mean
+    classic; a model with neither is held to gz-sim's list. Case does not matter
+    (`body.STL` is an STL).
+    """
+    from reedtool.io.meshes import format_problem, uri_problem
+
+    for link, kind, shape, mesh in _mesh_shapes(ctx):
+        if uri_problem(mesh.uri, mesh.path):
+            continue   # S131
+        problem = format_problem(mesh.uri, ctx.simulator)
+        if problem:
+            yield Issue(f"link '{link.name}' {kind} mesh '{mesh.uri}': {problem}",
+                        shape.loc, link.name,
+                        hint="export the part as STL or COLLADA (.dae) and reference that file")
+
+
+@rule("S131", "mesh-uri-escapes", "error",
+      "A mesh reference leaves its package or points at system files.")
+def mesh_uri_escapes(ctx: CheckContext) -> Iterator[Issue]:
+    """A `package://PKG/../../..` or `model://` path that climbs out of its package with
+    `..`, or a reference into a system directory (`file:///etc/passwd`, `/proc/...`),
+    is never a mesh: it makes every machine that loads the model open files outside the
+    model (a leak when the model comes from someone else) and works on no other machine.
+    reedtool does not open such a file.
+    """
+    from reedtool.io.meshes import uri_problem
+
+    for link, kind, shape, mesh in _mesh_shapes(ctx):
+        problem = uri_problem(mesh.uri, mesh.path)
+        if problem:
+            yield Issue(f"link '{link.name}' {kind} mesh '{mesh.uri}': {problem}",
+                        shape.loc, link.name,
+                        hint="reference the mesh inside its package: package://PKG/meshes/NAME")
 
 
 def _geometry_sizes(geometry) -> dict[str, float]:

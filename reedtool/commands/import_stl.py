@@ -145,7 +145,7 @@ def report_lines(outcome: ImportOutcome) -> list[str]:
     topo, props = imp.topology, imp.mass
     size = imp.size_m
     lines = [
-        f"read {imp.source}: {imp.file_format} STL, {imp.check.triangles} triangles, "
+        f"read {imp.source}: {imp.file_format}, {imp.check.triangles} triangles, "
         f"{topo.vertices} vertices",
         f"units: {imp.units.unit} ({imp.units.reason})",
         f"frame: {imp.frame.description}",

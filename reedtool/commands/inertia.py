@@ -43,7 +43,19 @@ def _finite_or_none(value):
     return None if value is None or not np.isfinite(value) else value
 
 
-def format_text(model: Path, robot, comparisons, whole, own) -> str:
+# Model-level findings `inertia` shares with `validate`: what makes the geometry it compares
+# against meaningless (a mesh Gazebo cannot load, leaving its package, in the wrong unit)
+# and a robot without mass. The per-link verdicts cover I201-I204, I208 and I209.
+SHARED_CODES = ("S130", "S131", "I207", "I210")
+
+
+def shared_findings(robot) -> list:
+    from reedtool.checks.runner import Selection, run_checks
+
+    return run_checks(robot, Selection(select=SHARED_CODES))
+
+
+def format_text(model: Path, robot, comparisons, whole, own, findings=()) -> str:
     from reedtool.physics.inertia import clean_tensor
     from reedtool.report import display_path
 
@@ -77,23 +89,38 @@ def format_text(model: Path, robot, comparisons, whole, own) -> str:
     lines.append(f"  reedtool's own sum over links {'agrees' if agree else 'DISAGREES'}: "
                  f"mass {own.mass_kg:.6g} kg, COM {_vec(own.com_m)} m")
     failing = [c for c in comparisons if c.failing]
+    warned = [c for c in comparisons if c.severity == "warning"]
+    known = [c for c in comparisons if c.verdict == "slowdown-scaled"]
     lines.append("")
+    for f in findings:
+        where = display_path(f.file) + (f":{f.line}" if f.line else "") if f.file else ""
+        lines.append(f"{f.severity} {f.code} {where}: {f.message} ({f.slug})")
+    if findings:
+        lines.append("")
+    if known:
+        lines.append("known exception (RotorS rotorVelocitySlowdownSim convention, not a "
+                     "difference): " + ", ".join(c.link for c in known))
+    if warned:
+        lines.append(f"{len(warned)} link(s) to look at (warning, as in validate): "
+                     + ", ".join(f"{c.link} ({c.verdict})" for c in warned))
     if failing:
-        lines.append(f"{len(failing)} of {len(comparisons)} links need attention: "
-                     + ", ".join(f"{c.link} ({c.verdict})" for c in failing))
+        lines.append(f"{len(failing)} of {len(comparisons)} links need attention (error, as in "
+                     "validate): " + ", ".join(f"{c.link} ({c.verdict})" for c in failing))
+    if failing or warned:
         lines.append("pass --fix to write the geometry's inertia into a .urdf, or to print "
                      "the blocks to paste into a .xacro")
-    else:
+    if not failing and not warned:
         lines.append("no link inertia needs attention")
     return "\n".join(lines) + "\n"
 
 
-def format_json(model: Path, robot, comparisons, whole, own) -> str:
+def format_json(model: Path, robot, comparisons, whole, own, findings=()) -> str:
     doc = {
         "model": str(model),
         "base_link": robot.base_link,
         "links": [{
             "link": c.link, "file": c.loc.file, "line": c.loc.line, "verdict": c.verdict,
+            "severity": c.severity,
             "message": c.message, "geometry": c.geometry,
             "declared": _props_json(c.declared), "derived": _props_json(c.derived),
             "inertia_rel_diff": _finite_or_none(c.inertia_rel_diff),
@@ -103,6 +130,7 @@ def format_json(model: Path, robot, comparisons, whole, own) -> str:
         "whole_robot": {**_props_json(whole), "source": "pinocchio"},
         "own_sum": _props_json(own),
         "failing": sum(c.failing for c in comparisons),
+        "findings": [f.to_dict() for f in findings],
     }
     return json.dumps(doc, indent=2) + "\n"
 
@@ -218,7 +246,9 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
 
     MODEL is a .urdf or .xacro (xacro arguments as NAME:=VALUE). Geometry is the first
     collision shape, else the first visual, as a uniform solid with the declared mass.
-    Exit 0 when no link needs attention, 1 otherwise, 2 on unreadable input.
+    The verdicts are validate's (one function): exit 1 exactly when validate reports an
+    inertia error (I201-I203, I207-I210) or a mesh Gazebo cannot load or must not open
+    (S130, S131); 0 otherwise, 2 on unreadable input.
     """
     from reedtool.checks.preflight import require_sound_model
     from reedtool.io.loader import load_robot
@@ -240,8 +270,9 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     own = whole_robot(robot)
     whole = whole_robot_pinocchio(robot)
 
+    findings = shared_findings(robot)
     render = format_json if fmt == "json" else format_text
-    click.echo(render(model, robot, comparisons, whole, own), nl=False)
+    click.echo(render(model, robot, comparisons, whole, own, findings), nl=False)
     failing = [c for c in comparisons if c.failing]
     if fix:
         is_urdf = model.suffix.lower() == ".urdf"
@@ -252,4 +283,5 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
         if is_urdf:
             # What --fix rewrote no longer fails; what it could not fix still does.
             failing = [c for c in failing if c.corrected() is None]
-    return 1 if failing else 0
+    errors = [f for f in findings if f.severity == "error"]
+    return 1 if failing or errors else 0

@@ -1,11 +1,12 @@
 """Any mesh file as triangles, refused when nothing sensible can be computed from it.
 
-STL is read here; other formats go through trimesh.
+STL, COLLADA and OBJ are read here with light readers (numpy, lxml): `validate` needs their
+extents and units and must not pay for trimesh/scipy. Other formats go through trimesh.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -13,14 +14,50 @@ import numpy as np
 from reedtool.errors import ReedtoolError
 from reedtool.io.stl import read_stl
 
+# What each simulator's mesh loader reads (gazebo classic: common::MeshManager; gz-sim:
+# gz-common's MeshManager, which adds glTF/GLB and FBX through assimp).
+CLASSIC_MESH_SUFFIXES = (".stl", ".dae", ".obj")
+GZ_MESH_SUFFIXES = CLASSIC_MESH_SUFFIXES + (".glb", ".gltf", ".fbx")
+LIGHT_SUFFIXES = (".stl", ".dae", ".obj")
+
+
+@dataclass
+class MeshFile:
+    triangles: np.ndarray           # (n, 3, 3) in the file's units
+    metres_per_unit: float          # what Gazebo multiplies them by (COLLADA <unit>), else 1
+    format: str                     # stl-binary | stl-ascii | dae | obj | other
+    unit_declared: bool = False     # the file states its unit (COLLADA)
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def triangles_m(self) -> np.ndarray:
+        return self.triangles * self.metres_per_unit if self.metres_per_unit != 1.0 \
+            else self.triangles
+
+
+def read_mesh(path: str | Path) -> MeshFile:
+    """A mesh file as Gazebo reads it, without the `<mesh scale>`; unreadable -> ReedtoolError."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".stl":
+        stl = read_stl(path)
+        return MeshFile(stl.triangles, 1.0, f"stl-{stl.format}", notes=list(stl.notes))
+    if suffix == ".dae":
+        from reedtool.io.dae import read_dae
+
+        dae = read_dae(path)
+        return MeshFile(dae.triangles, dae.metres_per_unit, "dae", dae.unit_declared, dae.notes)
+    if suffix == ".obj":
+        from reedtool.io.obj import read_obj
+
+        return MeshFile(read_obj(path), 1.0, "obj")
+    return MeshFile(_load_with_trimesh(path), 1.0, "other")
+
 
 def load_triangles(path: str | Path) -> np.ndarray:
-    """Any mesh file as (n, 3, 3) triangles in its own units: STL here, others via trimesh."""
-    path = Path(path)
-    if path.suffix.lower() == ".stl":
-        triangles = read_stl(path).triangles
-    else:
-        triangles = _load_with_trimesh(path)
+    """Any mesh file as (n, 3, 3) triangles in metres as Gazebo reads it (COLLADA <unit>
+    applied, `<mesh scale>` not), checked for content mass properties can be computed from."""
+    triangles = read_mesh(path).triangles_m
     check_triangles(triangles, path)
     return triangles
 
@@ -79,3 +116,60 @@ def check_triangles(triangles: np.ndarray, source: str | Path) -> MeshCheck:
                             file=source, hint="a flat surface has no volume, so no mass "
                                               "properties; export the solid body")
     return MeshCheck(len(triangles), zero_area, total_area, extent)
+
+
+# ------------------------------------------------------------ mesh references
+
+# Where no model's mesh belongs: reading them is a leak (a model shared as a package that
+# makes the simulator open /etc/passwd), and they hold no mesh anyway. Deliberately short:
+# workspaces do live under /root, /var/lib/jenkins, /opt or /usr/share.
+SYSTEM_DIRS = ("/etc", "/proc", "/sys", "/dev", "/boot", "/bin", "/sbin", "/usr/bin",
+               "/usr/sbin")
+
+
+def uri_problem(uri: str, path: Path | None = None) -> str | None:
+    """Why a mesh reference must not be followed, or None.
+
+    A `package://` or `model://` path that climbs out of its package with `..`, and any
+    reference (`file://`, absolute, or what a package path resolves to) inside a system
+    directory.
+    """
+    import posixpath
+    from urllib.parse import unquote, urlparse
+
+    text = unquote(uri.strip())
+    for scheme in ("package://", "model://"):
+        if text.startswith(scheme):
+            _name, _, rel = text[len(scheme):].partition("/")
+            normal = posixpath.normpath(rel) if rel else ""
+            if normal == ".." or normal.startswith("../") or rel.startswith("/"):
+                return f"the path climbs out of its package ('{rel}')"
+    if text.startswith("file://"):
+        text = urlparse(text).path
+    candidates = [posixpath.normpath(text)] if text.startswith("/") else []
+    if path is not None:
+        candidates.append(posixpath.normpath(str(path)))
+    for candidate in candidates:
+        for system in SYSTEM_DIRS:
+            if candidate == system or candidate.startswith(system + "/"):
+                return f"it points into the system directory {system}"
+    return None
+
+
+def format_problem(uri: str, simulator: str) -> str | None:
+    """Why Gazebo cannot load this mesh file format, or None.
+
+    `simulator`: "classic" (STL, COLLADA, OBJ) or "gz" (also glTF/GLB and FBX).
+    """
+    name = uri.rsplit("/", 1)[-1]
+    suffix = Path(name).suffix.lower()
+    allowed = GZ_MESH_SUFFIXES if simulator == "gz" else CLASSIC_MESH_SUFFIXES
+    if suffix in allowed:
+        return None
+    which = "gz-sim" if simulator == "gz" else "Gazebo classic"
+    if not suffix:
+        return f"'{name}' has no file extension; {which} picks its mesh loader by extension"
+    if suffix in GZ_MESH_SUFFIXES:
+        return f"{which} does not load {suffix} meshes (gz-sim does)"
+    return (f"{which} does not load {suffix} files (it loads "
+            f"{', '.join(s.lstrip('.').upper() for s in allowed)})")

@@ -8,6 +8,7 @@ place, `combine`, where parts are summed about their common COM.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Iterable
@@ -296,16 +297,35 @@ def principal_moments(inertia_kg_m2) -> np.ndarray:
     return np.linalg.eigvalsh((I + I.T) / 2.0)
 
 
-def physically_valid(inertia_kg_m2, rel_tol: float = 1e-9) -> bool:
-    """Positive principal moments obeying the triangle inequality (A + B >= C)."""
+# Principal moments may break A + B >= C by this fraction of the largest moment: hand-rounded
+# values of a thin plate (where A + B = C exactly) stay quiet, real mistakes do not.
+TRIANGLE_REL_TOL = 1e-3
+
+
+def tensor_problem(inertia_kg_m2) -> str | None:
+    """What makes a declared tensor physically impossible, or None.
+
+    "non-finite", "not-positive-definite" (asymmetric, or a principal moment <= 0, I202) or
+    "triangle" (A + B < C beyond TRIANGLE_REL_TOL, I203). `validate` and `inertia` both
+    decide here.
+    """
     I = np.asarray(inertia_kg_m2, dtype=float)
     if not np.all(np.isfinite(I)):
-        return False
-    moments = principal_moments(I)
-    scale = max(float(np.max(np.abs(moments))), 1e-300)
-    if moments[0] <= 0.0:
-        return False
-    return bool(moments[0] + moments[1] >= moments[2] - rel_tol * scale)
+        return "non-finite"
+    scale = max(float(np.max(np.abs(I))), 1e-300)
+    moments = np.linalg.eigvalsh((I + I.T) / 2.0)
+    if not np.allclose(I, I.T, rtol=0, atol=1e-12 * scale) or moments[0] <= 0 \
+            or moments[0] <= 1e-12 * max(float(moments[2]), 1e-300):
+        return "not-positive-definite"
+    a, b, c = moments
+    if a + b < c - TRIANGLE_REL_TOL * c:
+        return "triangle"
+    return None
+
+
+def physically_valid(inertia_kg_m2) -> bool:
+    """Positive principal moments obeying the triangle inequality (A + B >= C)."""
+    return tensor_problem(inertia_kg_m2) is None
 
 
 def relative_difference(declared, reference) -> float:
@@ -352,17 +372,37 @@ def inertial_xml(props: MassProperties, indent: str = "  ", rpy: str = "0 0 0") 
 
 
 # ------------------------------------------------- declared vs geometry, per link
+#
+# ONE verdict per link, shared by `reedtool inertia` and the I2xx rules of `validate`, so the
+# same link gets the same verdict in both and `inertia` fails exactly when `validate` reports
+# an inertia error. Severity of each verdict:
+#   error:   invalid (I202/I203), way-off (I209), massless-inertia (I208), negative-mass and
+#            massless-moving (I201)
+#   warning: implausible (I204)
+#   note:    differs, com-off (within what a real part can be), slowdown-scaled (RotorS
+#            convention), and the verdicts that have nothing to compare.
 
 # A real part is not a uniform solid of its collision shape, so only a large difference
-# means a wrong tensor: within 50 % is "ok"; beyond 10x (or 1/10) it is a placeholder or a
-# unit mistake (1.0 everywhere, mm^2 for m^2).
+# means a wrong tensor: within 50 % is "ok". The trace (twice the mass times the squared
+# radius of gyration) decides plausibility: all mass in the corners of a box gives only 3x
+# the solid box's inertia, so beyond 10x (or 1/10) no real mass distribution fits
+# (implausible, warning), and beyond 100x the tensor is a placeholder or a unit mistake
+# (1.0 everywhere, mm^2 for m^2) that certainly changes how the body flies (way-off, error).
 OK_REL_DIFF = 0.5
-WAY_OFF_FACTOR = 10.0
+WAY_OFF_FACTOR = 10.0            # kept for callers: the implausible threshold
+PLAUSIBLE_TRACE_RATIO = 10.0
+ORDERS_OFF_TRACE_RATIO = 100.0
 # The declared COM may sit anywhere inside the part; farther from the geometry's COM than
 # this many radii of gyration, it is probably outside it.
 COM_OFF_GYRATION_RADII = 1.0
 
-FAILING_VERDICTS = ("invalid", "way-off", "differs", "com-off")
+VERDICT_SEVERITY = {
+    "invalid": "error", "way-off": "error", "massless-inertia": "error",
+    "negative-mass": "error", "massless-moving": "error",
+    "implausible": "warning",
+}
+FAILING_VERDICTS = tuple(v for v, sev in VERDICT_SEVERITY.items() if sev == "error")
+FIXABLE_VERDICTS = ("invalid", "way-off", "implausible", "differs", "com-off")
 
 
 @dataclass
@@ -375,18 +415,24 @@ class LinkComparison:
     inertia_rel_diff: float | None
     trace_ratio: float | None          # trace(declared) / trace(derived)
     com_offset_m: float | None
-    verdict: str                       # ok | differs | way-off | com-off | invalid | massless |
-    #                                    no-geometry | no-inertial | geometry-error | no-mass
+    verdict: str                       # see VERDICT_SEVERITY; also ok | differs | com-off |
+    #   slowdown-scaled | massless | no-geometry | no-inertial | geometry-error
     message: str
+    slowdown: float | None = None      # rotorVelocitySlowdownSim of the rotor on this link
+    tensor_problem: str | None = None  # see tensor_problem()
+
+    @property
+    def severity(self) -> str | None:
+        return VERDICT_SEVERITY.get(self.verdict)
 
     @property
     def failing(self) -> bool:
-        return self.verdict in FAILING_VERDICTS
+        return self.severity == "error"
 
     def corrected(self) -> MassProperties | None:
         """The <inertial> --fix writes: declared mass, geometry tensor; the declared COM
         unless it is implausibly far from the geometry's."""
-        if self.derived is None or self.declared is None or not self.failing:
+        if self.derived is None or self.declared is None or self.verdict not in FIXABLE_VERDICTS:
             return None
         com = self.derived.com_m if self.verdict == "com-off" else self.declared.com_m
         return MassProperties(self.declared.mass_kg, np.array(com), self.derived.inertia_kg_m2)
@@ -398,8 +444,39 @@ def _geometry_label(kind: str, geometry) -> str:
     return f"{kind} {type(geometry).__name__.lower()}"
 
 
-def compare_link(link: Link) -> LinkComparison:
-    """Declared inertial beside the one its geometry implies at the same mass, with a verdict."""
+def rotor_slowdown_by_link(robot: Robot) -> dict[str, float]:
+    """rotorVelocitySlowdownSim of each rotor link's motor plugin (RotorS, PX4 classic, gz).
+
+    RotorS simulates rotors `s` times slower than they spin and multiplies the rotor link's
+    inertia by `s` to keep its angular momentum (multirotor_base.xacro: the rotor's box
+    inertia with mass * rotor_velocity_slowdown_sim). Only motor plugins (those that name a
+    jointName) count: the multirotor base plugin carries the same element for the body.
+    """
+    found: dict[str, float] = {}
+    for _block, plugin in robot.plugins():
+        text = plugin.param("rotorVelocitySlowdownSim")
+        joint = plugin.param("jointName")
+        if text is None or joint is None:
+            continue
+        try:
+            slowdown = float(text)
+        except ValueError:
+            continue
+        link = plugin.param("linkName")
+        if link is None and joint in robot.joint_map:
+            link = robot.joint_map[joint].child
+        if link and math.isfinite(slowdown) and slowdown > 1.0:
+            found[link] = slowdown
+    return found
+
+
+def compare_link(link: Link, *, moving: bool = False,
+                 slowdown: float | None = None) -> LinkComparison:
+    """Declared inertial beside the one its geometry implies at the same mass, with a verdict.
+
+    `moving`: the link is the child of a non-fixed joint (a massless one is an error there).
+    `slowdown`: rotorVelocitySlowdownSim of a motor plugin driving this link.
+    """
     declared = declared_mass_properties(link)
     loc = link.inertial.loc if link.inertial is not None else link.loc
     found = link.geometry_for_mass()
@@ -408,27 +485,40 @@ def compare_link(link: Link) -> LinkComparison:
         kind = "collision" if any(c.geometry is found[0] for c in link.collisions) else "visual"
         label = _geometry_label(kind, found[0])
 
-    def result(verdict, message, derived=None, rel=None, ratio=None, offset=None):
+    def result(verdict, message, derived=None, rel=None, ratio=None, offset=None, problem=None):
         return LinkComparison(link.name, loc, declared, derived, label, rel, ratio, offset,
-                              verdict, message)
+                              verdict, message, slowdown, problem)
 
     if declared is None:
         if found is None:
             return result("no-inertial", "no <inertial> and no geometry (a frame-only link)")
         return result("no-inertial", f"has a {label} but no <inertial>: Gazebo ignores its mass")
     mass = declared.mass_kg
-    if not np.isfinite(mass) or mass <= 0.0:
+    if not np.isfinite(mass):
         return result("massless", f"mass {mass:g} kg: nothing to compare")
-    invalid = not physically_valid(declared.inertia_kg_m2)
+    if mass < 0.0:
+        return result("negative-mass", f"mass {mass:g} kg is negative")
+    if mass == 0.0:
+        I = np.asarray(declared.inertia_kg_m2, dtype=float)
+        if np.any(I != 0.0):
+            return result("massless-inertia", "mass 0 kg with a non-zero inertia: a body "
+                                              "cannot have one without the other")
+        if moving:
+            return result("massless-moving", "mass 0 kg on a link that moves on its own joint")
+        return result("massless", "mass 0 kg (a frame merged into its parent): nothing to compare")
+    problem = tensor_problem(declared.inertia_kg_m2)
     if found is None:
-        if invalid:
+        if problem:
             return result("invalid", "declared tensor is not physically possible "
                                      "(non-positive or A + B < C principal moments); no geometry "
-                                     "to derive one from")
+                                     "to derive one from", problem=problem)
         return result("no-geometry", "no collision or visual geometry to compare with")
     try:
         derived = geometry_mass_properties(found[0], found[1], mass)
     except ReedtoolError as exc:
+        if problem:
+            return result("invalid", "declared tensor is not physically possible; "
+                                     f"{label}: {exc.one_line()}", problem=problem)
         return result("geometry-error", f"{label}: {exc.one_line()}")
     rel = relative_difference(declared.inertia_kg_m2, derived.inertia_kg_m2)
     trace_geom = float(np.trace(derived.inertia_kg_m2))
@@ -436,28 +526,72 @@ def compare_link(link: Link) -> LinkComparison:
     offset = float(np.linalg.norm(declared.com_m - derived.com_m))
     gyration_m = np.sqrt(trace_geom / (2.0 * mass)) if trace_geom > 0 else 0.0
     hull = " (of its convex hull: the mesh is open)" if derived.from_hull else ""
-    if invalid:
+    args = (derived, rel, ratio, offset, problem)
+    if problem:
         return result("invalid", "declared tensor is not physically possible (non-positive or "
                                  f"A + B < C principal moments); the {label}{hull} gives one",
-                      derived, rel, ratio, offset)
-    if ratio >= WAY_OFF_FACTOR or ratio <= 1.0 / WAY_OFF_FACTOR:
+                      *args)
+    if rel > OK_REL_DIFF and slowdown and _plausible(ratio / slowdown):
+        return result("slowdown-scaled", f"declared inertia is {_times(ratio)} the {label}'s, "
+                                         "plausible once divided by the motor's "
+                                         f"rotorVelocitySlowdownSim {slowdown:g} (RotorS "
+                                         "convention, not a mistake)", *args)
+    # A rotor with a slowdown is expected anywhere between its geometry and s times it:
+    # judge it against whichever of the two it is closer to.
+    judged = ratio
+    if slowdown and np.isfinite(ratio) and ratio > 0 \
+            and abs(math.log(ratio / slowdown)) < abs(math.log(ratio)):
+        judged = ratio / slowdown
+    if not _plausible(judged, ORDERS_OFF_TRACE_RATIO):
         return result("way-off", f"declared inertia is {_times(ratio)} the {label}'s{hull}",
-                      derived, rel, ratio, offset)
+                      *args)
+    if not _plausible(judged, PLAUSIBLE_TRACE_RATIO):
+        return result("implausible", f"declared inertia is {_times(ratio)} the {label}'s{hull}",
+                      *args)
     if rel > OK_REL_DIFF:
         return result("differs", f"declared inertia differs from the {label}'s{hull} by "
-                                 f"{rel:.0%}", derived, rel, ratio, offset)
+                                 f"{rel:.0%}", *args)
     if offset > COM_OFF_GYRATION_RADII * gyration_m:
         return result("com-off", f"declared COM is {offset * 1000:.3g} mm from the {label}'s "
-                                 f"centre{hull}", derived, rel, ratio, offset)
-    return result("ok", f"within {OK_REL_DIFF:.0%} of the {label}'s{hull}", derived, rel, ratio,
-                  offset)
+                                 f"centre{hull}", *args)
+    return result("ok", f"within {OK_REL_DIFF:.0%} of the {label}'s{hull}", *args)
+
+
+def _plausible(ratio: float, factor: float = PLAUSIBLE_TRACE_RATIO) -> bool:
+    return 1.0 / factor < ratio < factor
 
 
 def _times(ratio: float) -> str:
     def number(x: float) -> str:
         return f"{x:,.0f}" if x >= 100 else f"{x:.3g}"
+    if not np.isfinite(ratio) or ratio <= 0:
+        return f"{ratio:g}x"
     return f"{number(ratio)}x" if ratio >= 1.0 else f"1/{number(1.0 / ratio)} of"
 
 
+def moving_links(robot: Robot) -> set[str]:
+    """Links that are the child of a non-fixed joint (their own body in the simulator)."""
+    return {joint.child for joint in robot.joints if joint.moves}
+
+
 def compare_links(robot: Robot) -> list[LinkComparison]:
-    return [compare_link(link) for link in robot.links]
+    """compare_link for every link of the robot, in document order."""
+    moving = moving_links(robot)
+    slowdowns = rotor_slowdown_by_link(robot)
+    return [compare_link(link, moving=link.name in moving, slowdown=slowdowns.get(link.name))
+            for link in robot.links]
+
+
+def robot_mass_problem(robot: Robot) -> str | None:
+    """Why the whole robot cannot be simulated for its mass (sum <= 0 kg), or None.
+
+    The plain sum over links with a finite declared mass: Gazebo needs a positive total.
+    """
+    masses = [link.inertial.mass_kg for link in robot.links
+              if link.inertial is not None and math.isfinite(link.inertial.mass_kg)]
+    if not masses:
+        return None          # nothing declared: S117/I201 speak about the links
+    total = float(sum(masses))
+    if total <= 0.0:
+        return f"the whole robot's mass is {total:g} kg (sum over {len(masses)} links)"
+    return None

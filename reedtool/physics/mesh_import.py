@@ -12,8 +12,7 @@ import numpy as np
 
 from reedtool.errors import ReedtoolError
 from reedtool.frames import AxisConvention, axis_convention
-from reedtool.io.meshes import MeshCheck, check_triangles
-from reedtool.io.stl import read_stl
+from reedtool.io.meshes import MeshCheck, check_triangles, read_mesh
 from reedtool.physics.inertia import MassProperties, mesh_mass_properties
 from reedtool.physics.mesh_topology import (
     Topology,
@@ -53,7 +52,20 @@ def guess_units(extent: np.ndarray) -> UnitChoice:
                       f"{low:g}-{high:g} m; assuming {unit} — pass --units to be sure", True)
 
 
-def choose_units(name: str, extent: np.ndarray) -> UnitChoice:
+def _unit_name(metres_per_unit: float) -> str:
+    for unit, metres in UNITS_M.items():
+        if np.isclose(metres, metres_per_unit, rtol=1e-9):
+            return unit
+    return f"{metres_per_unit:g} m"
+
+
+def choose_units(name: str, extent: np.ndarray, declared_m: float | None = None) -> UnitChoice:
+    """--units NAME; "auto" takes the unit the file declares (COLLADA <unit>), as Gazebo
+    does, and guesses from the size only for formats without one (STL, OBJ)."""
+    if name == "auto" and declared_m is not None:
+        return UnitChoice(_unit_name(declared_m), declared_m,
+                          f"declared by the file (<unit meter=\"{declared_m:g}\">), as "
+                          "Gazebo reads it", False)
     if name == "auto":
         return guess_units(extent)
     if name not in UNITS_M:
@@ -92,7 +104,7 @@ def collision_triangles(triangles: np.ndarray, spec: CollisionSpec) -> np.ndarra
 @dataclass
 class ImportedMesh:
     source: Path
-    file_format: str                 # binary | ascii
+    file_format: str                 # binary STL | ASCII STL | COLLADA | OBJ
     triangles_m: np.ndarray          # (n, 3, 3), metres, FLU, recentred
     units: UnitChoice
     frame: AxisConvention
@@ -118,7 +130,8 @@ DEFAULT_DENSITY_KG_M3 = 1000.0
 def import_mesh(path: str | Path, *, units: str = "auto", from_frame: str = "flu",
                 mass_kg: float | None = None, density_kg_m3: float | None = None,
                 recenter: str = "none", collision: str = "same", progress=None) -> ImportedMesh:
-    """Read a CAD STL and return it in metres and FLU with its mass properties.
+    """Read a CAD mesh (STL, COLLADA .dae, OBJ) and return it in metres and FLU with its
+    mass properties. A .dae's <unit> is honoured (COLLADA node transforms applied).
 
     `progress(stage_name)` is called before each stage, for a progress bar.
     """
@@ -135,16 +148,17 @@ def import_mesh(path: str | Path, *, units: str = "auto", from_frame: str = "flu
             raise ReedtoolError(f"{flag} must be a positive number, not {value}")
 
     step("reading")
-    stl = read_stl(path)
+    read = read_mesh(path)
     step("checking")
-    check = check_triangles(stl.triangles, path)
-    topo = topology(stl.triangles)
-    choice = choose_units(units, check.extent)
+    check = check_triangles(read.triangles, path)
+    topo = topology(read.triangles)
+    choice = choose_units(units, check.extent,
+                          read.metres_per_unit if read.unit_declared else None)
 
     step("transforming")
     # Uniform scale and a rotation commute; one matrix does both.
     M = frame.R_flu_src * choice.metres_per_unit
-    triangles = stl.triangles @ M.T
+    triangles = read.triangles @ M.T
 
     step("mass properties")
     try:
@@ -175,11 +189,13 @@ def import_mesh(path: str | Path, *, units: str = "auto", from_frame: str = "flu
     step("collision mesh")
     collision_m = collision_triangles(triangles, spec)
 
-    notes = list(stl.notes)
+    notes = list(read.notes)
     if check.zero_area_triangles:
         notes.append(f"{check.zero_area_triangles} zero-area triangles (kept; they add nothing)")
     if props.from_hull:
         why = "not watertight" if not topo.watertight else "inconsistently wound"
         notes.append(f"mesh is {why}: mass properties are those of its convex hull")
-    return ImportedMesh(path, stl.format, triangles, choice, frame, offset, recenter, check,
+    file_format = {"stl-binary": "binary STL", "stl-ascii": "ASCII STL", "dae": "COLLADA",
+                   "obj": "OBJ"}.get(read.format, read.format)
+    return ImportedMesh(path, file_format, triangles, choice, frame, offset, recenter, check,
                         topo, props, mass_source, collision_m, spec, notes)

@@ -1,0 +1,101 @@
+"""One verdict for `validate` and `inertia`; generated packages pass `inertia`; the RotorS
+rotor-inertia convention is a known exception."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from cli_helpers import run_cli
+
+from reedtool.checks.runner import Selection, run_checks
+from reedtool.io.loader import load_robot
+from reedtool.physics.inertia import box_inertia, compare_links, cylinder_inertia
+from reedtool.scaffold.airframes import MULTIROTOR_FRAMES
+
+
+def rotor_model(rotor_inertia_diag, slowdown: str | None = "10", rotor_mass=0.005) -> str:
+    """A body box and one RotorS-style rotor (0.1 m radius, 5 mm disc) with its motor plugin."""
+    ixx, iyy, izz = np.diag(box_inertia(1.0, (0.3, 0.3, 0.1)))
+    rxx, ryy, rzz = rotor_inertia_diag
+    slow = f"<rotorVelocitySlowdownSim>{slowdown}</rotorVelocitySlowdownSim>" if slowdown else ""
+    return f"""<?xml version="1.0"?>
+<robot name="r">
+  <link name="base_link"><inertial><mass value="1"/>
+    <inertia ixx="{ixx}" ixy="0" ixz="0" iyy="{iyy}" iyz="0" izz="{izz}"/></inertial>
+    <collision><geometry><box size="0.3 0.3 0.1"/></geometry></collision></link>
+  <joint name="rotor_0_joint" type="continuous"><parent link="base_link"/><child link="rotor_0"/>
+    <origin xyz="0.2 0 0.05"/><axis xyz="0 0 1"/></joint>
+  <link name="rotor_0"><inertial><mass value="{rotor_mass}"/>
+    <inertia ixx="{rxx}" ixy="0" ixz="0" iyy="{ryy}" iyz="0" izz="{rzz}"/></inertial>
+    <collision><geometry><cylinder length="0.005" radius="0.1"/></geometry></collision></link>
+  <gazebo><plugin name="m0" filename="librotors_gazebo_motor_model.so">
+    <jointName>rotor_0_joint</jointName><linkName>rotor_0</linkName>
+    <turningDirection>ccw</turningDirection>{slow}</plugin></gazebo>
+  <gazebo><plugin name="base" filename="librotors_gazebo_multirotor_base_plugin.so">
+    <linkName>base_link</linkName>{slow}</plugin></gazebo>
+</robot>
+"""
+
+
+# RotorS multirotor_base.xacro: box_inertia(x=radius, y=0.015, z=0.003, mass=m * slowdown).
+ROTORS_MACRO = np.diag(box_inertia(0.005 * 10, (0.1, 0.015, 0.003)))
+CYLINDER = np.diag(cylinder_inertia(0.005, 0.1, 0.005))
+
+
+def verdicts(tmp_path, text):
+    path = tmp_path / "r.urdf"
+    path.write_text(text)
+    robot = load_robot(path)
+    i_codes = sorted(f.code for f in run_checks(robot, Selection(select=("I",))))
+    return {c.link: c.verdict for c in compare_links(robot)}["rotor_0"], i_codes, path
+
+
+@pytest.mark.parametrize("diag, verdict, i_codes", [
+    (ROTORS_MACRO, "slowdown-scaled", []),            # RotorS's own formula times 10
+    (CYLINDER * 10, "slowdown-scaled", []),           # the disc times the slowdown
+    (CYLINDER, "ok", []),                             # unscaled is fine too
+    (CYLINDER * 10 * 50, "implausible", ["I204"]),    # 50x beyond the convention
+    (np.ones(3), "way-off", ["I209"]),                # a 1.0 placeholder
+])
+def test_rotor_slowdown_convention(tmp_path, diag, verdict, i_codes):
+    assert verdicts(tmp_path, rotor_model(diag))[:2] == (verdict, i_codes)
+
+
+def test_without_slowdown_the_same_rotor_is_flagged(tmp_path):
+    # 10x the disc with no slowdown element: 10x is past the plausible factor.
+    verdict, i_codes, _ = verdicts(tmp_path, rotor_model(CYLINDER * 10.5, slowdown=None))
+    assert (verdict, i_codes) == ("implausible", ["I204"])
+
+
+@pytest.mark.parametrize("factor", [1.0, 20.0, 300.0, 1 / 300.0])
+def test_inertia_exits_1_exactly_when_validate_has_an_inertia_error(tmp_path, factor):
+    _, _, path = verdicts(tmp_path, rotor_model(CYLINDER * factor, slowdown=None))
+    validate_errors = [f for f in run_checks(load_robot(path), Selection(select=("I",)))
+                       if f.severity == "error"]
+    code, out = run_cli("inertia", path, "--format", "json")
+    doc = json.loads(out)
+    assert code == (1 if validate_errors else 0)
+    assert code == (1 if factor in (300.0, 1 / 300.0) else 0)
+    failing = [link["link"] for link in doc["links"] if link["severity"] == "error"]
+    assert failing == sorted({f.subject for f in validate_errors})
+
+
+@pytest.mark.parametrize("frame", sorted(MULTIROTOR_FRAMES))
+def test_generated_classic_package_passes_inertia(tmp_path, frame):
+    name = "gen_" + frame.replace("-", "_")
+    assert run_cli("new-package", name, "--frame", frame, "--ros", "1", "-o", tmp_path)[0] == 0
+    model = tmp_path / name / "urdf" / "mav_generic_odometry_sensor.gazebo"
+    code, out = run_cli("inertia", model, "--package-path", tmp_path, "--format", "json")
+    doc = json.loads(out)
+    assert code == 0, [link for link in doc["links"] if link["severity"]]
+    rotors = [link for link in doc["links"] if "/rotor_" in link["link"]]
+    assert rotors and {link["verdict"] for link in rotors} == {"slowdown-scaled"}
+
+
+def test_generated_gz_package_passes_inertia(tmp_path):
+    assert run_cli("new-package", "gz_quad", "--frame", "quad-x", "--ros", "2", "-o",
+                   tmp_path)[0] == 0
+    model = tmp_path / "gz_quad" / "urdf" / "gz_quad.urdf.xacro"
+    assert run_cli("inertia", model, "--package-path", tmp_path)[0] == 0

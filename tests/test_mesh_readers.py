@@ -1,0 +1,128 @@
+"""The light mesh readers (COLLADA, OBJ) against hand-derived numbers and trimesh, and the
+promise that `validate` never imports trimesh or scipy."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+from mesh_helpers import box_triangles, dae_text, write_dae, write_obj
+
+from reedtool.errors import ReedtoolError
+from reedtool.io.dae import parse_dae
+from reedtool.io.meshes import read_mesh
+from reedtool.io.obj import parse_obj
+from reedtool.physics.inertia import mesh_mass_properties
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def extent(triangles):
+    v = np.asarray(triangles).reshape(-1, 3)
+    return v.max(axis=0) - v.min(axis=0)
+
+
+def test_dae_unit_and_node_transforms():
+    # 1530 x 200 x 30 mm, translated 10 mm along x then turned 90 deg about z.
+    dae = parse_dae(dae_text(box_triangles((1530, 200, 30)), meter=0.001,
+                             node_xml="<translate>10 0 0</translate>"
+                                      "<rotate>0 0 1 90</rotate>").encode())
+    assert dae.unit_declared and dae.metres_per_unit == 0.001
+    assert extent(dae.triangles_m) == pytest.approx([0.2, 1.53, 0.03])
+    centre = dae.triangles_m.reshape(-1, 3).mean(axis=0)
+    assert centre == pytest.approx([0.01, 0, 0], abs=1e-12)
+    assert mesh_mass_properties(dae.triangles_m).volume_m3 == pytest.approx(1.53 * 0.2 * 0.03)
+
+
+def test_dae_matrix_scale_and_up_axis():
+    M = "2 0 0 1  0 1 0 0  0 0 1 0  0 0 0 1"          # scale x by 2, move x by 1
+    dae = parse_dae(dae_text(box_triangles((1, 2, 3)), meter=None, up_axis="Y_UP",
+                             node_xml=f"<matrix>{M}</matrix><scale>1 1 0.5</scale>",
+                             polylist=True).encode())
+    assert not dae.unit_declared and dae.metres_per_unit == 1.0
+    # x doubled, z halved; then Y up -> Z up swaps the y and z extents.
+    assert extent(dae.triangles) == pytest.approx([2.0, 1.5, 2.0])
+
+
+def test_dae_bounds_agree_with_trimesh(tmp_path):
+    """An independent reader (trimesh + pycollada) on the same file, transforms included."""
+    trimesh = pytest.importorskip("trimesh")
+    path = write_dae(tmp_path / "part.dae", box_triangles((0.3, 0.2, 0.1), centre=(1, 2, 3)),
+                     node_xml="<translate>0.5 0 0</translate><rotate>1 0 0 30</rotate>")
+    ours = read_mesh(path).triangles.reshape(-1, 3)
+    theirs = trimesh.load(str(path), force="mesh").vertices
+    assert ours.min(axis=0) == pytest.approx(theirs.min(axis=0), abs=1e-6)
+    assert ours.max(axis=0) == pytest.approx(theirs.max(axis=0), abs=1e-6)
+
+
+def test_obj_faces_and_agreement_with_trimesh(tmp_path):
+    trimesh = pytest.importorskip("trimesh")
+    path = write_obj(tmp_path / "part.obj", box_triangles((1, 2, 3)))
+    triangles = read_mesh(path).triangles
+    assert triangles.shape == (12, 3, 3)
+    assert mesh_mass_properties(triangles).volume_m3 == pytest.approx(6.0)
+    theirs = trimesh.load(str(path), force="mesh", process=False)
+    assert float(theirs.volume) == pytest.approx(6.0)
+    # A quad with v/vt/vn corners and relative indices: two triangles.
+    quad = parse_obj(b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf -4/1/1 -3/2/1 -2/3/1 -1/4/1\n")
+    assert quad.shape == (2, 3, 3)
+
+
+@pytest.mark.parametrize("data", [b"<COLLADA>", b"<svg/>", b"\x00\x01binary"])
+def test_dae_that_is_not_collada_is_refused(data):
+    with pytest.raises(ReedtoolError):
+        parse_dae(data)
+
+
+def test_validate_never_imports_trimesh_or_scipy(tmp_path):
+    """Importing the command and validating a RotorS-style model with .dae visuals."""
+    write_dae(tmp_path / "body.dae", box_triangles((300, 300, 80)), meter=0.001)
+    write_dae(tmp_path / "prop.dae", box_triangles((200, 20, 5)), meter=0.001)
+    (tmp_path / "m.urdf").write_text("""<?xml version="1.0"?>
+<robot name="m">
+  <link name="base_link"><inertial><mass value="1"/>
+    <inertia ixx="0.008033" ixy="0" ixz="0" iyy="0.008033" iyz="0" izz="0.015"/></inertial>
+    <visual><geometry><mesh filename="body.dae"/></geometry></visual>
+    <visual><geometry><mesh filename="body.dae"/></geometry></visual>
+    <collision><geometry><box size="0.3 0.3 0.08"/></geometry></collision></link>
+  <joint name="j" type="continuous"><parent link="base_link"/><child link="rotor"/>
+    <origin xyz="0.2 0 0.05"/><axis xyz="0 0 1"/></joint>
+  <link name="rotor"><inertial><mass value="0.005"/>
+    <inertia ixx="1.25e-05" ixy="0" ixz="0" iyy="1.25e-05" iyz="0" izz="2.5e-05"/></inertial>
+    <visual><geometry><mesh filename="prop.dae"/></geometry></visual>
+    <collision><geometry><cylinder length="0.005" radius="0.1"/></geometry></collision></link>
+</robot>
+""")
+    code = textwrap.dedent(f"""
+        import sys
+        import reedtool.commands.validate
+        from reedtool.cli import main
+        try:
+            main(["validate", {str(tmp_path / "m.urdf")!r}])
+        except SystemExit as exc:
+            print("exit", exc.code)
+        print(sorted({{m.split(".")[0] for m in sys.modules}} & {{"trimesh", "scipy"}}))
+    """)
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False,
+                          cwd=ROOT, env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
+    assert done.stdout.strip().splitlines()[-2:] == ["exit 0", "[]"], done.stdout + done.stderr
+
+
+def test_import_honours_the_dae_unit_and_guesses_only_without_one(tmp_path):
+    from reedtool.physics.mesh_import import import_mesh
+
+    # 300 x 200 x 100 with meter="0.01": centimetres declared, so 3 m x 2 m x 1 m, even
+    # though a guess from the size alone would call 300 units millimetres.
+    declared = import_mesh(write_dae(tmp_path / "cm.dae", box_triangles((300, 200, 100)),
+                                     meter=0.01), units="auto")
+    assert (declared.units.unit, declared.units.guessed) == ("cm", False)
+    assert declared.size_m == pytest.approx([3.0, 2.0, 1.0])
+    assert declared.mass.volume_m3 == pytest.approx(6.0)
+    unitless = import_mesh(write_obj(tmp_path / "mm.obj", box_triangles((300, 200, 100))),
+                           units="auto")
+    assert (unitless.units.unit, unitless.units.guessed) == ("mm", True)
+    assert unitless.size_m == pytest.approx([0.3, 0.2, 0.1])
