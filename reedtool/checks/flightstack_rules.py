@@ -470,7 +470,8 @@ def px4_param_out_of_range(ctx: CheckContext) -> Iterator[Issue]:
     table in reedtool.flightstack.px4, with its sources): CA_ROTOR_COUNT 0..12,
     CA_ROTORi_KM -1..1, positions and axes -100..100, SIM_GZ_EC_MIN/MAX 0..1000 rad/s,
     MPC_THR_HOVER 0.1..0.8, THR_MDL_FAC 0..1. QGroundControl refuses such values, and
-    PX4 may clamp them.
+    PX4 may clamp them. SIM_GZ_EC_MIN/MAX are left to C419/C420/C424, which compare them
+    with the model's motors (PX4's own px4vision airframe commands up to 1100 rad/s).
     """
     from reedtool.flightstack.px4 import out_of_range
 
@@ -478,6 +479,8 @@ def px4_param_out_of_range(ctx: CheckContext) -> Iterator[Issue]:
         if params.kind != "px4":
             continue
         for value, (low, high, _default, source) in out_of_range(params):
+            if value.name.startswith("SIM_GZ_EC_"):
+                continue
             yield Issue(f"{value.name} {value.value:g} is outside {low:g}..{high:g} ({source})",
                         value.loc, value.name)
 
@@ -501,6 +504,8 @@ def _ap_pairs(ctx: CheckContext, params: "ArduPilotParams"):
     """(AP motor, servo output, the SERVOn_FUNCTION line or None, model rotor)."""
     motors = _ap_frame(params) or ()
     rotors = _lift_rotors(ctx)
+    if len(motors) != len(rotors):
+        return []                                  # C431 says so; nothing pairs up
     with_channels = [r for r in rotors if _channel(r) is not None]
     if with_channels:
         by_output = {_channel(r) + 1: r for r in with_channels}
