@@ -251,7 +251,7 @@ def px4_airframe_text(name: str, rotors: list[RotorSpec], *, hover_throttle: flo
              "param set-default SIM_GZ_EN 1", "", "param set-default CA_AIRFRAME 0",
              f"param set-default CA_ROTOR_COUNT {len(order)}", ""]
     for i, rotor in enumerate(order):
-        p = frd_from_flu(rotor.position_flu_m)
+        p = np.round(frd_from_flu(rotor.position_flu_m), 9) + 0.0   # no "-0" in the file
         km = rotor.turning_sign * min(abs(rotor.moment_constant), 1.0)
         lines += [f"param set-default CA_ROTOR{i}_PX {p[0]:.6g}",
                   f"param set-default CA_ROTOR{i}_PY {p[1]:.6g}",
