@@ -240,6 +240,8 @@ def test_plus_frame_type_on_x_model(tmp_path):
     findings = ap_findings(tmp_path, text)
     assert not_info(findings) == ["C432"] * 4
     assert all(f"vehicle.parm:{line_of(text, 'FRAME_TYPE')}" in f.message for f in findings)
+    assert {f.line for f in findings} == {line_of(text, "FRAME_TYPE")}
+    assert all("x500_flat.sdf:" in f.message for f in findings)
 
 
 def test_swapped_servo_channels(tmp_path):
@@ -287,3 +289,13 @@ def test_match_frame_finds_quad_x_numbers():
     assert found == (1, 1, [1, 2, 3, 4])
     assert ardupilot.match_frame([45, -135, -45, 135], [1, 1, 1, -1]) is None
     assert np.isclose(ardupilot.angle_gap_deg(170, -170), 20)
+
+
+def test_docs_motor_tables_are_the_data():
+    doc = (Path(__file__).parents[1] / "docs" / "validate.md").read_text()
+    spin = {1: "CCW", -1: "CW", 0: "-"}
+    for (frame_class, frame_type), motors in ardupilot.MOTOR_TABLES.items():
+        cell = "; ".join(f"{m.number} {m.bearing_deg:g} {spin[m.spin]} ({m.test_order})"
+                         for m in motors)
+        assert f"| {frame_class} / {frame_type if frame_type is not None else 'other'} |" in doc
+        assert cell in doc, (frame_class, frame_type)

@@ -588,11 +588,16 @@ def ardupilot_motor_position(ctx: CheckContext) -> Iterator[Issue]:
             gap = _gap(motor.bearing_deg, _bearing(model))
             if gap <= BEARING_TOL_DEG and _same_quadrant(table * np.hypot(*model[:2]), model):
                 continue
+            # A motor whose bearing some model rotor has is misrouted (the SERVO line is
+            # to edit); one no rotor has means the frame type is not the model's.
+            routed = line is not None and any(
+                _gap(motor.bearing_deg, _bearing(_frd_about_com(ctx, r))) <= BEARING_TOL_DEG
+                for r in _lift_rotors(ctx))
             yield Issue(f"{_ap_where(params)} puts motor {motor.number} at bearing "
                         f"{motor.bearing_deg:g}°; it is sent on {_output_text(output, line)} "
                         f"to {_rotor_label(rotor)}, which sits at bearing "
                         f"{_bearing(model):.1f}° ({gap:.1f}° apart)",
-                        line.loc if line is not None else params.frame()[0].loc,
+                        line.loc if routed else params.frame()[1].loc,
                         rotor.joint or rotor.name,
                         hint="set FRAME_TYPE to the model's layout, or SERVOn_FUNCTION so "
                              f"motor {motor.number} reaches the rotor at {motor.bearing_deg:g}°")
