@@ -55,6 +55,11 @@ def _lift_rotors(ctx: CheckContext) -> list["Rotor"]:
     return [r for r in ctx.rotors if getattr(r, "role", "lift") == "lift"]
 
 
+def _all_rotors(ctx: CheckContext) -> list["Rotor"]:
+    """Every motor: PX4's CA_ROTOR table lists lift rotors and pushers/pullers alike."""
+    return ctx.rotors if ctx.tree_ok else []
+
+
 def _actuator(rotor: "Rotor") -> int | None:
     return rotor.motor_number
 
@@ -104,7 +109,7 @@ def _ardupilot(ctx: CheckContext) -> list["ArduPilotParams"]:
 def _px4_pairs(ctx: CheckContext, params: "Px4Params"
                ) -> list[tuple["Px4Rotor", int, "Rotor"]]:
     """(CA rotor, gz output k, model rotor on actuator k-1) for every connected pair."""
-    by_actuator = {_actuator(r): r for r in _lift_rotors(ctx) if _actuator(r) is not None}
+    by_actuator = {_actuator(r): r for r in _all_rotors(ctx) if _actuator(r) is not None}
     pairs = []
     for ca in params.rotors():
         outputs = params.outputs_of(ca.index) if params.uses_gz_outputs else [ca.index + 1]
@@ -117,14 +122,15 @@ def _px4_pairs(ctx: CheckContext, params: "Px4Params"
 # --------------------------------------------------------------- PX4: table shape
 
 @rule("C413", "px4-rotor-count", "error",
-      "CA_ROTOR_COUNT differs from the number of lift rotors in the model.")
+      "CA_ROTOR_COUNT differs from the number of rotors in the model.")
 def px4_rotor_count(ctx: CheckContext) -> Iterator[Issue]:
     """PX4's control allocation builds one effectiveness column per CA rotor. With fewer
     CA rotors than motors in the model, some motors are never commanded; with more, PX4
     allocates thrust to rotors that do not exist. Either way the vehicle cannot hover.
-    A missing CA_ROTOR_COUNT is PX4's default 0.
+    A missing CA_ROTOR_COUNT is PX4's default 0. Pushers and pullers count: PX4 lists
+    every rotor (a standard VTOL has five).
     """
-    rotors = _lift_rotors(ctx)
+    rotors = _all_rotors(ctx)
     for params in _px4(ctx):
         count = params.get("CA_ROTOR_COUNT")
         if not rotors or count.value == len(rotors):
@@ -132,7 +138,7 @@ def px4_rotor_count(ctx: CheckContext) -> Iterator[Issue]:
         where = ", ".join(str(r.loc) for r in rotors[:4]) + (", ..." if len(rotors) > 4 else "")
         written = f"({count.loc})" if count.explicit else "(not set: PX4's default)"
         yield Issue(f"CA_ROTOR_COUNT {count.value:g} {written}, but the model has "
-                    f"{len(rotors)} lift rotor(s) ({where})", count.loc, "CA_ROTOR_COUNT",
+                    f"{len(rotors)} rotor(s) ({where})", count.loc, "CA_ROTOR_COUNT",
                     hint=f"param set-default CA_ROTOR_COUNT {len(rotors)}")
 
 
@@ -146,7 +152,7 @@ def px4_output_mapping(ctx: CheckContext) -> Iterator[Issue]:
     """
     from reedtool.flightstack.px4 import MAX_GZ_OUTPUTS, MOTOR_FUNCTION_BASE
 
-    rotors = _lift_rotors(ctx)
+    rotors = _all_rotors(ctx)
     by_actuator = {_actuator(r): r for r in rotors if _actuator(r) is not None}
     for params in _px4(ctx):
         if not rotors or not params.uses_gz_outputs:
@@ -186,7 +192,7 @@ def px4_output_mapping(ctx: CheckContext) -> Iterator[Issue]:
 # --------------------------------------------------------------- PX4: per rotor
 
 def _describes_other(ctx: CheckContext, ca: "Px4Rotor", rotor: "Rotor") -> str:
-    for other in _lift_rotors(ctx):
+    for other in _all_rotors(ctx):
         if other is rotor:
             continue
         p = _frd_about_com(ctx, other)
@@ -375,9 +381,12 @@ def _hover_speeds(ctx: CheckContext) -> dict[int, float] | None:
     if not _physics_ready(ctx):
         return None
     trim = ctx.trim
-    if not trim.feasible or len(trim.omega_rad_s) != len(ctx.rotors):
+    if not trim.feasible:
         return None
-    return {id(r): float(w) for r, w in zip(ctx.rotors, trim.omega_rad_s)}
+    for rotors in (ctx.rotors, _lift_rotors(ctx)):   # the trim's rotors: all, or lift only
+        if len(trim.omega_rad_s) == len(rotors):
+            return {id(r): float(w) for r, w in zip(rotors, trim.omega_rad_s)}
+    return None
 
 
 @rule("C420", "px4-idle-command", "error",
@@ -416,10 +425,14 @@ def _hover_throttle(ctx: CheckContext, params: "Px4Params") -> tuple[float, floa
     needed = []
     for ca, k, rotor in pairs:
         low, high = params.get(f"SIM_GZ_EC_MIN{k}").value, params.get(f"SIM_GZ_EC_MAX{k}").value
-        if high <= low or id(rotor) not in hover:
+        if id(rotor) not in hover:
+            continue                                 # a pusher: not part of the hover
+        if high <= low:
             return None
         u = (hover[id(rotor)] - low) / (high - low)
         needed.append(thrust_fraction(min(max(u, 0.0), 1.0), factor))
+    if not needed:
+        return None
     return float(np.mean(needed)), params.get("MPC_THR_HOVER").value
 
 

@@ -17,7 +17,7 @@ import numpy as np
 from reedtool.checks.context import CheckContext
 from reedtool.checks.finding import Issue
 from reedtool.checks.registry import rule
-from reedtool.checks.rotor_rules import _physics_ready
+from reedtool.checks.rotor_rules import MAX_CONDITION_NUMBER, _normalised_allocation, _physics_ready
 
 if TYPE_CHECKING:
     from reedtool.physics.rotors import Rotor
@@ -145,9 +145,13 @@ def uneven_hover_trim(ctx: CheckContext) -> Iterator[Issue]:
     centre of mass sits over the rotors' centroid. Otherwise some rotors hover harder than
     others (one arm 0.15 m longer: one pair at 65 %, the other at 77 % of full speed),
     losing control margin on one side. Reported when the largest hover thrust is more
-    than 15 % above the smallest, with the COM shift that would even them out.
+    than 15 % above the smallest, with the COM shift that would even them out. A nearly
+    singular allocation (R306) spreads the thrusts by its geometry alone; that is R306's
+    finding, not this one.
     """
     if not _physics_ready(ctx):
+        return
+    if float(np.linalg.cond(_normalised_allocation(ctx))) > MAX_CONDITION_NUMBER:
         return
     rotors, trim = ctx.rotors, ctx.trim
     lift = _lift(ctx)
