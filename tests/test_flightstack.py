@@ -299,3 +299,21 @@ def test_docs_motor_tables_are_the_data():
                          for m in motors)
         assert f"| {frame_class} / {frame_type if frame_type is not None else 'other'} |" in doc
         assert cell in doc, (frame_class, frame_type)
+
+
+def test_parm_formats():
+    # .parm (space), Mission Planner (comma) and QGC (tab) lines read the same.
+    text = "FRAME_CLASS 1\nFRAME_TYPE,1\n1\t1\tSERVO1_FUNCTION\t33\t2\n"
+    params = ardupilot.parse_parm(text, "p")
+    assert [params.get(n).value for n in ("FRAME_CLASS", "FRAME_TYPE", "SERVO1_FUNCTION")] \
+        == [1, 1, 33]
+    assert params.get("SERVO1_FUNCTION").loc.line == 3
+
+
+def test_cli_missing_airframe_is_one_line(tmp_path):
+    from cli_helpers import run_cli
+
+    code, output = run_cli("validate", X500, "--airframe", tmp_path / "nope")
+    assert code == 2 and "nope" in output and "file not found" in output
+    code, output = run_cli("validate", X500, "--airframe", FIX / "x500_airframe")
+    assert code == 0 and "C421" in output

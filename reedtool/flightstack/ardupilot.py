@@ -165,6 +165,8 @@ class ArduPilotParams:
 
 
 _LINE = re.compile(r"^\s*([A-Za-z][A-Za-z0-9_]*)[\s,=]+([-+0-9.eE]+)\s*(#.*)?$")
+# A QGroundControl export of ArduPilot parameters: vehicle, component, NAME, VALUE, type.
+_QGC_LINE = re.compile(r"^\s*\d+\t\d+\t([A-Za-z][A-Za-z0-9_]*)\t(\S+)\t\d+\s*$")
 
 
 def parse_parm(text: str, file: str) -> ArduPilotParams:
@@ -173,7 +175,7 @@ def parse_parm(text: str, file: str) -> ArduPilotParams:
         stripped = line.strip()
         if not stripped or stripped.startswith("#"):
             continue
-        match = _LINE.match(line)
+        match = _QGC_LINE.match(line) or _LINE.match(line)
         loc = SourceLoc(file, number)
         if not match:
             raise ReedtoolError(f"cannot read '{stripped}' as `NAME VALUE`", file=file,
