@@ -37,11 +37,6 @@ MAX_GZ_OUTPUTS = 8                 # SIM_GZ_EC has 8 channels (gz_bridge module.
 MAX_CA_ROTORS = 12
 
 # Documented ranges of the parameters reedtool reads or writes: (min, max, default, source).
-# Sources: PX4-Autopilot src/modules/control_allocator/module.yaml (CA_*),
-# src/modules/simulation/gz_bridge/module.yaml (SIM_GZ_EC_* standard_params),
-# src/modules/mc_pos_control/multicopter_position_control_params (MPC_THR_HOVER),
-# src/modules/mc_pos_control (THR_MDL_FAC is defined by the actuator/mixer params:
-# "Thrust to motor control signal model parameter", 0..1).
 _CA = "PX4-Autopilot src/modules/control_allocator/module.yaml"
 _GZ = "PX4-Autopilot src/modules/simulation/gz_bridge/module.yaml"
 PARAM_RANGES: dict[str, tuple[float, float, float | None, str]] = {
@@ -55,8 +50,9 @@ PARAM_RANGES: dict[str, tuple[float, float, float | None, str]] = {
     "CA_ROTOR#_KM": (-1.0, 1.0, 0.05, _CA),
     "SIM_GZ_EC_MIN#": (0.0, 1000.0, 0.0, _GZ),
     "SIM_GZ_EC_MAX#": (0.0, 1000.0, 1000.0, _GZ),
-    "MPC_THR_HOVER": (0.1, 0.8, 0.5, "PX4-Autopilot mc_pos_control parameters"),
-    "THR_MDL_FAC": (0.0, 1.0, 0.0, "PX4 parameter reference (THR_MDL_FAC)"),
+    "MPC_THR_HOVER": (0.1, 0.8, 0.5, "PX4-Autopilot src/modules/mc_pos_control "
+                                     "(PARAM_DEFINE_FLOAT MPC_THR_HOVER: @min 0.1, @max 0.8)"),
+    "THR_MDL_FAC": (0.0, 1.0, 0.0, "PX4 parameter reference, THR_MDL_FAC (0..1)"),
 }
 
 _QGC_LINE = re.compile(r"^\s*(\d+)\t(\d+)\t([A-Za-z0-9_]+)\t(\S+)\t(\d+)\s*$")
@@ -114,7 +110,7 @@ class Px4Params:
         """The value set in the file, else PX4's documented default (explicit=False)."""
         if name in self.values:
             return self.values[name]
-        low, high, default, _ = PARAM_RANGES.get(range_key(name), (0, 0, None, ""))
+        default = PARAM_RANGES.get(range_key(name), (0, 0, None, ""))[2]
         return ParamValue(name, math.nan if default is None else float(default),
                           "", self.loc, explicit=False)
 
