@@ -117,6 +117,18 @@ class CheckContext:
         return discover_rotors(self.robot)
 
     @cached_property
+    def lift_rotors(self) -> list["Rotor"]:
+        """The rotors that hold the robot up: propulsion rotors (pushers) left out."""
+        return [r for r in self.rotors if r.role == "lift"]
+
+    @cached_property
+    def omnidirectional(self) -> bool:
+        """Reversible or every-direction rotors: hover uses the 6-DoF allocation."""
+        from reedtool.physics.rotors import is_omnidirectional
+
+        return is_omnidirectional(self.lift_rotors)
+
+    @cached_property
     def controller_tables(self) -> list:
         """Every controller rotor table: velocity-control plugins in the model, then files."""
         from reedtool.flightstack.controller_tables import velocity_control_tables
@@ -141,14 +153,22 @@ class CheckContext:
         """(4, n) map from rotor thrusts [N] to [thrust, roll, pitch, yaw] about the COM."""
         from reedtool.physics.allocation import allocation_matrix
 
-        return allocation_matrix(self.rotors, self.whole_robot.com_m)
+        return allocation_matrix(self.lift_rotors, self.whole_robot.com_m)
+
+    @cached_property
+    def wrench_allocation(self) -> np.ndarray:
+        """(6, n) map from lift-rotor thrusts to force and torque about the COM."""
+        from reedtool.physics.allocation import wrench_matrix
+
+        return wrench_matrix(self.lift_rotors, self.whole_robot.com_m)
 
     @cached_property
     def trim(self):
-        from reedtool.physics.trim import solve_trim
+        from reedtool.physics.trim import solve_trim, solve_trim_6dof
 
         whole = self.whole_robot
-        return solve_trim(whole.mass_kg, whole.com_m, self.rotors)
+        solve = solve_trim_6dof if self.omnidirectional else solve_trim
+        return solve(whole.mass_kg, whole.com_m, self.lift_rotors)
 
     def geometry_mass_properties(self, link: Link):
         """Mass properties of the link's own geometry at its declared mass, in the link frame.

@@ -1,6 +1,10 @@
 """Rotor rules (R3xx): the motor plugins describe rotors that can hold the robot in hover.
 
-They run only when motor-model plugins (RotorS, PX4 classic, gz-sim) are found. Geometry
+They run only when rotors are found (RotorS, PX4 classic and gz-sim motor models,
+ArduPilotPlugin velocity controls: reedtool.physics.rotors). The wiring rules (numbers,
+directions, targets) see every rotor; the hover rules see the lift rotors only (a pusher
+or puller is propulsion), and an omnidirectional frame is judged by its 6-DoF allocation.
+Geometry
 comes from reedtool.physics.rotors, the allocation matrix from reedtool.physics.allocation and the hover
 trim from reedtool.physics.trim; this module interprets them.
 """
@@ -43,7 +47,18 @@ def _fmt(value: float) -> str:
 
 
 def _rotors(ctx: CheckContext) -> list["Rotor"]:
+    """Every rotor (for the wiring rules)."""
     return ctx.rotors if ctx.tree_ok else []
+
+
+def _lift(ctx: CheckContext) -> list["Rotor"]:
+    """The lift rotors (for the hover rules)."""
+    return ctx.lift_rotors if ctx.tree_ok else []
+
+
+def _written(rotor: "Rotor") -> bool:
+    """Constants written in a motor plugin (ArduPilot's come from LiftDrag, if at all)."""
+    return rotor.kind != "ardupilot"
 
 
 def _constants_ok(rotor: "Rotor") -> bool:
@@ -54,7 +69,7 @@ def _constants_ok(rotor: "Rotor") -> bool:
 
 def _physics_ready(ctx: CheckContext) -> bool:
     """Every rotor placed, turning a known way, with usable constants; the robot has mass."""
-    rotors = _rotors(ctx)
+    rotors = _lift(ctx)
     if not rotors:
         return False
     for rotor in rotors:
@@ -71,16 +86,26 @@ def _physics_ready(ctx: CheckContext) -> bool:
 
 
 def _direction_loc(rotor: "Rotor"):
-    return rotor.plugin.param_loc("turningDirection")
+    return rotor.param_loc(rotor.direction_tag)
 
 
 # --------------------------------------------------------------- plugin wiring
 
+def _number_what(rotor: "Rotor") -> str:
+    return {"actuator_number": "actuator_number", "channel": "channel"}.get(
+        rotor.number_tag, "motor number")
+
+
+def _number_loc(rotor: "Rotor"):
+    return rotor.param_loc(rotor.number_tag)
+
+
 @rule("R301", "motor-number-duplicate", "error", "Two rotors have the same motor number.")
 def motor_number_duplicate(ctx: CheckContext) -> Iterator[Issue]:
-    """`<motorNumber>` is the rotor's index in the motor speed command the controller
-    sends. Two rotors with the same number receive the same command and another index
-    drives nothing; the vehicle flips on take-off.
+    """The motor number (`<motorNumber>`; gz-sim `<actuator_number>`; ArduPilot the
+    `<control channel>`) is the rotor's index in the command the flight stack sends. Two
+    rotors with the same number receive the same command and another index drives
+    nothing; the vehicle flips on take-off.
     """
     seen: dict[int, "Rotor"] = {}
     for rotor in _rotors(ctx):
@@ -88,8 +113,8 @@ def motor_number_duplicate(ctx: CheckContext) -> Iterator[Issue]:
         if number is None:
             continue
         if number in seen:
-            yield Issue(f"rotor '{rotor.name}' has motor number {number}, already used by "
-                        f"'{seen[number].name}'", rotor.plugin.param_loc("motorNumber"),
+            yield Issue(f"rotor '{rotor.name}' has {_number_what(rotor)} {number}, already "
+                        f"used by '{seen[number].name}'", _number_loc(rotor),
                         rotor.name, hint="number the rotors 0, 1, ..., n-1, each once")
         else:
             seen[number] = rotor
@@ -102,15 +127,17 @@ def motor_numbers_not_contiguous(ctx: CheckContext) -> Iterator[Issue]:
     has n entries and a rotor numbered n or above never receives one. A missing or
     unreadable `<motorNumber>` is reported here as well.
     """
-    rotors = _rotors(ctx)
+    # ArduPilot channels are servo outputs mapped by SERVOn_FUNCTION: any channel is fine.
+    rotors = [r for r in _rotors(ctx) if r.kind != "ardupilot"]
     if not rotors:
         return
     for rotor in rotors:
         if rotor.motor_number is None:
-            raw = rotor.plugin.param("motorNumber")
-            what = f"'{raw}' is not a motor number" if raw is not None else "no <motorNumber>"
-            yield Issue(f"rotor '{rotor.name}': {what}", rotor.plugin.param_loc("motorNumber"),
-                        rotor.name, hint="add <motorNumber>N</motorNumber>, N from 0 to "
+            tag = rotor.number_tag
+            raw = rotor.param(tag)
+            what = f"'{raw}' is not a motor number" if raw is not None else f"no <{tag}>"
+            yield Issue(f"rotor '{rotor.name}': {what}", _number_loc(rotor),
+                        rotor.name, hint=f"add <{tag}>N</{tag}>, N from 0 to "
                                          f"{len(rotors) - 1}")
     numbers = {r.motor_number for r in rotors if r.motor_number is not None}
     expected = set(range(len(rotors)))
@@ -118,9 +145,9 @@ def motor_numbers_not_contiguous(ctx: CheckContext) -> Iterator[Issue]:
     missing = sorted(expected - numbers)
     for rotor in rotors:
         if rotor.motor_number in outside:
-            yield Issue(f"rotor '{rotor.name}' has motor number {rotor.motor_number}; with "
-                        f"{len(rotors)} rotors the numbers are 0..{len(rotors) - 1}",
-                        rotor.plugin.param_loc("motorNumber"), rotor.name,
+            yield Issue(f"rotor '{rotor.name}' has {_number_what(rotor)} {rotor.motor_number}; "
+                        f"with {len(rotors)} rotors the numbers are 0..{len(rotors) - 1}",
+                        _number_loc(rotor), rotor.name,
                         hint=f"unused numbers: {', '.join(map(str, missing))}"
                         if missing else None)
 
@@ -132,6 +159,13 @@ def rotor_direction_invalid(ctx: CheckContext) -> Iterator[Issue]:
     rotor with an undefined sign.
     """
     for rotor in _rotors(ctx):
+        if rotor.kind == "ardupilot":
+            if rotor.turning_sign == 0:
+                yield Issue(f"rotor '{rotor.name}': <multiplier> '{rotor.param('multiplier')}' "
+                            "gives no spin direction", _direction_loc(rotor), rotor.name,
+                            hint="a positive multiplier spins the joint along its axis, a "
+                                 "negative one against it")
+            continue
         if rotor.direction not in DIRECTIONS:
             what = f"'{rotor.direction}'" if rotor.direction else "missing"
             yield Issue(f"rotor '{rotor.name}': turning direction {what}", _direction_loc(rotor),
@@ -149,7 +183,7 @@ def yaw_moment_imbalance(ctx: CheckContext) -> Iterator[Issue]:
 
     The hint names the rotor whose direction, flipped, balances the set when there is one.
     """
-    found = _yaw_imbalance(ctx)
+    found = None if ctx.omnidirectional else _yaw_imbalance(ctx)
     if found is None:
         return
     rotors, net_N_m, total_N_m = found
@@ -173,7 +207,7 @@ def _equal_speed_yaw(ctx: CheckContext, signs: np.ndarray) -> tuple[float, float
     Only the rotors' drag reaction (-turning_sign * momentConstant * thrust along the
     rotor axis) counts: the yaw a tilted rotor makes through its lever arm is R311's.
     """
-    rotors = _rotors(ctx)
+    rotors = _lift(ctx)
     k = np.array([r.motor_constant for r in rotors])
     axis_z = np.array([r.axis[2] / np.linalg.norm(r.axis) for r in rotors])
     km = np.array([r.moment_constant for r in rotors])
@@ -188,7 +222,7 @@ def _equal_speed_yaw(ctx: CheckContext, signs: np.ndarray) -> tuple[float, float
 def _yaw_imbalance(ctx: CheckContext):
     if not _physics_ready(ctx):
         return None
-    rotors = _rotors(ctx)
+    rotors = _lift(ctx)
     signs = np.array([r.turning_sign for r in rotors], dtype=float)
     net, total = _equal_speed_yaw(ctx, signs)
     if total <= 0 or abs(net) <= YAW_BALANCE_REL_TOL * total:
@@ -215,7 +249,7 @@ def _normalised_allocation(ctx: CheckContext, signs: np.ndarray | None = None) -
     """The allocation matrix with each row scaled to unit norm (unit-free conditioning)."""
     A = ctx.allocation.copy()
     if signs is not None:
-        rotors = _rotors(ctx)
+        rotors = _lift(ctx)
         current = np.array([r.turning_sign for r in rotors], dtype=float)
         drag = np.array([r.moment_constant * r.axis[2] / np.linalg.norm(r.axis) for r in rotors])
         A[3] = A[3] + (current - signs) * drag
@@ -241,7 +275,12 @@ def allocation_rank_deficient(ctx: CheckContext) -> Iterator[Issue]:
     commanded: typically neighbouring rotors of a quad-X turn the same way (yaw becomes
     roll or pitch), or all rotors lie on one line.
     """
-    if not _physics_ready(ctx) or _rank(ctx) == 4:
+    if not _physics_ready(ctx):
+        return
+    if ctx.omnidirectional:
+        yield from _wrench_rank_deficient(ctx)
+        return
+    if _rank(ctx) == 4:
         return
     A = _normalised_allocation(ctx)
     u, s, _vt = np.linalg.svd(A)
@@ -253,9 +292,31 @@ def allocation_rank_deficient(ctx: CheckContext) -> Iterator[Issue]:
     hint = ("check the turning directions: diagonal rotors of a quad-X share a direction, "
             "neighbours alternate") if "yaw" in coupled else \
         "spread the rotors around the centre of mass in both x and y"
-    yield Issue(f"allocation matrix has rank {rank} < 4 for {len(_rotors(ctx))} rotors: "
-                f"{', '.join(names)} cannot be set independently", _rotors(ctx)[0].loc,
+    yield Issue(f"allocation matrix has rank {rank} < 4 for {len(_lift(ctx))} rotors: "
+                f"{', '.join(names)} cannot be set independently", _lift(ctx)[0].loc,
                 "rotors", hint=hint)
+
+
+_WRENCH_AXES = ("force x", "force y", "force z", "roll", "pitch", "yaw")
+
+
+def _wrench_rank_deficient(ctx: CheckContext) -> Iterator[Issue]:
+    """Omnidirectional frames: the 6 x n force-and-torque allocation must have rank 6."""
+    W = ctx.wrench_allocation
+    norms = np.linalg.norm(W, axis=1, keepdims=True)
+    W = np.divide(W, norms, out=np.zeros_like(W), where=norms > 0)
+    u, s, _vt = np.linalg.svd(W)
+    rank = int(np.sum(s > RANK_TOL * max(s.max(initial=0), 1e-300)))
+    if rank == 6:
+        return
+    coupled = set()
+    for vector in u[:, rank:].T:
+        coupled |= {_WRENCH_AXES[i] for i in np.flatnonzero(np.abs(vector) > 1e-6)}
+    yield Issue(f"omnidirectional frame: the force-and-torque allocation has rank {rank} < 6 "
+                f"for {len(_lift(ctx))} rotors: "
+                f"{', '.join(a for a in _WRENCH_AXES if a in coupled)} cannot be set "
+                "independently", _lift(ctx)[0].loc, "rotors",
+                hint="point the rotors in more independent directions")
 
 
 @rule("R306", "allocation-ill-conditioned", "warning",
@@ -265,12 +326,12 @@ def allocation_ill_conditioned(ctx: CheckContext) -> Iterator[Issue]:
     condition number 1. Above 25 one axis is controlled only by large, opposing thrust
     changes: the controller saturates motors on small commands.
     """
-    if not _physics_ready(ctx) or _rank(ctx) < 4:
+    if not _physics_ready(ctx) or ctx.omnidirectional or _rank(ctx) < 4:
         return
     cond = float(np.linalg.cond(_normalised_allocation(ctx)))
     if cond > MAX_CONDITION_NUMBER:
         yield Issue(f"allocation matrix condition number {cond:.3g} > {MAX_CONDITION_NUMBER:g} "
-                    "(rows scaled to unit norm)", _rotors(ctx)[0].loc, "rotors",
+                    "(rows scaled to unit norm)", _lift(ctx)[0].loc, "rotors",
                     hint="place the rotors symmetrically about the centre of mass")
 
 
@@ -287,14 +348,18 @@ def trim_infeasible(ctx: CheckContext) -> Iterator[Issue]:
 
     Not reported when R304, R305 or R308 already explain it.
     """
-    if not _physics_ready(ctx) or _rank(ctx) < 4 or _yaw_imbalance(ctx) is not None:
+    if not _physics_ready(ctx):
+        return
+    if not ctx.omnidirectional and (_rank(ctx) < 4 or _yaw_imbalance(ctx) is not None):
+        return
+    if ctx.omnidirectional and next(_wrench_rank_deficient(ctx), None) is not None:
         return
     trim = ctx.trim
     if trim.feasible or trim.thrust_to_weight < THRUST_TO_WEIGHT_MIN:
         return
     com = ctx.whole_robot.com_m
     yield Issue(f"no hover trim: {trim.message} (COM at {', '.join(_fmt(v) for v in com)} m "
-                "in the base frame)", _rotors(ctx)[0].loc, "rotors",
+                "in the base frame)", _lift(ctx)[0].loc, "rotors",
                 hint="move the centre of mass (link masses and <inertial> origins) over the "
                      "middle of the rotors, or move the rotors")
 
@@ -311,10 +376,14 @@ def _weight_and_trim(ctx: CheckContext):
 def _omega_for(ctx: CheckContext, ratio: float) -> str:
     """maxRotVelocity that would bring thrust-to-weight to `ratio` (same for all rotors)."""
     trim = ctx.trim
-    omega = max(r.max_rot_velocity_rad_s for r in _rotors(ctx))
+    omega = max(r.max_rot_velocity_rad_s for r in _lift(ctx))
     needed = omega * math.sqrt(ratio / trim.thrust_to_weight) if trim.thrust_to_weight > 0 \
         else float("inf")
     return f"{needed:.0f} rad/s"
+
+
+def _max_loc(rotor: "Rotor"):
+    return rotor.param_loc("multiplier" if rotor.kind == "ardupilot" else "maxRotVelocity")
 
 
 @rule("R308", "thrust-to-weight-below-one", "error",
@@ -331,7 +400,7 @@ def thrust_to_weight_below_one(ctx: CheckContext) -> Iterator[Issue]:
     yield Issue(f"thrust-to-weight {trim.thrust_to_weight:.3g} < 1: the rotors give at most "
                 f"{_fmt(trim.thrust_to_weight * trim.weight_N)} N, the robot weighs "
                 f"{_fmt(trim.weight_N)} N ({_fmt(ctx.whole_robot.mass_kg)} kg)",
-                _rotors(ctx)[0].plugin.param_loc("maxRotVelocity"), "rotors",
+                _max_loc(_lift(ctx)[0]), "rotors",
                 hint=f"check mass and motor constants; for thrust-to-weight "
                      f"{THRUST_TO_WEIGHT_WARN:g} maxRotVelocity would be "
                      f"{_omega_for(ctx, THRUST_TO_WEIGHT_WARN)}")
@@ -350,7 +419,7 @@ def thrust_to_weight_low(ctx: CheckContext) -> Iterator[Issue]:
     yield Issue(f"thrust-to-weight {trim.thrust_to_weight:.3g} < {THRUST_TO_WEIGHT_WARN:g}: "
                 f"{_fmt(trim.thrust_to_weight * trim.weight_N)} N of thrust for "
                 f"{_fmt(trim.weight_N)} N of weight",
-                _rotors(ctx)[0].plugin.param_loc("maxRotVelocity"), "rotors",
+                _max_loc(_lift(ctx)[0]), "rotors",
                 hint=f"maxRotVelocity {_omega_for(ctx, THRUST_TO_WEIGHT_WARN)} (or a "
                      "correspondingly larger motor constant, or less mass) gives 1.5")
 
@@ -365,14 +434,14 @@ def hover_throttle_high(ctx: CheckContext) -> Iterator[Issue]:
     trim = _weight_and_trim(ctx)
     if trim is None or not trim.feasible or trim.hover_throttle_max <= HOVER_THROTTLE_MAX:
         return
-    rotors = _rotors(ctx)
+    rotors = _lift(ctx)
     worst = int(np.argmax(trim.throttle))
     rotor = rotors[worst]
     needed = trim.omega_rad_s[worst] / HOVER_THROTTLE_MAX
     yield Issue(f"rotor '{rotor.name}' hovers at {trim.omega_rad_s[worst]:.0f} rad/s, "
                 f"{100 * trim.throttle[worst]:.0f}% of its maximum "
                 f"{_fmt(rotor.max_rot_velocity_rad_s)} rad/s",
-                rotor.plugin.param_loc("maxRotVelocity"), rotor.name,
+                _max_loc(rotor), rotor.name,
                 hint=f"maxRotVelocity >= {needed:.0f} rad/s keeps hover at 80%")
 
 
@@ -384,8 +453,14 @@ def rotor_axis_tilted(ctx: CheckContext) -> Iterator[Issue]:
     that axis is the base link's z; a tilt usually comes from an `rpy` on the rotor joint
     or an axis written in the wrong frame. Deliberately tilted designs can ignore this
     rule (`--ignore R311`).
+
+    A balanced pattern (R320: several rotors tilted so that their side forces and tilt
+    yaw torques cancel, as on the AscTec Neo) is information, not this warning. Propulsion
+    rotors (R319) and omnidirectional frames are not judged by tilt.
     """
-    for rotor in _rotors(ctx):
+    if ctx.omnidirectional or balanced_tilt(ctx) is not None:
+        return
+    for rotor in _lift(ctx):
         axis = np.asarray(rotor.axis, dtype=float)
         norm = np.linalg.norm(axis)
         if not np.all(np.isfinite(axis)) or norm == 0:
@@ -448,16 +523,21 @@ def rotor_plugin_target_missing(ctx: CheckContext) -> Iterator[Issue]:
     """
     import difflib
 
+    from reedtool.physics.rotors import resolve_name
+
     for rotor in _rotors(ctx):
-        for tag, name, table in (("jointName", rotor.joint, ctx.robot.joint_map),
-                                 ("linkName", rotor.plugin.param("linkName"), ctx.robot.link_map)):
+        for tag, name, table in (("jointName", rotor.param("jointName"), ctx.robot.joint_map),
+                                 ("linkName", rotor.param("linkName"), ctx.robot.link_map)):
+            if rotor.kind == "ardupilot" and name is not None \
+                    and resolve_name(name, table) is not None:
+                continue  # ArduPilotPlugin finds scoped and unscoped names alike
             if tag == "jointName" and name is None:
                 yield Issue(f"motor plugin '{rotor.plugin.name}' has no <jointName>", rotor.loc,
                             rotor.name, hint="add <jointName> naming the rotor's joint")
             elif name is not None and name not in table:
                 close = difflib.get_close_matches(name, list(table), n=1)
                 yield Issue(f"motor plugin '{rotor.plugin.name}' <{tag}> '{name}' does not exist",
-                            rotor.plugin.param_loc(tag), rotor.name,
+                            rotor.param_loc(tag), rotor.name,
                             hint=f"did you mean '{close[0]}'?" if close else None)
 
 
@@ -470,12 +550,12 @@ def rotor_link_not_joint_child(ctx: CheckContext) -> Iterator[Issue]:
     """
     for rotor in _rotors(ctx):
         joint = ctx.robot.joint_map.get(rotor.joint or "")
-        link = rotor.plugin.param("linkName")
+        link = rotor.param("linkName")
         if joint is not None and link is not None and link in ctx.robot.link_map \
                 and joint.child != link:
             yield Issue(f"motor plugin '{rotor.plugin.name}': link '{link}' is not the child of "
                         f"joint '{joint.name}' (its child is '{joint.child}')",
-                        rotor.plugin.param_loc("linkName"), rotor.name,
+                        rotor.param_loc("linkName"), rotor.name,
                         hint=f"<linkName>{joint.child}</linkName>")
 
 
@@ -485,18 +565,135 @@ def rotor_constant_invalid(ctx: CheckContext) -> Iterator[Issue]:
     """`motorConstant` (thrust = k·ω², N/(rad/s)²) and `maxRotVelocity` (rad/s) must be
     positive and `momentConstant` (yaw drag torque per newton of thrust, m) must not be
     negative. Missing values silently fall back to a plugin default that differs between
-    RotorS, PX4 and gz-sim; write them out.
+    RotorS, PX4 and gz-sim; write them out. (ArduPilot rotors have no such elements:
+    R317 says what is estimated for them.)
     """
-    for rotor in _rotors(ctx):
+    for rotor in filter(_written, _rotors(ctx)):
         for attr, tag, unit in CONSTANTS:
             value = getattr(rotor, attr)
-            raw = rotor.plugin.param(tag)
+            raw = rotor.param(tag)
             floor_ok = value >= 0 if attr == "moment_constant" else value > 0
             if raw is None:
                 yield Issue(f"rotor '{rotor.name}': no <{tag}>", rotor.loc, rotor.name,
                             hint=f"add <{tag}> ({unit})")
             elif not (math.isfinite(value) and floor_ok):
                 yield Issue(f"rotor '{rotor.name}': <{tag}> is '{raw}'",
-                            rotor.plugin.param_loc(tag), rotor.name,
+                            rotor.param_loc(tag), rotor.name,
                             hint=f"a {'non-negative' if attr == 'moment_constant' else 'positive'}"
                                  f" number in {unit}")
+
+
+# ------------------------------------------------- families, roles and patterns
+
+# A tilt pattern is balanced when, at equal thrust, the rotors' side forces and tilt yaw
+# torques each cancel to within this fraction of their magnitudes.
+TILT_BALANCE_REL_TOL = 0.05
+
+
+def balanced_tilt(ctx: CheckContext):
+    """(tilted rotors, tilts in degrees) when several lift rotors are tilted in a pattern
+    whose side forces and tilt yaw torques cancel at equal thrust; else None."""
+    from reedtool.physics.allocation import tilt_balance
+
+    rotors = [r for r in _lift(ctx) if np.all(np.isfinite(r.axis))
+              and np.all(np.isfinite(r.position_m)) and np.linalg.norm(r.axis) > 0]
+    tilted = [r for r in rotors if r.tilt_deg > AXIS_TILT_TOL_DEG]
+    if len(tilted) < 2 or any(r.tilt_deg > 90 for r in tilted):
+        return None
+    side, side_abs, yaw, yaw_abs = tilt_balance(rotors, ctx.whole_robot.com_m
+                                                if math.isfinite(ctx.whole_robot.mass_kg)
+                                                and ctx.whole_robot.mass_kg > 0
+                                                else np.zeros(3))
+    if side > TILT_BALANCE_REL_TOL * side_abs or yaw > TILT_BALANCE_REL_TOL * max(yaw_abs, 1e-12):
+        return None
+    return tilted, [r.tilt_deg for r in tilted]
+
+
+@rule("R317", "rotor-constants-estimated", "info",
+      "An ArduPilot rotor's thrust constants are estimated from its LiftDrag blades.")
+def rotor_constants_estimated(ctx: CheckContext) -> Iterator[Issue]:
+    """ArduPilotPlugin models write no motor constant: thrust comes from LiftDrag plugins
+    on the blades. reedtool estimates k_f = sum(0.5·rho·r²·area·cla·a0) over the blades
+    (each blade's centre of pressure at radius r moving at omega·r, angle of attack a0),
+    the moment constant from their drag (cda·a0) at r, and the top speed from
+    |multiplier| (the joint target is multiplier × the [0, 1] command). The hover rules use
+    these numbers; LiftDrag in flight also sees the inflow, so the real thrust is lower.
+    Without blades the rotor's thrust is unknown and the hover rules are skipped.
+    """
+    for rotor in _rotors(ctx):
+        if rotor.kind != "ardupilot":
+            continue
+        if rotor.constants_estimated and math.isfinite(rotor.motor_constant):
+            yield Issue(f"rotor '{rotor.name}' (channel {rotor.channel}): estimated from "
+                        f"{len(rotor.blades)} LiftDrag blade(s): k_f ≈ "
+                        f"{_fmt(rotor.motor_constant)} N/(rad/s)², moment constant ≈ "
+                        f"{_fmt(rotor.moment_constant)} m, maximum speed "
+                        f"{_fmt(rotor.max_rot_velocity_rad_s)} rad/s", rotor.loc, rotor.name)
+        else:
+            yield Issue(f"rotor '{rotor.name}' (channel {rotor.channel}): no usable LiftDrag "
+                        f"blade on link '{rotor.link}', so its thrust is unknown; hover "
+                        "physics is not checked", rotor.loc, rotor.name)
+
+
+@rule("R318", "ardupilot-spin-against-blades", "error",
+      "An ArduPilot channel spins its rotor against the way its blades make lift.")
+def ardupilot_spin_against_blades(ctx: CheckContext) -> Iterator[Issue]:
+    """The ArduPilotPlugin turns the joint at `multiplier` × command about the joint axis,
+    so the multiplier's sign is the spin direction. Each LiftDrag blade makes lift only
+    when its centre of pressure moves along its `<forward>` vector; turning the other way
+    it pushes down. A multiplier whose sign disagrees with the blades (copying a cw
+    rotor's control block onto a ccw rotor) makes that rotor push the vehicle to the
+    ground at take-off.
+    """
+    for rotor in _rotors(ctx):
+        if rotor.kind != "ardupilot" or rotor.blade_turning_sign == 0 or rotor.turning_sign == 0:
+            continue
+        if rotor.blade_turning_sign != rotor.turning_sign:
+            want = "ccw" if rotor.blade_turning_sign > 0 else "cw"
+            yield Issue(f"rotor '{rotor.name}' (channel {rotor.channel}): multiplier "
+                        f"{rotor.param('multiplier')} spins it {rotor.direction}, but its "
+                        f"LiftDrag blades ({rotor.blades[0].plugin.loc}) lift when it turns "
+                        f"{want}", _direction_loc(rotor), rotor.name,
+                        hint="flip the sign of <multiplier>, or the blades' <forward> vectors")
+
+
+@rule("R319", "rotor-role", "info",
+      "Rotors that are not lift rotors, or an omnidirectional frame.")
+def rotor_role(ctx: CheckContext) -> Iterator[Issue]:
+    """A rotor whose thrust axis is more than 60° from body z on a vehicle that also has
+    lift rotors (or a wing) is propulsion: a fixed-wing puller or a VTOL pusher. It is
+    left out of the hover allocation, the trim and the lift-rotor rules (R304-R311). A
+    frame with reversible motors or rotors pointing in every direction is
+    omnidirectional: it is judged by the full 6-DoF force-and-torque allocation.
+    """
+    for rotor in _rotors(ctx):
+        if rotor.role == "propulsion":
+            axis = rotor.axis / np.linalg.norm(rotor.axis)
+            yield Issue(f"rotor '{rotor.name}' is propulsion (thrust axis "
+                        f"{', '.join(f'{v:.3f}' for v in axis)}, {rotor.tilt_deg:.0f}° from "
+                        "body z): not used for hover", rotor.loc, rotor.name)
+    if _lift(ctx) and ctx.omnidirectional:
+        reversible = sum(r.reversible for r in _lift(ctx))
+        yield Issue(f"omnidirectional frame: {len(_lift(ctx))} rotors ({reversible} "
+                    "reversible) checked with the 6-DoF force-and-torque allocation",
+                    _lift(ctx)[0].loc, "rotors")
+
+
+@rule("R320", "rotor-tilt-pattern", "info",
+      "The rotors are tilted in a balanced pattern.")
+def rotor_tilt_pattern(ctx: CheckContext) -> Iterator[Issue]:
+    """Some frames tilt every rotor on purpose: the AscTec Neo (RotorS neo9/neo11) tilts
+    each rotor 5° sideways, alternating, for more yaw authority; tailsitters tilt theirs
+    tangentially. At equal thrust their side forces cancel and so do the yaw torques the
+    tilts make through the lever arms. Such a pattern is reported here; a single or
+    unbalanced tilt is R311's warning.
+    """
+    if ctx.omnidirectional:
+        return
+    found = balanced_tilt(ctx)
+    if found is None:
+        return
+    tilted, tilts = found
+    yield Issue(f"{len(tilted)} rotors tilted {min(tilts):.1f}-{max(tilts):.1f}° in a balanced "
+                "pattern (side forces and tilt yaw torques cancel at equal thrust)",
+                tilted[0].loc, "rotors")

@@ -145,12 +145,13 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
     import numpy as np
 
     from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
-    from reedtool.physics.rotors import discover_rotors
+    from reedtool.physics.rotors import discover_rotors, lift_rotors
     from reedtool.physics.trim import solve_trim
     from reedtool.sim import ExitStatus
     from reedtool.sim.params import VehicleParams, check_rotor_dynamics
 
-    rotors = discover_rotors(robot)
+    # Hover is held by the lift rotors: a VTOL's pusher or a plane's puller stays off.
+    rotors = lift_rotors(discover_rotors(robot))
     props = whole_robot_pinocchio(robot)
     trim = solve_trim(props.mass_kg, props.com_m, rotors)
     report: dict = {

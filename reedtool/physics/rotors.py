@@ -1,18 +1,35 @@
-"""Rotor discovery: one Rotor type from RotorS, PX4 gazebo-classic and gz-sim motor plugins.
+"""Rotor discovery: one Rotor type from every way a Gazebo model spins a propeller.
 
-All three plugins use the same element names (jointName, linkName, turningDirection,
-motorConstant, ...). Thrust acts along the rotor link's z axis in every one of them, so
-that axis, expressed in the base frame, is the rotor's thrust axis here.
+Four families are read:
+
+- RotorS and PX4 gazebo-classic motor models (`gazebo_motor_model`): jointName, linkName,
+  turningDirection, motorConstant, ... A `<motorType>` other than `velocity` (the
+  plugins' default) is a position or force servo (RotorS omav's tilt arms), not a rotor.
+- gz-sim's MulticopterMotorModel: the same elements, numbered by `<actuator_number>`
+  (`<motorNumber>` is its deprecated alias, read when the new one is absent), and
+  `<reversible>` motors that may spin both ways (PX4's omnicopter).
+- ArduPilot's ArduPilotPlugin: one `<control channel="N">` per servo output. A VELOCITY
+  control spinning a rotor joint is a rotor; its spin direction is the sign of
+  `<multiplier>` (the joint turns at multiplier x command about its axis), its number
+  the channel. Thrust comes from LiftDrag plugins on the blades, so the constants here
+  are an estimate from them (`constants_estimated`).
+
+Thrust acts along the rotor link's z axis in the motor-model plugins (for ArduPilot
+rotors: along the blades' LiftDrag `<upward>`); that axis in the base frame is the
+rotor's thrust axis. Every rotor gets a role: `lift`, or `propulsion` when its thrust is
+nearly horizontal on a vehicle that lifts otherwise (a fixed-wing puller, a VTOL pusher).
+Discovery never raises on odd input: whatever cannot be read becomes NaN/None and a
+rule says what is wrong.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from reedtool.model import Plugin, Robot, SourceLoc
+from reedtool.model import Plugin, Robot, SourceLoc, XmlNode
 from reedtool.physics.kinematics import link_poses
 
 # Plugin library (see Plugin.library) -> rotor kind.
@@ -24,10 +41,41 @@ MOTOR_PLUGINS = {
 }
 MOTOR_PLUGIN_NAMES = {"gz::sim::systems::MulticopterMotorModel": "gz",
                       "ignition::gazebo::systems::MulticopterMotorModel": "gz"}
+ARDUPILOT_PLUGINS = {"ArduPilotPlugin"}        # libArduPilotPlugin.so (classic) and gz
+LIFT_DRAG_PLUGINS = {"LiftDragPlugin", "gz-sim-lift-drag-system",
+                     "ignition-gazebo-lift-drag-system"}
+LIFT_DRAG_NAMES = {"gz::sim::systems::LiftDrag", "ignition::gazebo::systems::LiftDrag"}
 
 MAVLINK_PLUGINS = {"rotors_gazebo_mavlink_interface", "gazebo_mavlink_interface"}
 
 TURNING_SIGN = {"ccw": 1, "cw": -1}
+
+# A thrust axis further than this from body z is not lifting (the role 'propulsion').
+PROPULSION_MIN_ANGLE_DEG = 60.0
+# The rotors' axes span every direction when the 3 x n matrix of unit axes has its
+# smallest singular value above this fraction of its largest: an omnidirectional frame.
+OMNI_MIN_SINGULAR_RATIO = 0.3
+
+# LiftDrag defaults (gz-sim LiftDrag / gazebo-classic LiftDragPlugin) when an element
+# is absent.
+LIFT_DRAG_DEFAULTS = {"a0": 0.0, "cla": 1.0, "cda": 0.01, "area": 1.0,
+                      "air_density": 1.2041, "alpha_stall": 0.5 * math.pi}
+
+
+@dataclass
+class Blade:
+    """One LiftDrag plugin on a rotor link, in the rotor link's frame."""
+
+    plugin: Plugin
+    cp_m: np.ndarray
+    forward: np.ndarray
+    upward: np.ndarray
+    a0_rad: float
+    cla: float
+    cda: float
+    area_m2: float
+    air_density_kg_m3: float
+    alpha_stall_rad: float
 
 
 @dataclass
@@ -36,10 +84,10 @@ class Rotor:
     joint: str | None
     link: str | None
     position_m: np.ndarray          # rotor link origin in the base frame (NaN if the link is unknown)
-    axis: np.ndarray                # unit thrust axis in the base frame (the rotor link's z axis)
+    axis: np.ndarray                # unit thrust axis in the base frame
     direction: str                  # as written: 'ccw', 'cw', or anything else (a finding)
-    turning_sign: int               # +1 ccw, -1 cw, 0 unknown
-    motor_number: int | None
+    turning_sign: int               # +1 ccw, -1 cw about `axis`, 0 unknown
+    motor_number: int | None        # the index the flight stack commands (ArduPilot: channel)
     motor_constant: float           # thrust = motor_constant * omega^2 [N/(rad/s)^2]
     moment_constant: float          # yaw drag torque = moment_constant * thrust [m]
     max_rot_velocity_rad_s: float
@@ -47,13 +95,37 @@ class Rotor:
     time_constant_down_s: float
     rotor_drag_coefficient: float
     rolling_moment_coefficient: float
-    kind: str                       # 'rotors' | 'px4' | 'gz'
+    kind: str                       # 'rotors' | 'px4' | 'gz' | 'ardupilot'
     plugin: Plugin
     loc: SourceLoc
+    node: XmlNode | None = None     # element holding the parameters (plugin, or <control>)
+    number_tag: str = "motorNumber"  # element (or attribute) the number was read from
+    direction_tag: str = "turningDirection"
+    channel: int | None = None      # ArduPilot: the SDF channel attribute as written (0-based)
+    reversible: bool = False        # gz: may spin (and push) both ways
+    role: str = "lift"              # 'lift' | 'propulsion'
+    constants_estimated: bool = False  # constants derived from LiftDrag blades, not written
+    blades: list[Blade] = field(default_factory=list)
+    blade_turning_sign: int = 0     # spin (about `axis`) the blades lift with; 0 unknown/none
 
     @property
     def max_thrust_N(self) -> float:
         return self.motor_constant * self.max_rot_velocity_rad_s ** 2
+
+    def param(self, tag: str) -> str | None:
+        return (self.node if self.node is not None else self.plugin.node).findtext(tag)
+
+    def param_loc(self, tag: str) -> SourceLoc:
+        node = self.node if self.node is not None else self.plugin.node
+        child = node.find(tag)
+        return child.loc if child is not None else node.loc
+
+    @property
+    def tilt_deg(self) -> float:
+        norm = float(np.linalg.norm(self.axis))
+        if not (np.all(np.isfinite(self.axis)) and norm > 0):
+            return math.nan
+        return math.degrees(math.acos(float(np.clip(self.axis[2] / norm, -1.0, 1.0))))
 
 
 @dataclass
@@ -70,51 +142,268 @@ def motor_plugin_kind(plugin: Plugin) -> str | None:
     return MOTOR_PLUGINS.get(plugin.library) or MOTOR_PLUGIN_NAMES.get(plugin.name or "")
 
 
-def _number(plugin: Plugin, tag: str) -> float:
-    text = plugin.param(tag)
+def is_ardupilot_plugin(plugin: Plugin) -> bool:
+    return plugin.library in ARDUPILOT_PLUGINS or (plugin.name or "").endswith("ArduPilotPlugin")
+
+
+def is_lift_drag_plugin(plugin: Plugin) -> bool:
+    return plugin.library in LIFT_DRAG_PLUGINS or (plugin.name or "") in LIFT_DRAG_NAMES
+
+
+def _float(text: str | None) -> float:
     try:
         return float(text) if text is not None else math.nan
     except ValueError:
         return math.nan
 
 
+def _int(text: str | None) -> int | None:
+    try:
+        return int(text.strip()) if text is not None else None
+    except ValueError:
+        return None
+
+
+def _vector(text: str | None, default: tuple[float, float, float]) -> np.ndarray:
+    if text is None:
+        return np.array(default, dtype=float)
+    try:
+        values = [float(v) for v in text.split()]
+    except ValueError:
+        return np.full(3, math.nan)
+    return np.array(values, dtype=float) if len(values) == 3 else np.full(3, math.nan)
+
+
+def _bool(text: str | None) -> bool:
+    return (text or "").strip().lower() in ("1", "true")
+
+
+def resolve_name(name: str | None, table) -> str | None:
+    """`name` as the model spells it: exact, else without leading `model::` scopes, else
+    the one entry that ends with `::name` (Gazebo resolves scoped names both ways)."""
+    if name is None:
+        return None
+    name = name.strip()
+    if name in table:
+        return name
+    parts = name.split("::")
+    for i in range(1, len(parts)):
+        candidate = "::".join(parts[i:])
+        if candidate in table:
+            return candidate
+    matches = [key for key in table if key.endswith("::" + name)]
+    return matches[0] if len(matches) == 1 else None
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    norm = float(np.linalg.norm(v))
+    return v / norm if np.all(np.isfinite(v)) and norm > 0 else np.full(3, math.nan)
+
+
+# ------------------------------------------------------------------ discovery
+
 def discover_rotors(robot: Robot) -> list[Rotor]:
-    """Every motor-model plugin in the model, as a Rotor in the base frame."""
+    """Every rotor in the model, in the base frame, each with its role."""
     poses = link_poses(robot)
-    rotors = []
+    rotors: list[Rotor] = []
+    blades = _blades_by_link(robot)
     for _block, plugin in robot.plugins():
         kind = motor_plugin_kind(plugin)
-        if kind is None:
+        if kind is not None:
+            rotor = _motor_model_rotor(robot, plugin, kind, poses, len(rotors))
+            if rotor is not None:
+                rotors.append(rotor)
+        elif is_ardupilot_plugin(plugin):
+            rotors.extend(_ardupilot_rotors(robot, plugin, poses, blades, len(rotors)))
+    assign_roles(rotors, has_wing=_has_wing(robot, rotors, blades))
+    return rotors
+
+
+def _motor_model_rotor(robot: Robot, plugin: Plugin, kind: str, poses, index: int):
+    motor_type = (plugin.param("motorType") or "velocity").strip().lower()
+    if motor_type != "velocity":
+        return None  # a position/force servo (a tilt arm), not a propeller
+    link = plugin.param("linkName")
+    joint = plugin.param("jointName")
+    if link is None and joint in robot.joint_map:
+        link = robot.joint_map[joint].child
+    T_base_link = poses.get(link or "")
+    if T_base_link is None:
+        position, axis = np.full(3, math.nan), np.full(3, math.nan)
+    else:
+        position, axis = T_base_link[:3, 3].copy(), T_base_link[:3, 2].copy()
+    direction = (plugin.param("turningDirection") or "").strip()
+    number_tag = "motorNumber"
+    if kind == "gz" and (plugin.node.find("actuator_number") is not None
+                         or plugin.node.find("motorNumber") is None):
+        number_tag = "actuator_number"  # gz's own element; motorNumber is the old alias
+    return Rotor(
+        name=link or joint or plugin.name or f"rotor{index}",
+        joint=joint, link=link, position_m=position, axis=axis,
+        direction=direction, turning_sign=TURNING_SIGN.get(direction.lower(), 0),
+        motor_number=_int(plugin.param(number_tag)),
+        motor_constant=_float(plugin.param("motorConstant")),
+        moment_constant=_float(plugin.param("momentConstant")),
+        max_rot_velocity_rad_s=_float(plugin.param("maxRotVelocity")),
+        time_constant_up_s=_float(plugin.param("timeConstantUp")),
+        time_constant_down_s=_float(plugin.param("timeConstantDown")),
+        rotor_drag_coefficient=_float(plugin.param("rotorDragCoefficient")),
+        rolling_moment_coefficient=_float(plugin.param("rollingMomentCoefficient")),
+        kind=kind, plugin=plugin, loc=plugin.loc, node=plugin.node, number_tag=number_tag,
+        reversible=kind == "gz" and _bool(plugin.param("reversible")))
+
+
+def _blades_by_link(robot: Robot) -> dict[str, list[Blade]]:
+    out: dict[str, list[Blade]] = {}
+    for block, plugin in robot.plugins():
+        if not is_lift_drag_plugin(plugin):
             continue
-        link = plugin.param("linkName")
-        joint = plugin.param("jointName")
-        if link is None and joint in robot.joint_map:
-            link = robot.joint_map[joint].child
+        link = resolve_name(plugin.param("link_name") or block.reference, robot.link_map)
+        if link is None:
+            continue
+        values = {tag: _float(plugin.param(tag)) if plugin.param(tag) is not None else default
+                  for tag, default in LIFT_DRAG_DEFAULTS.items()}
+        out.setdefault(link, []).append(Blade(
+            plugin=plugin, cp_m=_vector(plugin.param("cp"), (0.0, 0.0, 0.0)),
+            forward=_vector(plugin.param("forward"), (1.0, 0.0, 0.0)),
+            upward=_vector(plugin.param("upward"), (0.0, 0.0, 1.0)),
+            a0_rad=values["a0"], cla=values["cla"], cda=values["cda"],
+            area_m2=values["area"], air_density_kg_m3=values["air_density"],
+            alpha_stall_rad=values["alpha_stall"]))
+    return out
+
+
+def _ardupilot_rotors(robot: Robot, plugin: Plugin, poses, blades, index: int) -> list[Rotor]:
+    """The VELOCITY controls of an ArduPilotPlugin that spin a rotor."""
+    out = []
+    controls = plugin.node.findall("control") or plugin.node.findall("rotor")
+    for order, control in enumerate(controls):
+        control_type = (control.findtext("type") or "VELOCITY").strip().upper()
+        if control_type != "VELOCITY":
+            continue  # POSITION/EFFORT/COMMAND: a servo or a relayed command
+        channel_text = control.attrib.get("channel", control.attrib.get("id"))
+        channel = _int(channel_text) if channel_text is not None else order
+        joint_name = resolve_name(control.findtext("jointName"), robot.joint_map)
+        joint = robot.joint_map.get(joint_name or "")
+        link = joint.child if joint is not None else None
+        link_blades = blades.get(link or "", [])
         T_base_link = poses.get(link or "")
+        axis_link = _unit(np.asarray(joint.axis, dtype=float)) if joint is not None             else np.full(3, math.nan)
+        if not link_blades and not _vertical(T_base_link, axis_link):
+            continue  # a wheel or another spinning joint: no blades, not a lift axis
+        thrust_link = _unit(np.mean([b.upward for b in link_blades], axis=0)) if link_blades             else np.array([0.0, 0.0, 1.0])
         if T_base_link is None:
             position, axis = np.full(3, math.nan), np.full(3, math.nan)
         else:
-            position, axis = T_base_link[:3, 3].copy(), T_base_link[:3, 2].copy()
-        direction = (plugin.param("turningDirection") or "").strip()
-        motor_number_text = plugin.param("motorNumber")
-        try:
-            motor_number = int(motor_number_text) if motor_number_text is not None else None
-        except ValueError:
-            motor_number = None
-        rotors.append(Rotor(
-            name=link or joint or plugin.name or f"rotor{len(rotors)}",
-            joint=joint, link=link, position_m=position, axis=axis,
-            direction=direction, turning_sign=TURNING_SIGN.get(direction.lower(), 0),
-            motor_number=motor_number,
-            motor_constant=_number(plugin, "motorConstant"),
-            moment_constant=_number(plugin, "momentConstant"),
-            max_rot_velocity_rad_s=_number(plugin, "maxRotVelocity"),
-            time_constant_up_s=_number(plugin, "timeConstantUp"),
-            time_constant_down_s=_number(plugin, "timeConstantDown"),
-            rotor_drag_coefficient=_number(plugin, "rotorDragCoefficient"),
-            rolling_moment_coefficient=_number(plugin, "rollingMomentCoefficient"),
-            kind=kind, plugin=plugin, loc=plugin.loc))
-    return rotors
+            position, axis = T_base_link[:3, 3].copy(), T_base_link[:3, :3] @ thrust_link
+        multiplier = _float(control.findtext("multiplier"))             if control.find("multiplier") is not None else 1.0  # the plugin's default
+        along = float(np.dot(axis_link, thrust_link))
+        sign = int(np.sign(multiplier) * np.sign(along)) if np.isfinite(multiplier)             and np.isfinite(along) else 0
+        offset = _float(control.findtext("offset")) if control.find("offset") is not None else 0.0
+        slowdown = _float(control.findtext("rotorVelocitySlowdownSim")
+                          or control.findtext("controlVelocitySlowdownSim") or "1") or 1.0
+        # Commands arrive normalised to [0, 1]; the joint target is multiplier*(cmd+offset).
+        omega_max = abs(multiplier) * max(abs(offset), abs(1.0 + offset)) / slowdown
+        k_f, k_m, blade_sign = lift_drag_constants(link_blades, axis_link, thrust_link)
+        out.append(Rotor(
+            name=link or joint_name or f"channel{channel}",
+            joint=joint_name or control.findtext("jointName"), link=link,
+            position_m=position, axis=axis,
+            direction={1: "ccw", -1: "cw"}.get(sign, ""), turning_sign=sign,
+            motor_number=channel, motor_constant=k_f, moment_constant=k_m,
+            max_rot_velocity_rad_s=omega_max, time_constant_up_s=math.nan,
+            time_constant_down_s=math.nan, rotor_drag_coefficient=math.nan,
+            rolling_moment_coefficient=math.nan, kind="ardupilot", plugin=plugin,
+            loc=control.loc, node=control, number_tag="channel", direction_tag="multiplier",
+            channel=channel, constants_estimated=bool(link_blades), blades=link_blades,
+            blade_turning_sign=blade_sign))
+        index += 1
+    return out
+
+
+def _vertical(T_base_link, axis_link: np.ndarray) -> bool:
+    if T_base_link is None or not np.all(np.isfinite(axis_link)):
+        return False
+    axis = T_base_link[:3, :3] @ axis_link
+    return abs(float(axis[2])) >= math.cos(math.radians(PROPULSION_MIN_ANGLE_DEG))
+
+
+def lift_drag_constants(blades: list[Blade], spin_axis: np.ndarray,
+                        thrust_axis: np.ndarray) -> tuple[float, float, int]:
+    """(k_f [N/(rad/s)^2], moment constant [m], blade turning sign) from LiftDrag blades.
+
+    In hover without inflow each blade's centre of pressure moves at omega * r (r its
+    distance from the spin axis) along `forward` when the rotor turns the way the blade
+    is built for, so its angle of attack is a0 and (below stall) its lift
+    0.5 * rho * (omega r)^2 * area * cla * a0 along `upward`: k_f is the sum of
+    0.5 * rho * r^2 * area * cla * a0 over the blades. Their drag (cda * a0) acting at r
+    gives the yaw torque, hence moment constant = sum(drag r) / sum(lift). An estimate:
+    real LiftDrag also sees the induced inflow, which lowers the angle of attack.
+    The sign is the spin about `thrust_axis` (+1 ccw) that moves the blades along
+    `forward`; 0 when there are no blades or they disagree.
+    """
+    if not blades or not np.all(np.isfinite(spin_axis)):
+        return math.nan, math.nan, 0
+    k_f = k_drag = 0.0
+    signs = set()
+    for blade in blades:
+        tangent = np.cross(spin_axis, blade.cp_m)       # velocity direction of +spin
+        r_m = float(np.linalg.norm(tangent))
+        forward = _unit(blade.forward)
+        if r_m == 0 or not np.all(np.isfinite(forward)):
+            return math.nan, math.nan, 0
+        signs.add(int(np.sign(np.dot(tangent, forward))))
+        alpha = blade.a0_rad
+        cl = blade.cla * alpha if abs(alpha) <= blade.alpha_stall_rad else math.nan
+        q_per_w2 = 0.5 * blade.air_density_kg_m3 * r_m ** 2 * blade.area_m2
+        k_f += q_per_w2 * cl * float(np.dot(_unit(blade.upward), thrust_axis))
+        k_drag += q_per_w2 * abs(blade.cda * alpha) * r_m
+    about_joint = signs.pop() if len(signs) == 1 else 0
+    along = float(np.dot(spin_axis, thrust_axis))
+    sign = int(about_joint * np.sign(along)) if np.isfinite(along) else 0
+    return k_f, (k_drag / k_f if k_f > 0 else math.nan), sign
+
+
+# ---------------------------------------------------------------------- roles
+
+def assign_roles(rotors: list[Rotor], has_wing: bool = False) -> None:
+    """Mark nearly horizontal rotors as propulsion (see the module docstring).
+
+    An omnidirectional frame (reversible motors, or axes spanning every direction) keeps
+    every rotor as lift: it hovers with all of them through the 6-DoF allocation. A
+    vehicle whose rotors are all horizontal is a fixed-wing aircraft only when it has a
+    wing (a LiftDrag surface not on a rotor); otherwise its rotors stay 'lift' and the
+    hover rules say why it cannot hover.
+    """
+    if is_omnidirectional(rotors):
+        return
+    cos_max = math.cos(math.radians(PROPULSION_MIN_ANGLE_DEG))
+    horizontal = [r for r in rotors if np.all(np.isfinite(r.axis))
+                  and float(_unit(r.axis)[2]) < cos_max]
+    if len(horizontal) < len(rotors) or has_wing:
+        for rotor in horizontal:
+            rotor.role = "propulsion"
+
+
+def is_omnidirectional(rotors: list[Rotor]) -> bool:
+    """Reversible motors, or thrust axes that span every direction (3 x n well conditioned)."""
+    if any(r.reversible for r in rotors):
+        return True
+    axes = [_unit(r.axis) for r in rotors]
+    axes = [a for a in axes if np.all(np.isfinite(a))]
+    if len(axes) < 6:
+        return False
+    singular = np.linalg.svd(np.array(axes).T, compute_uv=False)
+    return bool(singular[-1] > OMNI_MIN_SINGULAR_RATIO * singular[0])
+
+
+def lift_rotors(rotors: list[Rotor]) -> list[Rotor]:
+    return [r for r in rotors if r.role == "lift"]
+
+
+def _has_wing(robot: Robot, rotors: list[Rotor], blades: dict[str, list[Blade]]) -> bool:
+    rotor_links = {r.link for r in rotors}
+    return any(link not in rotor_links for link in blades)
 
 
 def declared_rotor_counts(robot: Robot) -> list[RotorCountDeclaration]:

@@ -167,6 +167,70 @@ def trim_from_allocation(A: np.ndarray, motor_constant: np.ndarray, omega_max_ra
                   + DIRECTION_HINT, demand)
 
 
+def solve_trim_6dof(mass_kg: float, com_m: np.ndarray, rotors: Sequence,
+                    g_m_s2: float = STANDARD_GRAVITY_M_S2) -> TrimResult:
+    """Hover trim of an omnidirectional frame: the full force-and-torque allocation.
+
+    The wrench to produce is [0, 0, m*g, 0, 0, 0] (no side force either: the rotors point
+    in many directions); a reversible rotor's thrust may be negative, down to -k*omega_max^2.
+    Thrust-to-weight is the upward force with every rotor pushing its most upward way
+    (an upper bound: it ignores the torques that leaves).
+    """
+    from reedtool.physics.allocation import wrench_matrix
+
+    names = tuple(r.name for r in rotors)
+    weight_N = mass_kg * g_m_s2
+    bad = _invalid_rotor(rotors)
+    if bad or not rotors:
+        cause = TrimCause.INVALID_PARAMETERS if bad else TrimCause.NO_ROTORS
+        return _empty(cause, bad or "the model has no rotors", len(rotors), weight_N, names)
+    A = wrench_matrix(rotors, np.asarray(com_m, dtype=float))
+    k = np.array([r.motor_constant for r in rotors], dtype=float)
+    omega_max = np.array([r.max_rot_velocity_rad_s for r in rotors], dtype=float)
+    if not (np.all(np.isfinite(A)) and weight_N > 0):
+        return _empty(TrimCause.INVALID_PARAMETERS,
+                      "rotor geometry or mass is not a finite number", len(rotors), weight_N,
+                      names)
+    thrust_max = k * omega_max ** 2
+    reversible = np.array([bool(getattr(r, "reversible", False)) for r in rotors])
+    thrust_min = np.where(reversible, -thrust_max, 0.0)
+    wrench = np.array([0.0, 0.0, weight_N, 0.0, 0.0, 0.0])
+    rank = int(np.linalg.matrix_rank(A))
+    cond = float(np.linalg.cond(A)) if rank == 6 else float("inf")
+    thrust_to_weight = float(np.sum(np.maximum(A[2] * thrust_max, A[2] * thrust_min))
+                             / weight_N)
+    demand = np.linalg.pinv(A) @ wrench
+    span = thrust_max - thrust_min
+    lo, hi = thrust_min + BOUND_MARGIN * span, thrust_max - BOUND_MARGIN * span
+    thrust = None
+    if thrust_to_weight >= 1.0:
+        thrust = demand if _inside(demand, lo, hi) else None
+        for margin in (0.1, 0.02, BOUND_MARGIN):
+            if thrust is not None:
+                break
+            thrust = _feasible_point(A, wrench, thrust_min + margin * span,
+                                     thrust_max - margin * span, demand)
+    shown = thrust if thrust is not None else demand
+    clipped = np.clip(shown, thrust_min, thrust_max)
+    omega = np.sign(clipped) * np.sqrt(np.abs(clipped) / k)
+    throttle = np.abs(omega) / omega_max
+    if thrust is not None:
+        message = (f"hover at |omega| {np.abs(omega).min():.1f}-{np.abs(omega).max():.1f} rad/s "
+                   f"(6-DoF allocation), thrust-to-weight {thrust_to_weight:.2f}")
+        cause = None
+    elif thrust_to_weight < 1.0:
+        cause = TrimCause.INSUFFICIENT_THRUST
+        message = (f"the rotors lift at most {thrust_to_weight * weight_N:.4g} N but the robot "
+                   f"weighs {weight_N:.4g} N")
+    else:
+        cause = TrimCause.RANK_DEFICIENT if rank < 6 else TrimCause.COM_UNBALANCED
+        message = (f"no thrusts within the rotors' limits give force m*g up and no torque "
+                   f"(6-DoF allocation rank {rank})")
+    return TrimResult(thrust is not None, cause, message, shown, omega, throttle,
+                      thrust_to_weight, float(throttle.max()), A @ clipped - wrench,
+                      np.zeros(3), A, rank, cond, weight_N, names)
+
+
 # ------------------------------------------------------------------- helpers
 
 def _inside(thrust: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:

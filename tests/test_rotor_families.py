@@ -1,0 +1,206 @@
+"""Rotor families (issue 10): ArduPilotPlugin + LiftDrag, a VTOL pusher, RotorS Neo tilts
+and omav servos, a reversible omnidirectional frame.
+
+Fixtures: tests/fixtures/rotor_families.py. Every expected number is derived here by hand
+from the fixture's written values (positions, LiftDrag coefficients, multipliers).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from reedtool.checks.runner import run_checks
+from reedtool.io.loader import load_robot
+from reedtool.physics.rotors import discover_rotors
+
+FIXTURES = Path(__file__).parent / "fixtures"
+
+# (fixture relative to tests/fixtures/validate, as rule_helpers.codes expects, codes)
+CASES = [
+    ("../ardupilot/iris_lift_drag.sdf", ["R317"] * 4),
+    ("../ardupilot/R318_bad_multiplier_sign.sdf", ["R304"] + ["R317"] * 4 + ["R318"]),
+    ("../ardupilot/R317_bad_no_blades.sdf", ["R317"] * 4),
+    ("../vtol/vtol_pusher.sdf", ["R319"]),
+    ("../vtol/R304_bad_flipped_direction.sdf", ["R304", "R319"]),
+    ("../vtol/R301_bad_duplicate_actuator.sdf", ["R301", "R319"]),
+    ("../vtol/R311_bad_single_tilt.sdf", ["R311", "R319"]),
+    ("../vtol/vtol_motor_number_alias.sdf", ["R319"]),
+    ("../rotors_neo/neo_balanced_tilt.sdf", ["R320"]),
+    ("../rotors_neo/omav_tilt_servos.sdf", []),
+    ("../omni/omni_reversible.sdf", ["R319"]),
+    # The R319/R320 pair: a pusher and a balanced tilt are information (their bad fixtures).
+    ("../vtol/R319_bad_pusher.sdf", ["R319"]),
+    ("../rotors_neo/R320_bad_balanced_tilt.sdf", ["R320"]),
+]
+GOOD = [name for name, _ in CASES if "_bad_" not in name]
+
+
+def _findings(name):
+    return run_checks(load_robot(FIXTURES / "validate" / name))
+
+
+@pytest.mark.parametrize("name,expected", CASES, ids=[c[0] for c in CASES])
+def test_codes(name, expected):
+    assert sorted(f.code for f in _findings(name)) == expected
+
+
+@pytest.mark.parametrize("name", GOOD)
+def test_good_fixtures_have_no_error_or_warning(name):
+    assert [f.code for f in _findings(name) if f.severity in ("error", "warning")] == []
+
+
+def _rotors(path):
+    return discover_rotors(load_robot(FIXTURES / path))
+
+
+# ----------------------------------------------------------------- ArduPilot
+
+def test_ardupilot_iris_rotors():
+    rotors = _rotors("ardupilot/iris_lift_drag.sdf")
+    assert [r.channel for r in rotors] == [0, 1, 2, 3]
+    assert [r.motor_number for r in rotors] == [0, 1, 2, 3]
+    # ArduCopter quad X: motors 1, 2 (channels 0, 1) ccw, 3, 4 cw; multiplier +838 / -838
+    # on joints whose axis is +z (the thrust axis), so + is ccw.
+    assert [r.direction for r in rotors] == ["ccw", "ccw", "cw", "cw"]
+    expected_xy = [(0.13, -0.22), (-0.13, 0.22), (0.13, 0.22), (-0.13, -0.22)]
+    for rotor, (x, y) in zip(rotors, expected_xy):
+        np.testing.assert_allclose(rotor.position_m, [x, y, 0.023], atol=1e-12)
+        np.testing.assert_allclose(rotor.axis, [0, 0, 1], atol=1e-12)
+        assert rotor.kind == "ardupilot" and rotor.role == "lift"
+        assert rotor.constants_estimated and len(rotor.blades) == 2
+        # Two blades, cp at r = 0.084 m: k_f = 2 * 0.5 * rho * r^2 * area * cla * a0.
+        k_f = 2 * 0.5 * 1.2041 * 0.084 ** 2 * 0.002 * 4.25 * 0.3
+        assert rotor.motor_constant == pytest.approx(k_f, rel=1e-12)
+        assert rotor.motor_constant == pytest.approx(2.16651e-05, rel=1e-5)
+        # Drag cda * a0 at r over lift cla * a0: r * cda / cla.
+        assert rotor.moment_constant == pytest.approx(0.084 * 0.10 / 4.25, rel=1e-12)
+        # Command [0, 1] times |multiplier|, offset 0.
+        assert rotor.max_rot_velocity_rad_s == 838
+        assert rotor.blade_turning_sign == rotor.turning_sign
+
+
+def test_ardupilot_hover_trim_by_hand():
+    from reedtool.checks.context import CheckContext
+
+    ctx = CheckContext(load_robot(FIXTURES / "ardupilot/iris_lift_drag.sdf"))
+    mass = 1.5 + 4 * 0.005
+    k_f = 2 * 0.5 * 1.2041 * 0.084 ** 2 * 0.002 * 4.25 * 0.3
+    assert ctx.trim.feasible
+    np.testing.assert_allclose(ctx.trim.omega_rad_s, math.sqrt(mass * 9.80665 / (4 * k_f)),
+                               rtol=1e-9)
+
+
+def test_ardupilot_multiplier_against_blades_names_the_channel():
+    (finding,) = [f for f in _findings("../ardupilot/R318_bad_multiplier_sign.sdf")
+                  if f.code == "R318"]
+    assert "channel 2" in finding.message and finding.severity == "error"
+
+
+def test_ardupilot_non_velocity_controls_are_not_rotors(tmp_path):
+    text = (FIXTURES / "ardupilot/iris_lift_drag.sdf").read_text()
+    text = text.replace('<control channel="3">', '<control channel="3">\n<type>POSITION</type>', 1)
+    text = text.replace("<type>VELOCITY</type>\n        <p_gain>0.20</p_gain><i_gain>0</i_gain>"
+                        "<d_gain>0</d_gain>\n        <i_max>0</i_max><i_min>0</i_min><cmd_max>2.5"
+                        "</cmd_max><cmd_min>-2.5</cmd_min>\n      </control>\n    </plugin>",
+                        "<p_gain>0.20</p_gain>\n      </control>\n    </plugin>")
+    path = tmp_path / "iris.sdf"
+    path.write_text(text)
+    assert [r.channel for r in discover_rotors(load_robot(path))] == [0, 1, 2]
+
+
+# ---------------------------------------------------------------------- VTOL
+
+def test_vtol_pusher_is_propulsion():
+    rotors = _rotors("vtol/vtol_pusher.sdf")
+    roles = {r.name: r.role for r in rotors}
+    assert roles == {"rotor_0": "lift", "rotor_1": "lift", "rotor_2": "lift", "rotor_3": "lift",
+                     "rotor_puller": "propulsion"}
+    pusher = rotors[-1]
+    np.testing.assert_allclose(pusher.axis, [1, 0, 0], atol=1e-9)  # pitch 90°: z onto +x
+    np.testing.assert_allclose(pusher.position_m, [-0.35, 0, 0], atol=1e-12)
+    assert [r.motor_number for r in rotors] == [0, 1, 2, 3, 4]
+    assert all(r.number_tag == "actuator_number" for r in rotors)
+    alias = _rotors("vtol/vtol_motor_number_alias.sdf")
+    assert [r.motor_number for r in alias] == [0, 1, 2, 3, 4]
+    assert alias[3].number_tag == "motorNumber"
+
+
+def test_gz_missing_number_hint_names_actuator_number(tmp_path):
+    path = tmp_path / "vtol.sdf"
+    path.write_text((FIXTURES / "vtol/vtol_pusher.sdf").read_text().replace(
+        "      <actuator_number>2</actuator_number>\n", ""))
+    findings = [f for f in run_checks(load_robot(path)) if f.code == "R302"]
+    assert len(findings) == 1
+    assert "<actuator_number>" in findings[0].message + findings[0].hint
+    assert "motorNumber" not in findings[0].message + findings[0].hint
+
+
+def test_vtol_hover_test_uses_lift_rotors(capsys):
+    import json
+
+    from reedtool.cli import main
+
+    with pytest.raises(SystemExit) as info:
+        main(["hover-test", str(FIXTURES / "vtol/vtol_pusher.sdf"), "--format", "json"])
+    report = json.loads(capsys.readouterr().out)
+    assert info.value.code == 0 and report["passed"] is True
+    trim = report["trim"]
+    assert trim["feasible"] and len(trim["rotors"]) == 4
+    # Symmetric quad about the COM: each rotor carries a quarter of the weight.
+    mass = 5.0 + 5 * 0.005
+    # The pusher's mass sits at x = -0.35; COM shifts, so check the sum, not each speed.
+    total = sum(r["thrust_N"] for r in trim["rotors"])
+    assert total == pytest.approx(mass * 9.80665, rel=1e-9)
+
+
+# ----------------------------------------------------------------- RotorS
+
+def test_neo_tilts_are_five_degrees_alternating():
+    rotors = _rotors("rotors_neo/neo_balanced_tilt.sdf")
+    assert len(rotors) == 6
+    for i, rotor in enumerate(rotors):
+        bearing = math.radians(30 + 60 * i)
+        assert rotor.tilt_deg == pytest.approx(5.0, abs=1e-9)
+        # Rolled about the arm: the axis leans tangentially, -/+ alternately.
+        tangent = np.array([-math.sin(bearing), math.cos(bearing), 0])
+        sign = -1 if i % 2 == 0 else 1
+        assert float(rotor.axis @ tangent) == pytest.approx(sign * math.sin(math.radians(5)))
+
+
+def test_omav_servos_are_not_rotors():
+    rotors = _rotors("rotors_neo/omav_tilt_servos.sdf")
+    assert len(rotors) == 12
+    assert sorted(r.motor_number for r in rotors) == list(range(12))
+    assert not [r for r in rotors if r.link.startswith("arm_")]
+
+
+# --------------------------------------------------------------------- omni
+
+def test_omni_frame_uses_6dof_allocation():
+    from reedtool.checks.context import CheckContext
+
+    ctx = CheckContext(load_robot(FIXTURES / "omni/omni_reversible.sdf"))
+    assert len(ctx.rotors) == 8 and all(r.reversible for r in ctx.rotors)
+    assert ctx.omnidirectional and all(r.role == "lift" for r in ctx.rotors)
+    assert np.linalg.matrix_rank(ctx.wrench_allocation) == 6
+    trim = ctx.trim
+    assert trim.feasible
+    # The trim thrusts produce exactly the weight upward and nothing else.
+    W = ctx.wrench_allocation
+    weight = (1.5 + 8 * 0.005) * 9.80665
+    np.testing.assert_allclose(W @ trim.thrust_N, [0, 0, weight, 0, 0, 0], atol=1e-6)
+
+
+def test_omni_without_reversible_and_spread_is_not_omni(tmp_path):
+    path = tmp_path / "omni.sdf"
+    path.write_text((FIXTURES / "omni/omni_reversible.sdf").read_text().replace(
+        "<reversible>true</reversible>", "<reversible>false</reversible>"))
+    from reedtool.physics.rotors import is_omnidirectional
+
+    rotors = discover_rotors(load_robot(path))
+    # Axes still span every direction (cube corners, tangential lean): omnidirectional.
+    assert is_omnidirectional(rotors) and not any(r.reversible for r in rotors)
