@@ -65,7 +65,10 @@ def _actuator(rotor: "Rotor") -> int | None:
 
 
 def _rotor_label(rotor: "Rotor") -> str:
-    number = f"motor {rotor.motor_number}" if rotor.motor_number is not None else "motor"
+    if _channel(rotor) is not None:
+        number = f"rotor on channel {_channel(rotor)}"
+    else:
+        number = f"motor {rotor.motor_number}" if rotor.motor_number is not None else "motor"
     return f"the model's {number} ('{rotor.joint or rotor.link}', {rotor.loc})"
 
 
@@ -273,7 +276,7 @@ def px4_rotor_spin(ctx: CheckContext) -> Iterator[Issue]:
                 yield Issue(f"{ca.where('KM')} says {SPIN_NAME[int(np.sign(ca.km))]}, but "
                             f"{_rotor_label(rotor)} on output {k} turns "
                             f"{SPIN_NAME[rotor.turning_sign]} (turningDirection at "
-                            f"{rotor.plugin.param_loc('turningDirection')})",
+                            f"{rotor.param_loc(rotor.direction_tag)})",
                             ca.loc_of("KM"), f"CA_ROTOR{ca.index}",
                             hint=f"param set-default CA_ROTOR{ca.index}_KM {-ca.km:g}, or fix "
                                  "the motor's turningDirection if PX4 is right")
@@ -294,7 +297,7 @@ def px4_moment_ratio(ctx: CheckContext) -> Iterator[Issue]:
                 continue
             if abs(abs(ca.km) - model) > KM_REL_TOL * model:
                 yield Issue(f"{ca.where('KM')} vs momentConstant {model:g} of "
-                            f"{_rotor_label(rotor)} ({rotor.plugin.param_loc('momentConstant')})"
+                            f"{_rotor_label(rotor)} ({rotor.param_loc('momentConstant')})"
                             f": PX4's yaw effectiveness is {abs(ca.km) / model:.3g}x the model's",
                             ca.loc_of("KM"), f"CA_ROTOR{ca.index}")
 
@@ -346,7 +349,7 @@ def px4_command_above_max(ctx: CheckContext) -> Iterator[Issue]:
             written = str(high.loc) if high.explicit else "PX4's default"
             yield Issue(f"SIM_GZ_EC_MAX{k} {high.value:g} rad/s ({written}) is above "
                         f"maxRotVelocity {limit:g} of {_rotor_label(rotor)} "
-                        f"({rotor.plugin.param_loc('maxRotVelocity')}): the top "
+                        f"({rotor.param_loc('maxRotVelocity')}): the top "
                         f"{100 * lost:.0f} % of the command range does nothing",
                         high.loc, f"SIM_GZ_EC_MAX{k}",
                         hint=f"param set-default SIM_GZ_EC_MAX{k} {limit:g}")
@@ -370,7 +373,7 @@ def px4_command_below_max(ctx: CheckContext) -> Iterator[Issue]:
             written = str(high.loc) if high.explicit else "PX4's default"
             yield Issue(f"SIM_GZ_EC_MAX{k} {high.value:g} rad/s ({written}) is below "
                         f"maxRotVelocity {limit:g} of {_rotor_label(rotor)} "
-                        f"({rotor.plugin.param_loc('maxRotVelocity')}): PX4 reaches "
+                        f"({rotor.param_loc('maxRotVelocity')}): PX4 reaches "
                         f"{100 * (high.value / limit) ** 2:.0f} % of the rotor's thrust",
                         high.loc, f"SIM_GZ_EC_MAX{k}",
                         hint=f"param set-default SIM_GZ_EC_MAX{k} {limit:g}")

@@ -64,7 +64,7 @@ def thrust_to_weight_high(ctx: CheckContext) -> Iterator[Issue]:
                 f"{trim.thrust_to_weight * trim.weight_N:.4g} N at maxRotVelocity "
                 f"{rotor.max_rot_velocity_rad_s:g} rad/s for {trim.weight_N:.4g} N of weight "
                 f"({ctx.whole_robot.mass_kg:.4g} kg)",
-                rotor.plugin.param_loc("maxRotVelocity"), "rotors",
+                rotor.param_loc("maxRotVelocity"), "rotors",
                 hint=f"check motorConstant and maxRotVelocity; maxRotVelocity {needed:.0f} rad/s "
                      "gives thrust-to-weight 3")
 
