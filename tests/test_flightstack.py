@@ -317,3 +317,16 @@ def test_cli_missing_airframe_is_one_line(tmp_path):
     assert code == 2 and "nope" in output and "file not found" in output
     code, output = run_cli("validate", X500, "--airframe", FIX / "x500_airframe")
     assert code == 0 and "C421" in output
+
+
+def test_vtol_pusher_is_a_ca_rotor_but_not_in_the_hover(tmp_path):
+    vtol = Path(__file__).parent / "fixtures" / "vtol" / "vtol_pusher.sdf"
+    text = (FIX / "vtol_pusher_airframe").read_text()
+    findings = px4_findings(tmp_path, text, vtol)
+    assert not_info(findings) == []                     # 5 CA rotors = 4 lift + the pusher
+    assert "C421" in [f.code for f in findings]
+    flipped = text.replace("CA_ROTOR4_KM 0.05", "CA_ROTOR4_KM -0.05")
+    assert not_info(px4_findings(tmp_path, flipped, vtol)) == ["C416"]
+    level = text.replace("CA_ROTOR4_AX 1", "CA_ROTOR4_AX 0").replace("CA_ROTOR4_AZ 0",
+                                                                       "CA_ROTOR4_AZ -1")
+    assert not_info(px4_findings(tmp_path, level, vtol)) == ["C418"]
