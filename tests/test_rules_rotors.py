@@ -29,7 +29,8 @@ CASES = [
     ("R308_bad_heavy.urdf", ["R308"]),
     # T/W 1.35 on a symmetric quad means sqrt(1/1.35) = 86 % hover throttle as well.
     ("R309_bad_low_margin.urdf", ["R309", "R310"]),
-    ("R310_bad_front_heavy.urdf", ["R310"]),
+    # Front-heavy: the rear rotors hover harder than the front ones (R342 names the shift).
+    ("R310_bad_front_heavy.urdf", ["R310", "R342"]),
     ("R311_bad_tilted.urdf", ["R311"]),
     ("R312_bad_rotor_count.urdf", ["R312"]),
     ("R313_bad_revolute.urdf", ["R313"]),
@@ -38,6 +39,11 @@ CASES = [
     ("R315_bad_link_mismatch.urdf", ["R315"]),
     ("R316_bad_motor_constant.urdf", ["R316"]),
     ("R316_bad_missing_max_speed.urdf", ["R316"]),
+    # Plausibility (checks/plausibility_rules.py): clean_quad_x with one edit each.
+    ("R340_bad_copied_speed.urdf", ["R340"]),
+    ("R341_bad_joint_axis.urdf", ["R341"]),
+    ("R342_bad_long_arm.urdf", ["R342"]),
+    ("I220_bad_tiny_frame.urdf", ["I220", "I220"]),
     ("clean_quad_x.urdf", []),
     ("clean_hex.urdf", []),
     ("clean_octo.urdf", []),

@@ -65,8 +65,12 @@ def build_tree(robot: Robot) -> Tree:
 
 
 class CheckContext:
-    def __init__(self, robot: Robot, controllers: Sequence[Any] = ()):
+    def __init__(self, robot: Robot, controllers: Sequence[Any] = (),
+                 flight_params: Sequence[Any] = ()):
         self.robot = robot
+        # Autopilot parameter files (validate --airframe / --autopilot-params):
+        # reedtool.flightstack.px4.Px4Params and .ardupilot.ArduPilotParams.
+        self.flight_params = list(flight_params)
         # Controller tables read from files (validate --controller), reedtool.flightstack.controller_tables.
         self.controllers = list(controllers)
         self._geometry_props: dict[str, Any] = {}

@@ -27,6 +27,11 @@ FAMILIES: dict[str, tuple[str, str]] = {
     "R": ("reedtool.checks.rotor_rules", "Rotors"),
     "C": ("reedtool.checks.controller_rules", "Controller cross-check"),
 }
+# Further rule modules of the families above (a family may span modules).
+EXTRA_RULE_MODULES: tuple[str, ...] = (
+    "reedtool.checks.flightstack_rules",
+    "reedtool.checks.plausibility_rules",
+)
 
 _CODE = re.compile(r"^[A-Z]\d{3}$")
 _SLUG = re.compile(r"^[a-z0-9]+(-[a-z0-9]+)*$")
@@ -77,6 +82,8 @@ def rule(code: str, slug: str, severity: str, summary: str) -> Callable[[CheckFn
 
 def _load_families() -> None:
     for module_name, _title in FAMILIES.values():
+        importlib.import_module(module_name)
+    for module_name in EXTRA_RULE_MODULES:
         importlib.import_module(module_name)
 
 

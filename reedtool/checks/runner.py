@@ -77,13 +77,13 @@ def parse_severity_overrides(values: Mapping[str, str], *, origin: str) -> dict[
 
 
 def run_checks(robot: Robot, selection: Selection | None = None, *,
-               controllers: Sequence = ()) -> list[Finding]:
+               controllers: Sequence = (), flight_params: Sequence = ()) -> list[Finding]:
     """Every finding of every selected rule, in deterministic order, duplicates removed.
 
     `controllers`: controller rotor tables read from files (reedtool.flightstack.controller_tables).
     """
     selection = selection or Selection()
-    ctx = CheckContext(robot, controllers)
+    ctx = CheckContext(robot, controllers, flight_params)
     findings: set[Finding] = set()
     for rule in all_rules():
         if not selection.enabled(rule.code):

@@ -61,9 +61,16 @@ def _import_body_mesh(spec, units: str, from_frame: str):
 
 
 def new_package(spec, output_dir: Path, *, force: bool = False, mesh_units: str = "auto",
-                mesh_frame: str = "flu") -> NewPackageResult:
-    """Render the package for `spec` into output_dir/spec.name, all or nothing."""
+                mesh_frame: str = "flu", autopilot: str | None = None) -> NewPackageResult:
+    """Render the package for `spec` into output_dir/spec.name, all or nothing.
+
+    `autopilot` ('px4' | 'ardupilot') adds the autopilot's rotor table, written from the
+    same frame as the model (reedtool.scaffold.autopilot).
+    """
+    from reedtool.scaffold.autopilot import autopilot_files, prepare_spec
     from reedtool.scaffold.render import RenderedFile, check_target, render_tree, write_tree
+
+    spec = prepare_spec(spec, autopilot)
 
     target = Path(output_dir) / spec.name
     check_target(target.absolute(), force)   # fail before any expensive work
@@ -76,6 +83,7 @@ def new_package(spec, output_dir: Path, *, force: bool = False, mesh_units: str 
     files = render_tree(template_sets(spec.kind, spec.ros, spec.sim), context)
     if mesh_data is not None:
         files.append(RenderedFile(PurePosixPath("meshes", context["mesh_file"]), mesh_data, 0o644))
+    files += autopilot_files(spec, autopilot)
     backup = write_tree(target, files, force=force)
     return NewPackageResult(target, sorted(f.path for f in files), backup, context)
 
@@ -97,8 +105,11 @@ def _summary(result: NewPackageResult, spec) -> list[str]:
         lines.append(f"mass {ctx['p']['mass']} kg body, {ctx['total_mass_kg']} kg total; "
                      f"{len(ctx['wheels'])} wheels, {ctx['drive'].replace('_', '-')} on cmd_vel")
     model = model_path(spec)
+    autopilot = next((f for f in result.files if f.parts[0] in ("px4", "ardupilot")), None)
+    option = {"px4": "--airframe", "ardupilot": "--autopilot-params"}
+    check = f" {option[autopilot.parts[0]]} {result.target / autopilot}" if autopilot else ""
     lines.append("next:")
-    lines.append(f"  reedtool validate {result.target / model}")
+    lines.append(f"  reedtool validate {result.target / model}{check}")
     if spec.kind == "multirotor":
         lines.append(f"  reedtool hover-test {result.target / model}")
     if spec.sim == "gz":
@@ -132,8 +143,11 @@ def _summary(result: NewPackageResult, spec) -> list[str]:
               help="Directory to create the package directory NAME in.")
 @click.option("--force", is_flag=True,
               help="Regenerate into an existing package; the old tree is kept as NAME.bak.")
+@click.option("--autopilot", type=click.Choice(["px4", "ardupilot"]), default=None,
+              help="Also write the autopilot's rotor table for this model: a PX4 gz airframe "
+                   "(px4/) or an ArduPilot .parm (ardupilot/).")
 def command(name, frame, ros, sim, spec_file, mass, arm_length, mesh, mesh_units, mesh_frame,
-            output_dir, force) -> int:
+            output_dir, force, autopilot=None) -> int:
     """Create the ROS package NAME for a multirotor or ground robot.
 
     Masses and inertias are computed from the geometry; a multirotor (gz-sim
@@ -145,7 +159,7 @@ def command(name, frame, ros, sim, spec_file, mass, arm_length, mesh, mesh_units
     spec = build_spec(name, frame=frame, ros=int(ros) if ros else None, spec_file=spec_file,
                       flags={"mass": mass, "arm_length": arm_length}, mesh=mesh, sim=sim)
     result = new_package(spec, output_dir, force=force, mesh_units=mesh_units,
-                         mesh_frame=mesh_frame)
+                         mesh_frame=mesh_frame, autopilot=autopilot)
     for line in _summary(result, spec):
         click.echo(line)
     return 0

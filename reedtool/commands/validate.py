@@ -53,10 +53,17 @@ def _use_color(no_color: bool) -> bool:
               type=click.Path(path_type=Path, dir_okay=False),
               help="RotorS-style vehicle parameter YAML to cross-check against the model "
                    "(repeatable).")
+@click.option("--airframe", "airframe_files", multiple=True, metavar="FILE",
+              type=click.Path(path_type=Path, dir_okay=False),
+              help="PX4 airframe script or parameter file to cross-check (repeatable).")
+@click.option("--autopilot-params", "autopilot_files", multiple=True, metavar="FILE.parm",
+              type=click.Path(path_type=Path, dir_okay=False),
+              help="ArduPilot .parm file to cross-check (FRAME_CLASS/TYPE, SERVOn_FUNCTION).")
 def command(model: Path | None, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
             model_name: str | None, fmt: str, select: tuple[str, ...], ignore: tuple[str, ...],
             explain_code: str | None, strict: bool | None, no_color: bool,
-            controller_files: tuple[Path, ...] = ()) -> int:
+            controller_files: tuple[Path, ...] = (), airframe_files: tuple[Path, ...] = (),
+            autopilot_files: tuple[Path, ...] = ()) -> int:
     """Check MODEL (.urdf, .xacro or .sdf, with xacro NAME:=VALUE arguments) for mistakes.
 
     Exit 0 when there is no error, 1 when there are errors (or warnings with --strict),
@@ -102,10 +109,14 @@ def command(model: Path | None, mappings: tuple[str, ...], package_paths: tuple[
         from reedtool.flightstack.controller_tables import load_controller_yaml
 
         controllers = [load_controller_yaml(path) for path in controller_files]
+    from reedtool.flightstack.params_files import load_flight_params
+
+    flight_params = load_flight_params(airframe_files, autopilot_files)
     findings = []
     outputs = []
     for robot in robots:
-        robot_findings = run_checks(robot, selection, controllers=controllers)
+        robot_findings = run_checks(robot, selection, controllers=controllers,
+                                    flight_params=flight_params)
         findings += robot_findings
         # A world checked model by model reports each under its name.
         label = str(model) if len(robots) == 1 else f"{model} [model {robot.name}]"

@@ -1,0 +1,266 @@
+"""PX4 parameters with their lines: airframe scripts and QGroundControl parameter files.
+
+Two formats, recognised line by line so a file may mix them:
+
+* an airframe script (PX4-Autopilot `ROMFS/px4fmu_common/init.d-posix/airframes/*`):
+  `param set-default NAME VALUE` and `param set NAME VALUE`; `#` comments and every
+  other shell line are ignored. A `param set` value beats a `set-default` one whatever
+  their order (set-default only changes the default); otherwise the last line wins.
+* a QGroundControl export: tab-separated `vehicle-id  component-id  NAME  VALUE  type`.
+
+What the rotor table means (PX4 control allocation, v1.14+; src/modules/control_allocator
+module.yaml and ActuatorEffectivenessRotors): `CA_ROTOR_COUNT` rotors, rotor i at
+`CA_ROTORi_PX/PY/PZ` metres in the body frame FRD (x forward, y right, z down) relative to
+the centre of gravity, thrust along `CA_ROTORi_AX/AY/AZ` (default 0, 0, -1: up), and
+`CA_ROTORi_KM` the yaw moment per thrust, positive for a counter-clockwise rotor (seen
+from above), negative for clockwise. For Gazebo SITL the gz bridge (src/modules/simulation/
+gz_bridge module.yaml) sends ESC output k (1-based) as velocity k-1 of the motor command,
+which the MulticopterMotorModel with that actuator number turns into rad/s; output k
+carries CA rotor i when `SIM_GZ_EC_FUNCk` = 101 + i (function "Motor i+1"), and its
+command range is `SIM_GZ_EC_MINk` .. `SIM_GZ_EC_MAXk` rad/s.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from reedtool.errors import ReedtoolError
+from reedtool.model import SourceLoc
+
+MOTOR_FUNCTION_BASE = 101          # PX4 output function "Motor 1"
+MAX_GZ_OUTPUTS = 8                 # SIM_GZ_EC has 8 channels (gz_bridge module.yaml)
+MAX_CA_ROTORS = 12
+
+# Documented ranges of the parameters reedtool reads or writes: (min, max, default, source).
+_CA = "PX4-Autopilot src/modules/control_allocator/module.yaml"
+_GZ = "PX4-Autopilot src/modules/simulation/gz_bridge/module.yaml"
+PARAM_RANGES: dict[str, tuple[float, float, float | None, str]] = {
+    "CA_ROTOR_COUNT": (0, MAX_CA_ROTORS, 0, _CA),
+    "CA_ROTOR#_PX": (-100.0, 100.0, 0.0, _CA),
+    "CA_ROTOR#_PY": (-100.0, 100.0, 0.0, _CA),
+    "CA_ROTOR#_PZ": (-100.0, 100.0, 0.0, _CA),
+    "CA_ROTOR#_AX": (-100.0, 100.0, 0.0, _CA),
+    "CA_ROTOR#_AY": (-100.0, 100.0, 0.0, _CA),
+    "CA_ROTOR#_AZ": (-100.0, 100.0, -1.0, _CA),
+    "CA_ROTOR#_KM": (-1.0, 1.0, 0.05, _CA),
+    "SIM_GZ_EC_MIN#": (0.0, 1000.0, 0.0, _GZ),
+    "SIM_GZ_EC_MAX#": (0.0, 1000.0, 1000.0, _GZ),
+    "MPC_THR_HOVER": (0.1, 0.8, 0.5, "PX4-Autopilot src/modules/mc_pos_control "
+                                     "(PARAM_DEFINE_FLOAT MPC_THR_HOVER: @min 0.1, @max 0.8)"),
+    "THR_MDL_FAC": (0.0, 1.0, 0.0, "PX4 parameter reference, THR_MDL_FAC (0..1)"),
+}
+
+_QGC_LINE = re.compile(r"^\s*(\d+)\t(\d+)\t([A-Za-z0-9_]+)\t(\S+)\t(\d+)\s*$")
+_PARAM_CMD = re.compile(r"^\s*param\s+(set-default|set)\s+([A-Za-z0-9_]+)\s+(\S+)")
+
+
+def range_key(name: str) -> str:
+    """CA_ROTOR3_KM -> CA_ROTOR#_KM, SIM_GZ_EC_MAX2 -> SIM_GZ_EC_MAX#: the PARAM_RANGES key."""
+    return re.sub(r"\d+", "#", name) if re.search(r"(ROTOR\d+_|EC_M(IN|AX)\d+$)", name) else name
+
+
+@dataclass
+class ParamValue:
+    name: str
+    value: float
+    text: str
+    loc: SourceLoc
+    explicit: bool = True          # False: the documented default, no line in the file
+
+
+@dataclass
+class Px4Rotor:
+    """One CA_ROTOR entry, in PX4's body frame FRD relative to the centre of gravity."""
+
+    index: int                     # i in CA_ROTORi_*
+    position_frd_m: np.ndarray
+    axis_frd: np.ndarray           # as written (not normalised)
+    km: float
+    params: dict[str, ParamValue]  # 'PX', 'PY', ... -> the value and its line
+
+    def loc_of(self, suffix: str) -> SourceLoc:
+        return self.params[suffix].loc
+
+    def where(self, *suffixes: str) -> str:
+        return ", ".join(f"CA_ROTOR{self.index}_{s} {self.params[s].value:g} "
+                         f"({self.params[s].loc})" for s in suffixes)
+
+
+@dataclass
+class Px4Params:
+    file: str
+    values: dict[str, ParamValue] = field(default_factory=dict)
+    problems: list[tuple[str, SourceLoc]] = field(default_factory=list)
+    kind: str = "px4"
+
+    @property
+    def label(self) -> str:
+        return f"PX4 parameters {Path(self.file).name}"
+
+    @property
+    def loc(self) -> SourceLoc:
+        return SourceLoc(self.file, 1)
+
+    def get(self, name: str) -> ParamValue:
+        """The value set in the file, else PX4's documented default (explicit=False)."""
+        if name in self.values:
+            return self.values[name]
+        default = PARAM_RANGES.get(range_key(name), (0, 0, None, ""))[2]
+        return ParamValue(name, math.nan if default is None else float(default),
+                          "", self.loc, explicit=False)
+
+    def has(self, name: str) -> bool:
+        return name in self.values
+
+    @property
+    def rotor_count(self) -> int | None:
+        value = self.values.get("CA_ROTOR_COUNT")
+        return int(value.value) if value is not None and value.value.is_integer() else None
+
+    def rotors(self) -> list[Px4Rotor]:
+        out = []
+        for i in range(min(self.rotor_count or 0, MAX_CA_ROTORS)):
+            params = {s: self.get(f"CA_ROTOR{i}_{s}")
+                      for s in ("PX", "PY", "PZ", "AX", "AY", "AZ", "KM")}
+            out.append(Px4Rotor(
+                i, np.array([params[s].value for s in ("PX", "PY", "PZ")]),
+                np.array([params[s].value for s in ("AX", "AY", "AZ")]),
+                params["KM"].value, params))
+        return out
+
+    def outputs_of(self, ca_index: int) -> list[int]:
+        """The gz ESC outputs k (1-based) whose function is CA rotor `ca_index`."""
+        return [k for k in range(1, MAX_GZ_OUTPUTS + 1)
+                if self.get(f"SIM_GZ_EC_FUNC{k}").value == MOTOR_FUNCTION_BASE + ca_index]
+
+    @property
+    def uses_gz_outputs(self) -> bool:
+        return any(self.has(f"SIM_GZ_EC_FUNC{k}") for k in range(1, MAX_GZ_OUTPUTS + 1))
+
+
+def _number(text: str, name: str, loc: SourceLoc) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise ReedtoolError(f"{name}: '{text}' is not a number", file=loc.file, line=loc.line,
+                            hint="PX4 parameter values are plain numbers") from None
+
+
+def parse_px4_params(text: str, file: str) -> Px4Params:
+    """Read an airframe script or a QGC parameter file; a value that is no number is an error."""
+    params = Px4Params(file)
+    from_set: set[str] = set()
+    for number, line in enumerate(text.splitlines(), start=1):
+        loc = SourceLoc(file, number)
+        stripped = line.strip()
+        if not stripped or stripped.startswith("#"):
+            continue
+        qgc = _QGC_LINE.match(line)
+        if qgc:
+            name, value_text = qgc.group(3), qgc.group(4)
+            params.values[name] = ParamValue(name, _number(value_text, name, loc), value_text, loc)
+            continue
+        cmd = _PARAM_CMD.match(line)
+        if cmd:
+            verb, name, value_text = cmd.groups()
+            value_text = value_text.split("#", 1)[0]
+            if verb == "set-default" and name in from_set:
+                continue
+            if verb == "set":
+                from_set.add(name)
+            params.values[name] = ParamValue(name, _number(value_text, name, loc), value_text, loc)
+    return params
+
+
+def load_px4_params(path: Path) -> Px4Params:
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ReedtoolError("file not found", file=str(path),
+                            hint="give a PX4 airframe script or parameter file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ReedtoolError(f"cannot read the PX4 parameters: {exc}", file=str(path)) from None
+    params = parse_px4_params(text, str(path))
+    if not params.values:
+        raise ReedtoolError("no PX4 parameter found (expected `param set-default NAME VALUE` "
+                            "lines or a QGroundControl tab-separated export)", file=str(path),
+                            hint="--airframe takes a PX4 airframe script or .params file")
+    return params
+
+
+def out_of_range(params: Px4Params) -> list[tuple[ParamValue, tuple]]:
+    """Every value set in the file outside PX4's documented range."""
+    bad = []
+    for value in params.values.values():
+        limits = PARAM_RANGES.get(range_key(value.name))
+        if limits and not (limits[0] <= value.value <= limits[1]):
+            bad.append((value, limits))
+    return bad
+
+
+def frd_from_flu(vector: np.ndarray) -> np.ndarray:
+    """A vector in the ROS body frame (x forward, y left, z up) in PX4's FRD."""
+    return np.array([vector[0], -vector[1], -vector[2]], dtype=float)
+
+
+def bearing_deg(x_forward: float, y_right: float) -> float:
+    """Bearing in the horizontal plane, degrees clockwise from the nose seen from above."""
+    return math.degrees(math.atan2(y_right, x_forward))
+
+
+def thrust_fraction(u: float, thr_mdl_fac: float) -> float:
+    """PX4's thrust model: relative thrust for a relative motor command u (THR_MDL_FAC)."""
+    return thr_mdl_fac * u * u + (1.0 - thr_mdl_fac) * u
+
+
+# ------------------------------------------------------------------ writing
+
+@dataclass
+class RotorSpec:
+    """What new-package knows about one rotor, in the ROS body frame (FLU, about the COM)."""
+
+    actuator_index: int
+    position_flu_m: np.ndarray
+    turning_sign: int              # +1 ccw, -1 cw
+    moment_constant: float
+    max_rot_velocity_rad_s: float
+
+
+def px4_airframe_text(name: str, rotors: list[RotorSpec], *, hover_throttle: float,
+                      idle_rad_s: float = 0.0) -> str:
+    """A PX4 gz airframe script for the rotors (numbered by actuator index)."""
+    order = sorted(rotors, key=lambda r: r.actuator_index)
+    max_rad_s = max(r.max_rot_velocity_rad_s for r in order)
+    if max_rad_s > PARAM_RANGES["SIM_GZ_EC_MAX#"][1]:
+        raise ReedtoolError(f"max_rot_velocity {max_rad_s:g} rad/s is above what PX4 can command "
+                            "through SIM_GZ_EC_MAX (at most 1000 rad/s, gz_bridge module.yaml)",
+                            hint="use a max_rot_velocity of at most 1000 rad/s with --autopilot px4")
+    lines = ["#!/bin/sh", "#", f"# @name {name} (generated by reedtool new-package)", "#",
+             "# @type Multicopter", "#", "", ". ${R}etc/init.d/rc.mc_defaults", "",
+             "PX4_SIMULATOR=${PX4_SIMULATOR:=gz}", f"PX4_SIM_MODEL=${{PX4_SIM_MODEL:={name}}}", "",
+             "param set-default SIM_GZ_EN 1", "", "param set-default CA_AIRFRAME 0",
+             f"param set-default CA_ROTOR_COUNT {len(order)}", ""]
+    for i, rotor in enumerate(order):
+        p = np.round(frd_from_flu(rotor.position_flu_m), 9) + 0.0   # no "-0" in the file
+        km = rotor.turning_sign * min(abs(rotor.moment_constant), 1.0)
+        lines += [f"param set-default CA_ROTOR{i}_PX {p[0]:.6g}",
+                  f"param set-default CA_ROTOR{i}_PY {p[1]:.6g}",
+                  f"param set-default CA_ROTOR{i}_PZ {p[2]:.6g}",
+                  f"param set-default CA_ROTOR{i}_KM {km:.6g}", ""]
+    for k, rotor in enumerate(order, start=1):
+        lines.append(f"param set-default SIM_GZ_EC_FUNC{rotor.actuator_index + 1} "
+                     f"{MOTOR_FUNCTION_BASE + k - 1}")
+    lines.append("")
+    for rotor in order:
+        k = rotor.actuator_index + 1
+        lines.append(f"param set-default SIM_GZ_EC_MIN{k} {idle_rad_s:g}")
+        lines.append(f"param set-default SIM_GZ_EC_MAX{k} {rotor.max_rot_velocity_rad_s:g}")
+    lines += ["", f"param set-default MPC_THR_HOVER {hover_throttle:.2f}",
+              "param set-default THR_MDL_FAC 0", ""]
+    return "\n".join(lines)

@@ -1,0 +1,102 @@
+"""new-package --autopilot: the PX4 airframe or ArduPilot .parm of a generated multirotor.
+
+Both files are written from the frame catalogue entry the model is rendered from
+(reedtool.scaffold.airframes), so the package is consistent by construction:
+
+* PX4 (`px4/airframe_gz_<name>`): CA rotor i is the rotor with the i-th smallest motor
+  number, at its position about the model's centre of mass in FRD, KM = ±momentConstant
+  (+ for ccw), SIM_GZ_EC_FUNC(actuator+1) = 101 + i, SIM_GZ_EC_MIN 0 and SIM_GZ_EC_MAX =
+  maxRotVelocity, MPC_THR_HOVER = hover speed / maxRotVelocity (THR_MDL_FAC 0: PX4's thrust
+  model linear in the command, as the gz bridge maps the command to rad/s linearly).
+* ArduPilot (`ardupilot/<name>.parm`): the first AP_MotorsMatrix frame whose motors sit at
+  the frame's bearings with its spins, and SERVO(actuator+1)_FUNCTION = the motor of that
+  bearing. PX4's octorotor X spins every rotor the other way from ArduPilot's octa X; for
+  ArduPilot the catalogue frame is used with its spins reversed (a mirror-image prop set),
+  and the model is generated with those spins too.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import PurePosixPath
+
+import numpy as np
+
+from reedtool.errors import ReedtoolError
+from reedtool.scaffold.airframes import Airframe
+
+AUTOPILOTS = ("px4", "ardupilot")
+# ArduPilot bearings from add_motor_raw factors (Y6) are atan2 of rounded factors: 63.4°
+# for a 60° arm. Within this, a catalogue rotor and an ArduPilot motor are the same place.
+AP_BEARING_TOL_DEG = 10.0
+
+
+def _spins(frame: Airframe) -> list[int]:
+    return [1 if slot.direction == "ccw" else -1 for slot in frame.rotors]
+
+
+def ardupilot_frame(frame: Airframe) -> tuple[Airframe, int, int, list[int]]:
+    """(the frame to generate, FRAME_CLASS, FRAME_TYPE, AP motor number per catalogue rotor)."""
+    from reedtool.flightstack.ardupilot import match_frame
+
+    bearings = [slot.bearing_deg for slot in frame.rotors]
+    found = match_frame(bearings, _spins(frame), AP_BEARING_TOL_DEG)
+    if found is not None:
+        return frame, *found
+    reversed_frame = dataclasses.replace(frame, rotors=tuple(
+        dataclasses.replace(slot, direction="cw" if slot.direction == "ccw" else "ccw")
+        for slot in frame.rotors), reference=frame.reference + "; spins reversed for ArduPilot")
+    found = match_frame(bearings, _spins(reversed_frame), AP_BEARING_TOL_DEG)
+    if found is None:
+        raise ReedtoolError(f"no ArduPilot frame has the rotor layout of '{frame.name}'",
+                            hint="use --autopilot px4 for this frame")
+    return reversed_frame, *found
+
+
+def prepare_spec(spec, autopilot: str | None):
+    """The spec to render for an autopilot (ArduPilot may need the spins of its frame)."""
+    if autopilot == "ardupilot" and spec.kind == "multirotor":
+        spec.frame = ardupilot_frame(spec.frame)[0]
+    return spec
+
+
+def _com_m(spec, positions: np.ndarray) -> np.ndarray:
+    """Whole-model COM: body and sensors at the origin, each rotor's mass at its hub."""
+    from reedtool.scaffold.package_spec import total_mass_estimate_kg
+
+    return spec["mass_rotor"] * positions.sum(axis=0) / total_mass_estimate_kg(spec)
+
+
+def autopilot_files(spec, autopilot: str | None):
+    """The RenderedFiles for `--autopilot`, or [] without it."""
+    from reedtool.scaffold.render import RenderedFile
+
+    if autopilot is None:
+        return []
+    if spec.kind != "multirotor":
+        raise ReedtoolError("--autopilot applies to multirotor frames only",
+                            hint="drop --autopilot for a ground robot")
+    frame: Airframe = spec.frame
+    positions = frame.rotor_positions_m(spec["arm_length"], spec["rotor_offset_top"])
+    if autopilot == "px4":
+        from reedtool.flightstack.px4 import RotorSpec, px4_airframe_text
+        from reedtool.scaffold.package_spec import STANDARD_GRAVITY_M_S2, total_mass_estimate_kg
+
+        com = _com_m(spec, positions)
+        rotors = [RotorSpec(slot.motor_number, position - com,
+                            1 if slot.direction == "ccw" else -1, spec["moment_constant"],
+                            spec["max_rot_velocity"])
+                  for slot, position in zip(frame.rotors, positions)]
+        weight_N = total_mass_estimate_kg(spec) * STANDARD_GRAVITY_M_S2
+        hover_rad_s = np.sqrt(weight_N / (frame.rotor_count * spec["motor_constant"]))
+        throttle = float(np.clip(hover_rad_s / spec["max_rot_velocity"], 0.1, 0.8))
+        text = px4_airframe_text(spec.name, rotors, hover_throttle=throttle)
+        path = PurePosixPath("px4", f"airframe_gz_{spec.name}")
+    else:
+        from reedtool.flightstack.ardupilot import parm_text
+
+        _frame, frame_class, frame_type, motors = ardupilot_frame(frame)
+        outputs = {slot.motor_number + 1: motor for slot, motor in zip(frame.rotors, motors)}
+        text = parm_text(spec.name, frame_class, frame_type, outputs)
+        path = PurePosixPath("ardupilot", f"{spec.name}.parm")
+    return [RenderedFile(path, text.encode("utf-8"), 0o644)]

@@ -1,0 +1,62 @@
+"""new-package --autopilot: every multirotor frame validates clean against its own autopilot file."""
+
+from __future__ import annotations
+
+import pytest
+
+from reedtool.checks.runner import Selection, run_checks
+from reedtool.commands.new_package import model_path, new_package
+from reedtool.flightstack import ardupilot, px4
+from reedtool.io.loader import load_robot
+from reedtool.scaffold.airframes import MULTIROTOR_FRAMES
+from reedtool.scaffold.package_spec import build_spec
+
+
+def _generate(tmp_path, frame: str, autopilot: str, ros: int = 2, sim: str | None = None):
+    name = f"ap_{frame.replace('-', '_')}_{autopilot}"
+    spec = build_spec(name, frame=frame, ros=ros, flags={}, sim=sim)
+    result = new_package(spec, tmp_path, autopilot=autopilot)
+    extra = [f for f in result.files if f.parts[0] == autopilot]
+    assert len(extra) == 1
+    return result.target / model_path(spec), result.target / extra[0], spec
+
+
+@pytest.mark.parametrize("frame", MULTIROTOR_FRAMES)
+@pytest.mark.parametrize("autopilot", ["px4", "ardupilot"])
+def test_generated_autopilot_file_is_clean(tmp_path, frame, autopilot):
+    model, table, _spec = _generate(tmp_path, frame, autopilot)
+    params = px4.load_px4_params(table) if autopilot == "px4" else ardupilot.load_parm(table)
+    findings = run_checks(load_robot(model), Selection(), flight_params=[params])
+    assert [f for f in findings if f.severity != "info"] == []
+    # PX4: only the hover-throttle comparison, no position offset, no KM mismatch.
+    assert sorted(f.code for f in findings) == (["C421"] if autopilot == "px4" else [])
+    if autopilot == "px4":
+        assert px4.out_of_range(params) == []               # PX4's documented ranges
+        assert params.rotor_count == len(params.rotors()) > 0
+
+
+def test_rotors_classic_package_with_px4(tmp_path):
+    model, table, _spec = _generate(tmp_path, "quad-x", "px4", ros=1, sim="classic")
+    findings = run_checks(load_robot(model), Selection(select=("C",)),
+                          flight_params=[px4.load_px4_params(table)])
+    assert sorted(f.code for f in findings) == ["C421"]
+
+
+def test_quad_x_airframe_values_by_hand(tmp_path):
+    _model, table, spec = _generate(tmp_path, "quad-x", "px4")
+    params = px4.load_px4_params(table)
+    arm = spec["arm_length"]
+    # Motor 1 (CA rotor 0) front-right ccw: FRD (+L, +L), KM +momentConstant.
+    assert params.get("CA_ROTOR0_PX").value == pytest.approx(arm, abs=1e-6)
+    assert params.get("CA_ROTOR0_PY").value == pytest.approx(arm, abs=1e-6)
+    assert params.get("CA_ROTOR0_KM").value == pytest.approx(spec["moment_constant"])
+    assert params.get("CA_ROTOR2_KM").value == pytest.approx(-spec["moment_constant"])
+    assert params.get("SIM_GZ_EC_MAX1").value == pytest.approx(spec["max_rot_velocity"])
+
+
+def test_octo_x_for_ardupilot_takes_its_spins(tmp_path):
+    # ArduPilot's octa X spins every rotor the other way from the catalogue's PX4 octo X.
+    _model, table, spec = _generate(tmp_path, "octo-x", "ardupilot")
+    params = ardupilot.load_parm(table)
+    assert (params.get("FRAME_CLASS").value, params.get("FRAME_TYPE").value) == (3, 1)
+    assert spec.frame.rotors[0].direction == "cw"          # AP motor 1 at 22.5°: CW
