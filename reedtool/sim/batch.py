@@ -413,6 +413,7 @@ class BatchReport:
     worst: list[dict]
     spreads: Spreads
     seed: int | None
+    engine: str = "numpy"
 
     @property
     def pass_rate(self) -> float:
@@ -421,6 +422,7 @@ class BatchReport:
     def to_dict(self) -> dict:
         return {"samples": self.n_vehicles, "passed": self.passed,
                 "pass_rate": self.pass_rate, "counts": self.counts, "seed": self.seed,
+                "engine": self.engine,
                 "spreads": {"mass_rel": self.spreads.mass_rel, "com_m": self.spreads.com_m,
                             "inertia_rel": self.spreads.inertia_rel,
                             "motor_constant_rel": self.spreads.motor_constant_rel},
@@ -430,11 +432,22 @@ class BatchReport:
 def robustness_batch(params: VehicleParams, n_vehicles: int, config: HoverConfig = HoverConfig(),
                      spreads: Spreads = Spreads(), seed: int | None = 0, n_worst: int = 5,
                      design: ControllerDesign = ControllerDesign(),
-                     progress: Callable[[int], None] | None = None) -> BatchReport:
-    """Fly `n_vehicles` perturbed copies of `params`; pass rate and the worst cases."""
+                     progress: Callable[[int], None] | None = None,
+                     engine: str = "numpy") -> BatchReport:
+    """Fly `n_vehicles` perturbed copies of `params`; pass rate and the worst cases.
+
+    `engine`: "numpy" (this module, the reference) or "numba" (`compiled`, all cores).
+    """
     perturbation = sample_perturbations(n_vehicles, params.n_rotors, spreads, seed)
-    outcome = simulate_batch(params, config, perturbed_plant(params, perturbation), design,
-                             progress)
+    plant = perturbed_plant(params, perturbation)
+    if engine == "numba":
+        from reedtool.sim.compiled import simulate_batch_compiled
+
+        outcome = simulate_batch_compiled(params, config, plant, design)
+        if progress is not None:
+            progress(config.n_steps)
+    else:
+        outcome = simulate_batch(params, config, plant, design, progress)
     passed = outcome.status_code == STATUS_CODES[ExitStatus.PASSED]
     counts: dict[str, int] = {}
     for code in outcome.status_code:
@@ -458,7 +471,7 @@ def robustness_batch(params: VehicleParams, n_vehicles: int, config: HoverConfig
             "max_attitude_error_deg": float(outcome.max_attitude_error_deg[i]),
             "settle_time_s": _finite_or_none(float(outcome.settle_time_s[i])),
         })
-    return BatchReport(n_vehicles, int(passed.sum()), counts, worst, spreads, seed)
+    return BatchReport(n_vehicles, int(passed.sum()), counts, worst, spreads, seed, engine)
 
 
 def _finite_or_none(value: float) -> float | None:
