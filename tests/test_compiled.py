@@ -83,7 +83,7 @@ def test_perturbed_batch_equals_the_numpy_batch():
     plant = perturbed_plant(params, sample_perturbations(
         48, 4, Spreads(mass_rel=0.3, com_m=0.03, inertia_rel=0.2, motor_constant_rel=0.15), 3))
     ref = simulate_batch(params, config, plant)
-    got = compiled.simulate_batch_compiled(params, config, plant)
+    got = simulate_batch(params, config, plant, engine="numba")
     assert len(set(ref.status_code.tolist())) >= 3        # not all alike
     assert ref.longest_saturation_s.max() > 0.5
     assert_same_outcome(ref, got)
@@ -94,14 +94,14 @@ def test_awkward_vehicle_batch_equals_the_numpy_batch():
     config = HoverConfig(duration_s=2.0, yaw_rad=0.2)
     plant = perturbed_plant(params, sample_perturbations(16, 6, Spreads(), 5))
     assert_same_outcome(simulate_batch(params, config, plant),
-                        compiled.simulate_batch_compiled(params, config, plant))
+                        simulate_batch(params, config, plant, engine="numba"))
 
 
 def _one(params, config, change):
     plant = Plant.from_params(params)
     change(plant)
     return (simulate_batch(params, config, plant),
-            compiled.simulate_batch_compiled(params, config, plant))
+            simulate_batch(params, config, plant, engine="numba"))
 
 
 @pytest.mark.parametrize("change,status", [

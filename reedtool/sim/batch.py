@@ -130,13 +130,20 @@ def hover_speeds(params: VehicleParams, gains: ControllerGains) -> np.ndarray:
 
 def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
                    plant: Plant | None = None, design: ControllerDesign = ControllerDesign(),
-                   progress: Callable[[int], None] | None = None) -> Outcome:
+                   progress: Callable[[int], None] | None = None,
+                   engine: str = "numpy") -> Outcome:
     """Fly every vehicle of `plant` (default: one nominal vehicle) on the nominal controller.
 
     `progress(steps)` is called now and then with the number of steps done since the last call.
+    `engine`: "numpy" (this loop, the reference) or "numba" (`compiled`, across the cores).
     """
     config.validate()
     plant = plant or Plant.from_params(params, 1)
+    if engine == "numba":
+        outcome = _simulate_compiled(params, config, plant, design)
+        if progress is not None:
+            progress(config.n_steps)
+        return outcome
     gains = ControllerGains.from_params(params, design)
     kernel = PlantKernel(plant)
     N, n = plant.n_vehicles, params.n_rotors
@@ -322,6 +329,37 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
         final_state=state, config=config)
 
 
+def _simulate_compiled(params: VehicleParams, config: HoverConfig, plant: Plant,
+                       design: ControllerDesign) -> Outcome:
+    """simulate_batch on the compiled kernel: the same Outcome."""
+    from reedtool.sim.compiled import fly_batch
+
+    out = fly_batch(params, config, plant, design)
+    reason = out["reason"]
+    status = np.array([STATUS_CODES[_STATUS_OF_REASON[REASONS[r]]] for r in reason],
+                      dtype=np.int64)
+    F = out["final"].T
+    state = State(p=F[0:3].copy(), v=F[3:6].copy(), q=F[6:10].copy(), w=F[10:13].copy(),
+                  omega=F[13:].copy())
+    return Outcome(
+        status_code=status, reason=reason, reason_value=out["reason_value"],
+        end_time_s=out["end_time_s"], settle_time_s=out["settle_time_s"],
+        max_position_error_m=out["max_position_error_m"],
+        max_attitude_error_deg=np.degrees(np.arccos(out["min_cos_attitude"])),
+        final_position_error_m=out["final_position_error_m"],
+        final_attitude_error_deg=np.degrees(np.arccos(out["final_cos_attitude"])),
+        max_throttle=out["max_throttle"], longest_saturation_s=out["longest_saturation_s"],
+        final_omega_rad_s=state.omega.copy(), final_state=state, config=config)
+
+
+_STATUS_OF_REASON = {
+    "settled": ExitStatus.PASSED, "not-settled": ExitStatus.NOT_SETTLED,
+    "saturated": ExitStatus.SATURATED, "non-finite": ExitStatus.DIVERGED,
+    "drifted": ExitStatus.DIVERGED, "rate": ExitStatus.DIVERGED,
+    "ground": ExitStatus.CRASHED, "flipped": ExitStatus.CRASHED,
+    "yaw-spin": ExitStatus.YAW_SPIN}
+
+
 def _judge_events(config: HoverConfig, status: np.ndarray, reason: np.ndarray,
                   reason_value: np.ndarray, end_time: np.ndarray, running: np.ndarray,
                   t: float, state: State, R: np.ndarray, pos: np.ndarray) -> np.ndarray:
@@ -439,15 +477,8 @@ def robustness_batch(params: VehicleParams, n_vehicles: int, config: HoverConfig
     `engine`: "numpy" (this module, the reference) or "numba" (`compiled`, all cores).
     """
     perturbation = sample_perturbations(n_vehicles, params.n_rotors, spreads, seed)
-    plant = perturbed_plant(params, perturbation)
-    if engine == "numba":
-        from reedtool.sim.compiled import simulate_batch_compiled
-
-        outcome = simulate_batch_compiled(params, config, plant, design)
-        if progress is not None:
-            progress(config.n_steps)
-    else:
-        outcome = simulate_batch(params, config, plant, design, progress)
+    outcome = simulate_batch(params, config, perturbed_plant(params, perturbation), design,
+                             progress, engine)
     passed = outcome.status_code == STATUS_CODES[ExitStatus.PASSED]
     counts: dict[str, int] = {}
     for code in outcome.status_code:

@@ -23,7 +23,7 @@ import time
 
 import numpy as np
 
-from reedtool.sim import STATUS_CODES, ExitStatus, HoverConfig
+from reedtool.sim import HoverConfig
 from reedtool.sim.controller import ControllerDesign, ControllerGains
 
 try:        # the extra; everything below the guard needs it
@@ -485,52 +485,56 @@ def _nominal(params, gains: ControllerGains, config: HoverConfig, plant) -> tupl
 
 
 def _start(params, gains, config: HoverConfig) -> tuple[np.ndarray, tuple, np.ndarray]:
-    """(state0, setpoint, parked state) as batch.initial_state makes them."""
-    from reedtool.sim.batch import initial_state
+    """(state0, setpoint, parked state) as batch.initial_state makes them: the disturbed
+    start at rest with the rotors at the controller's trim speeds."""
+    from reedtool.sim.dynamics import quat_from_rpy
+    from reedtool.sim.motor import speed_command
 
-    state, setpoint = initial_state(params, gains, config, 1)
-    state0 = np.concatenate([state.p[:, 0], state.v[:, 0], state.q[:, 0], state.w[:, 0],
-                             np.zeros(3), state.omega[:, 0]])
-    park = np.concatenate([setpoint, np.zeros(3), [1.0, 0.0, 0.0, 0.0], np.zeros(3),
-                           state.omega[:, 0]])
+    setpoint = np.array([0.0, 0.0, config.hover_altitude_m])
+    p0 = setpoint + np.asarray(config.offset_m, dtype=float)
+    q0 = quat_from_rpy(config.roll_rad, config.pitch_rad, config.yaw_rad)
+    omega0 = speed_command(gains.allocation_pinv @ np.array([params.weight_N, 0.0, 0.0, 0.0]),
+                           gains.motor_constant, gains.omega_max_rad_s)
+    state0 = np.concatenate([p0, np.zeros(3), q0, np.zeros(3), np.zeros(3), omega0])
+    park = np.concatenate([setpoint, np.zeros(3), [1.0, 0.0, 0.0, 0.0], np.zeros(3), omega0])
     return state0, tuple(float(x) for x in setpoint), park
 
 
 def warm_up() -> float:
     """Compile (or load from numba's cache) both kernels on a tiny vehicle; seconds spent."""
+    from reedtool.sim.dynamics import Plant
     from reedtool.sim.params import symmetric_multirotor
 
     start = time.perf_counter()
     params = symmetric_multirotor(4)
     config = HoverConfig(duration_s=0.02, hold_s=0.01)
-    simulate_batch_compiled(params, config)
-    simulate_batch_compiled(params, config, n_vehicles_if_nominal=2)
+    for n_vehicles in (1, 2):
+        fly_batch(params, config, Plant.from_params(params, n_vehicles))
     return time.perf_counter() - start
 
 
-def simulate_batch_compiled(params, config: HoverConfig = HoverConfig(), plant=None,
-                            design: ControllerDesign = ControllerDesign(),
-                            n_vehicles_if_nominal: int = 1):
-    """batch.simulate_batch on the compiled kernel: the same Outcome.
+def fly_batch(params, config: HoverConfig, plant,
+              design: ControllerDesign = ControllerDesign()) -> dict[str, np.ndarray]:
+    """Every vehicle of `plant` flown on the nominal controller, judged as
+    batch.simulate_batch judges: per-vehicle arrays "reason" (batch.REASONS index),
+    "saturation_rotor", the OUT_FIELDS and "final" (N, 13 + n: p, v, q, w, omega; the
+    parked level hover for vehicles that ended early, as the numpy batch parks them).
+    batch.simulate_batch(engine="numba") turns them into its Outcome.
 
     One vehicle runs on the serial kernel, more on the parallel one.
     """
-    from reedtool.sim.batch import Outcome
-    from reedtool.sim.dynamics import Plant, State
-
     if numba is None:
         raise RuntimeError(unavailable_reason())
     config.validate()
-    plant = plant or Plant.from_params(params, n_vehicles_if_nominal)
     gains = ControllerGains.from_params(params, design)
     state0, setpoint, park = _start(params, gains, config)
     cfg = _settings(params, gains, config, setpoint)
     nominal = _nominal(params, gains, config, plant)
     N, n = plant.n_vehicles, params.n_rotors
-    mass = np.ascontiguousarray(plant.mass_kg, dtype=float)
-    S = np.ascontiguousarray(plant.inertia_scale_sqrt, dtype=float)
-    shift = np.ascontiguousarray(plant.com_shift_m, dtype=float)
-    k = np.ascontiguousarray(plant.motor_constant, dtype=float)
+    mass = np.array(plant.mass_kg, dtype=float)
+    S = np.array(plant.inertia_scale_sqrt, dtype=float, order="C")
+    shift = np.array(plant.com_shift_m, dtype=float, order="C")
+    k = np.array(plant.motor_constant, dtype=float, order="C")
     out_f = np.zeros((N, len(OUT_FIELDS)))
     out_i = np.zeros((N, 2), dtype=np.int64)
     final = np.zeros((N, 13 + n))
@@ -539,27 +543,12 @@ def simulate_batch_compiled(params, config: HoverConfig = HoverConfig(), plant=N
                  k[:, 0].copy(), state0, out_f[0], out_i[0], final[0], np.empty((0, 0)))
     else:
         _fly_batch(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final)
-    reason = out_i[:, 0]
-    # Vehicles that ended early are reported parked at a level hover, as the numpy batch
-    # parks them.
+    reason = out_i[:, 0].copy()
     ended = ~np.isin(reason, [_SETTLED, _NOT_SETTLED, _SATURATED])
     final[ended] = park
-    status = np.array([STATUS_CODES[_STATUS_OF_REASON[int(r)]] for r in reason],
-                      dtype=np.int64)
-    col = {name: out_f[:, i] for i, name in enumerate(OUT_FIELDS)}
-    F = final.T
-    state = State(p=F[0:3].copy(), v=F[3:6].copy(), q=F[6:10].copy(), w=F[10:13].copy(),
-                  omega=F[13:].copy())
-    return Outcome(
-        status_code=status, reason=reason.copy(), reason_value=col["reason_value"].copy(),
-        end_time_s=col["end_time_s"].copy(), settle_time_s=col["settle_time_s"].copy(),
-        max_position_error_m=col["max_position_error_m"].copy(),
-        max_attitude_error_deg=np.degrees(np.arccos(col["min_cos_attitude"])),
-        final_position_error_m=col["final_position_error_m"].copy(),
-        final_attitude_error_deg=np.degrees(np.arccos(col["final_cos_attitude"])),
-        max_throttle=col["max_throttle"].copy(),
-        longest_saturation_s=col["longest_saturation_s"].copy(),
-        final_omega_rad_s=state.omega.copy(), final_state=state, config=config)
+    result = {name: out_f[:, i].copy() for i, name in enumerate(OUT_FIELDS)}
+    result.update(reason=reason, saturation_rotor=out_i[:, 1].copy(), final=final)
+    return result
 
 
 def vehicle_flyer(params, gains: ControllerGains, config: HoverConfig, setpoint_m):
@@ -604,10 +593,3 @@ def vehicle_flyer(params, gains: ControllerGains, config: HoverConfig, setpoint_
                       col["final_position_error_m"], col["final_cos_attitude"], omega_end)
 
     return fly
-
-
-_STATUS_OF_REASON = {
-    0: ExitStatus.NOT_SETTLED, _SETTLED: ExitStatus.PASSED, _NOT_SETTLED: ExitStatus.NOT_SETTLED,
-    _NON_FINITE: ExitStatus.DIVERGED, _DRIFTED: ExitStatus.DIVERGED, _RATE: ExitStatus.DIVERGED,
-    _GROUND: ExitStatus.CRASHED, _FLIPPED: ExitStatus.CRASHED, _SATURATED: ExitStatus.SATURATED,
-    _YAW_SPIN: ExitStatus.YAW_SPIN}
