@@ -65,6 +65,10 @@ MAX_STEPS = 10_000_000
               show_default=True, help=f"{SPREAD_HELP} of each principal moment (fraction).")
 @click.option("--motor-spread", type=FiniteFloatRange(0.0, 0.9), default=0.05,
               show_default=True, help=f"{SPREAD_HELP} of each motor constant (fraction).")
+@click.option("--engine", type=click.Choice(["numpy", "numba"]), default="numpy",
+              show_default=True,
+              help="Simulator engine: numpy (the reference) or numba (compiled, all cores; "
+                   "needs pip install 'reedtool[fast]').")
 @click.option("--min-pass-rate", type=FiniteFloatRange(0.0, 1.0), default=0.95,
               show_default=True, help="Batch pass rate needed to exit 0.")
 def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
@@ -73,7 +77,7 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
             roll_rad: float, pitch_rad: float, yaw_rad: float, plot_path: Path | None,
             csv_path: Path | None, force: bool, fmt: str, samples: int | None, seed: int,
             mass_spread: float, com_spread_m: float, inertia_spread: float,
-            motor_spread: float, min_pass_rate: float) -> int:
+            motor_spread: float, engine: str, min_pass_rate: float) -> int:
     """Trim MODEL (.urdf or .xacro, with xacro NAME:=VALUE arguments) for hover and fly it.
 
     Starts from a disturbance (default 0.5 m off the setpoint, rolled 0.2 rad) and passes
@@ -93,6 +97,12 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
                             f"is {steps:.3g} steps, more than {MAX_STEPS:.0e}",
                             hint="a hover test settles in seconds; the defaults are 10 s at "
                                  "1000 Hz")
+    if engine == "numba":
+        from reedtool.sim.compiled import available, unavailable_reason
+
+        if not available():
+            raise ReedtoolError(f"bad option: --engine numba: {unavailable_reason()}",
+                                hint="or use --engine numpy (the default)")
     for path in (plot_path, csv_path):
         if path is not None and path.exists() and not force:
             raise ReedtoolError("refusing to overwrite an existing file", file=path,
@@ -110,7 +120,8 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     require_sound_model(robot)
     report = hover_test(robot, config, samples=samples, seed=seed,
                         spreads=(mass_spread, com_spread_m, inertia_spread, motor_spread),
-                        record=bool(plot_path or csv_path), show_progress=fmt == "text")
+                        record=bool(plot_path or csv_path), show_progress=fmt == "text",
+                        engine=engine)
     batch = report.get("batch")
     if batch is not None:
         batch["min_pass_rate"] = min_pass_rate
@@ -139,7 +150,8 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
 
 def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
                spreads: tuple[float, float, float, float] = (0.1, 0.01, 0.1, 0.05),
-               record: bool = False, show_progress: bool = False) -> dict:
+               record: bool = False, show_progress: bool = False,
+               engine: str = "numpy") -> dict:
     """Trim, simulate and (optionally) batch one robot; the JSON-ready report.
 
     Keys: "model", "trim", "sim" (None when the trim failed), "batch" (None without
@@ -190,7 +202,7 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
 
     from reedtool.sim.run import simulate_hover
 
-    run = simulate_hover(params, config, record=record)
+    run = simulate_hover(params, config, record=record, engine=engine)
     sim = run.to_dict()
     sim["trim_omega_rad_s"] = dict(zip(params.rotor_names,
                                        (float(w) for w in trim.omega_rad_s)))
@@ -210,9 +222,9 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
             with click.progressbar(length=config.n_steps, file=sys.stderr,
                                    label=f"flying {samples} vehicles") as bar:
                 batch = robustness_batch(params, samples, config, spread, seed,
-                                         progress=bar.update)
+                                         progress=bar.update, engine=engine)
         else:
-            batch = robustness_batch(params, samples, config, spread, seed)
+            batch = robustness_batch(params, samples, config, spread, seed, engine=engine)
         report["batch"] = batch.to_dict()
     return report
 
@@ -247,7 +259,7 @@ def render_text(report: dict) -> str:
         lines.append(f"sim: {sim['status'].upper()}: {sim['message']}")
         lines.append(f"  start {c['offset_m']} m off, roll {c['roll_rad']:g} pitch "
                      f"{c['pitch_rad']:g} yaw {c['yaw_rad']:g} rad; {c['duration_s']:g} s at "
-                     f"{c['rate_hz']:g} Hz ({c['integrator']})")
+                     f"{c['rate_hz']:g} Hz ({c['integrator']}; engine {sim['engine']})")
         lines.append(f"  max error {sim['max_position_error_m']:.3f} m, "
                      f"{sim['max_attitude_error_deg']:.1f} deg; final "
                      f"{100 * sim['final_position_error_m']:.2f} cm, "

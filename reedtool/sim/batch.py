@@ -130,13 +130,20 @@ def hover_speeds(params: VehicleParams, gains: ControllerGains) -> np.ndarray:
 
 def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
                    plant: Plant | None = None, design: ControllerDesign = ControllerDesign(),
-                   progress: Callable[[int], None] | None = None) -> Outcome:
+                   progress: Callable[[int], None] | None = None,
+                   engine: str = "numpy") -> Outcome:
     """Fly every vehicle of `plant` (default: one nominal vehicle) on the nominal controller.
 
     `progress(steps)` is called now and then with the number of steps done since the last call.
+    `engine`: "numpy" (this loop, the reference) or "numba" (`compiled`, across the cores).
     """
     config.validate()
     plant = plant or Plant.from_params(params, 1)
+    if engine == "numba":
+        outcome = _simulate_compiled(params, config, plant, design)
+        if progress is not None:
+            progress(config.n_steps)
+        return outcome
     gains = ControllerGains.from_params(params, design)
     kernel = PlantKernel(plant)
     N, n = plant.n_vehicles, params.n_rotors
@@ -322,6 +329,37 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
         final_state=state, config=config)
 
 
+def _simulate_compiled(params: VehicleParams, config: HoverConfig, plant: Plant,
+                       design: ControllerDesign) -> Outcome:
+    """simulate_batch on the compiled kernel: the same Outcome."""
+    from reedtool.sim.compiled import fly_batch
+
+    out = fly_batch(params, config, plant, design)
+    reason = out["reason"]
+    status = np.array([STATUS_CODES[_STATUS_OF_REASON[REASONS[r]]] for r in reason],
+                      dtype=np.int64)
+    F = out["final"].T
+    state = State(p=F[0:3].copy(), v=F[3:6].copy(), q=F[6:10].copy(), w=F[10:13].copy(),
+                  omega=F[13:].copy())
+    return Outcome(
+        status_code=status, reason=reason, reason_value=out["reason_value"],
+        end_time_s=out["end_time_s"], settle_time_s=out["settle_time_s"],
+        max_position_error_m=out["max_position_error_m"],
+        max_attitude_error_deg=np.degrees(np.arccos(out["min_cos_attitude"])),
+        final_position_error_m=out["final_position_error_m"],
+        final_attitude_error_deg=np.degrees(np.arccos(out["final_cos_attitude"])),
+        max_throttle=out["max_throttle"], longest_saturation_s=out["longest_saturation_s"],
+        final_omega_rad_s=state.omega.copy(), final_state=state, config=config)
+
+
+_STATUS_OF_REASON = {
+    "settled": ExitStatus.PASSED, "not-settled": ExitStatus.NOT_SETTLED,
+    "saturated": ExitStatus.SATURATED, "non-finite": ExitStatus.DIVERGED,
+    "drifted": ExitStatus.DIVERGED, "rate": ExitStatus.DIVERGED,
+    "ground": ExitStatus.CRASHED, "flipped": ExitStatus.CRASHED,
+    "yaw-spin": ExitStatus.YAW_SPIN}
+
+
 def _judge_events(config: HoverConfig, status: np.ndarray, reason: np.ndarray,
                   reason_value: np.ndarray, end_time: np.ndarray, running: np.ndarray,
                   t: float, state: State, R: np.ndarray, pos: np.ndarray) -> np.ndarray:
@@ -413,6 +451,7 @@ class BatchReport:
     worst: list[dict]
     spreads: Spreads
     seed: int | None
+    engine: str = "numpy"
 
     @property
     def pass_rate(self) -> float:
@@ -421,6 +460,7 @@ class BatchReport:
     def to_dict(self) -> dict:
         return {"samples": self.n_vehicles, "passed": self.passed,
                 "pass_rate": self.pass_rate, "counts": self.counts, "seed": self.seed,
+                "engine": self.engine,
                 "spreads": {"mass_rel": self.spreads.mass_rel, "com_m": self.spreads.com_m,
                             "inertia_rel": self.spreads.inertia_rel,
                             "motor_constant_rel": self.spreads.motor_constant_rel},
@@ -430,11 +470,15 @@ class BatchReport:
 def robustness_batch(params: VehicleParams, n_vehicles: int, config: HoverConfig = HoverConfig(),
                      spreads: Spreads = Spreads(), seed: int | None = 0, n_worst: int = 5,
                      design: ControllerDesign = ControllerDesign(),
-                     progress: Callable[[int], None] | None = None) -> BatchReport:
-    """Fly `n_vehicles` perturbed copies of `params`; pass rate and the worst cases."""
+                     progress: Callable[[int], None] | None = None,
+                     engine: str = "numpy") -> BatchReport:
+    """Fly `n_vehicles` perturbed copies of `params`; pass rate and the worst cases.
+
+    `engine`: "numpy" (this module, the reference) or "numba" (`compiled`, all cores).
+    """
     perturbation = sample_perturbations(n_vehicles, params.n_rotors, spreads, seed)
     outcome = simulate_batch(params, config, perturbed_plant(params, perturbation), design,
-                             progress)
+                             progress, engine)
     passed = outcome.status_code == STATUS_CODES[ExitStatus.PASSED]
     counts: dict[str, int] = {}
     for code in outcome.status_code:
@@ -458,7 +502,7 @@ def robustness_batch(params: VehicleParams, n_vehicles: int, config: HoverConfig
             "max_attitude_error_deg": float(outcome.max_attitude_error_deg[i]),
             "settle_time_s": _finite_or_none(float(outcome.settle_time_s[i])),
         })
-    return BatchReport(n_vehicles, int(passed.sum()), counts, worst, spreads, seed)
+    return BatchReport(n_vehicles, int(passed.sum()), counts, worst, spreads, seed, engine)
 
 
 def _finite_or_none(value: float) -> float | None:

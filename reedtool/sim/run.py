@@ -42,6 +42,7 @@ class HoverRun:
     config: HoverConfig
     rotor_names: tuple[str, ...]
     series: dict[str, np.ndarray] = field(default_factory=dict)  # sampled time series
+    engine: str = "numpy"              # which engine flew it ("numpy" or "numba")
 
     @property
     def passed(self) -> bool:
@@ -51,6 +52,7 @@ class HoverRun:
         c = self.config
         return {
             "status": self.status.value,
+            "engine": self.engine,
             "passed": self.passed,
             "message": self.message,
             "end_time_s": self.end_time_s,
@@ -75,14 +77,24 @@ class HoverRun:
 
 def simulate_hover(params: VehicleParams, config: HoverConfig = HoverConfig(),
                    design: ControllerDesign = ControllerDesign(),
-                   record: bool = True) -> HoverRun:
-    """Fly `params` from the disturbed start for config.duration_s and judge the hover."""
+                   record: bool = True, engine: str = "numpy") -> HoverRun:
+    """Fly `params` from the disturbed start for config.duration_s and judge the hover.
+
+    `engine`: "numpy" (the reference: the generated float step) or "numba" (the compiled
+    kernel of `compiled`, same equations and the same Flight).
+    """
     config.validate()
     gains = ControllerGains.from_params(params, design)
     sample_dt = config.sample_every * config.dt_s
     acos, degrees = math.acos, math.degrees
     setpoint = (0.0, 0.0, float(config.hover_altitude_m))
-    fly = compile_vehicle(params, gains, config, setpoint, _most_out_of_range, _prioritised)
+    if engine == "numba":
+        from reedtool.sim.compiled import vehicle_flyer
+
+        fly = vehicle_flyer(params, gains, config, setpoint)
+    else:
+        fly = compile_vehicle(params, gains, config, setpoint, _most_out_of_range,
+                              _prioritised)
 
     # ---- the disturbed start: rotors at the trim speeds, at rest
     p0 = tuple(sp + off for sp, off in zip(setpoint, config.offset_m))
@@ -124,7 +136,7 @@ def simulate_hover(params: VehicleParams, config: HoverConfig = HoverConfig(),
         longest_saturation_s=sat_longest,
         final_omega_rad_s=np.array(omega), initial_omega_rad_s=omega0, gains=gains,
         config=config, rotor_names=params.rotor_names,
-        series=_series(rec, params.rotor_names) if record else {})
+        series=_series(rec, params.rotor_names) if record else {}, engine=engine)
 
 
 # How the generated engine's early endings map to statuses.

@@ -1,0 +1,595 @@
+"""The hover simulation compiled with numba: one vehicle, or a batch across the cores.
+
+Optional (`pip install 'reedtool[fast]'`): without numba, `available()` is False and the
+numpy engines (`run`, `batch`) are all there is; they stay the reference. The equations
+are theirs, step for step: the Lee controller at heading 0 and its allocation
+(`controller`), the motor model (`motor`), the semi-implicit Euler rigid body with the
+exact quaternion exponential (`dynamics`) and the judge of `batch.simulate_batch`. Only
+the order of a few sums differs, so results agree to rounding (tests/test_compiled.py
+holds them to 1e-9 relative).
+
+The batch runs vehicle by vehicle (`prange` over vehicles, the time loop inside): each
+vehicle's state stays in registers and cache, and vehicles that end early stop costing.
+
+Rotor failures: every per-rotor quantity goes through `_fly` as arrays indexed by rotor,
+and the rotor speed is advanced in one place (`_advance_motors`); a per-rotor "alive"
+mask or failure time belongs there (a dead rotor's command and speed set to 0).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from reedtool.sim import HoverConfig
+from reedtool.sim.controller import ControllerDesign, ControllerGains
+
+try:        # the extra; everything below the guard needs it
+    import numba
+    from numba import njit, prange
+except ImportError:         # pragma: no cover - exercised where the extra is absent
+    numba = None
+
+ENGINE_NUMPY = "numpy"
+ENGINE_COMPILED = "numba"
+
+
+def available() -> bool:
+    """True when numba imports (the `fast` extra is installed)."""
+    return numba is not None
+
+
+def unavailable_reason() -> str:
+    return ("the compiled engine needs numba: pip install 'reedtool[fast]'")
+
+
+# Reason codes: batch.REASONS indices (kept literal here: numba needs constants).
+_SETTLED, _NOT_SETTLED, _NON_FINITE, _DRIFTED, _RATE, _GROUND, _FLIPPED, _SATURATED, \
+    _YAW_SPIN = 1, 2, 3, 4, 5, 6, 7, 8, 9
+
+# Layout of the float outputs per vehicle.
+OUT_FIELDS = ("reason_value", "end_time_s", "settle_time_s", "max_position_error_m",
+              "min_cos_attitude", "final_position_error_m", "final_cos_attitude",
+              "max_throttle", "longest_saturation_s", "last_out_s", "within")
+# Layout of the scalar settings vector.
+CFG_FIELDS = ("dt", "g", "m_ctl", "kp", "kd", "ki", "kR", "kw", "a_h", "a_v", "i_max",
+              "sp_x", "sp_y", "sp_z", "pos_tol", "cos_tol", "yaw_spin", "div_dist",
+              "div_rate", "duration", "hold", "sat_limit", "n_steps", "every")
+REC_FIXED = 11          # t, x, y, z, R00, R10, R20, R21, R22, pos, cos_att; then omega
+
+
+if numba is not None:
+
+    @njit(cache=True, error_model="numpy")
+    def _rotation(q, R):
+        qw, qx, qy, qz = q[0], q[1], q[2], q[3]
+        x2 = qx + qx
+        y2 = qy + qy
+        z2 = qz + qz
+        xx = qx * x2
+        yy = qy * y2
+        zz = qz * z2
+        xy = qx * y2
+        xz = qx * z2
+        yz = qy * z2
+        xw = qw * x2
+        yw = qw * y2
+        zw = qw * z2
+        R[0, 0] = 1.0 - (yy + zz)
+        R[0, 1] = xy - zw
+        R[0, 2] = xz + yw
+        R[1, 0] = xy + zw
+        R[1, 1] = 1.0 - (xx + zz)
+        R[1, 2] = yz - xw
+        R[2, 0] = xz - yw
+        R[2, 1] = yz + xw
+        R[2, 2] = 1.0 - (xx + yy)
+
+    @njit(cache=True, error_model="numpy")
+    def _control(cfg, Jc, pinv, thrust_max, e, v, integ, R, w, T):
+        """controller.control_kernel + allocation_kernel for one vehicle: thrusts into T.
+
+        Returns (saturated, most-out-of-range rotor)."""
+        kp, kd, ki = cfg[3], cfg[4], cfg[5]
+        kR, kw, a_h, a_v = cfg[6], cfg[7], cfg[8], cfg[9]
+        m, g = cfg[2], cfg[1]
+        ax = -kp * e[0] - kd * v[0] - ki * integ[0]
+        ay = -kp * e[1] - kd * v[1] - ki * integ[1]
+        az = -kp * e[2] - kd * v[2] - ki * integ[2]
+        h = math.sqrt(ax * ax + ay * ay)
+        scale = (m * a_h) / (a_h if a_h > h else h)
+        Fx = scale * ax
+        Fy = scale * ay
+        Fz = (a_v if az > a_v else (-a_v if az < -a_v else az)) + g
+        Fz = Fz * m
+        F_norm = math.sqrt(Fx * Fx + Fy * Fy + Fz * Fz)
+        inv_F = 1.0 / F_norm
+        b3x = Fx * inv_F
+        b3y = Fy * inv_F
+        b3z = Fz * inv_F
+        n_sq = b3y * b3y + b3z * b3z
+        inv_n = 1.0 / math.sqrt(n_sq)
+        b1x = n_sq * inv_n
+        u = inv_n * b3x
+        A1 = b3y * R[1, 1] + b3z * R[2, 1]
+        A2 = b3y * R[1, 2] + b3z * R[2, 2]
+        f = F_norm * (b3x * R[0, 2] + A2)
+        # 2 e_R = vee(Rd^T R - R^T Rd)
+        e0 = (b3x * R[0, 1] + A1) - inv_n * (b3z * R[1, 2] - b3y * R[2, 2])
+        e1 = (b1x * R[0, 2] - u * A2) - (b3x * R[0, 0] + b3y * R[1, 0] + b3z * R[2, 0])
+        e2 = inv_n * (b3z * R[1, 0] - b3y * R[2, 0]) - (b1x * R[0, 1] - u * A1)
+        # tau = w x J w - J (kR e_R + kw w)
+        s0 = 0.5 * kR * e0 + kw * w[0]
+        s1 = 0.5 * kR * e1 + kw * w[1]
+        s2 = 0.5 * kR * e2 + kw * w[2]
+        Jw0 = Jc[0, 0] * w[0] + Jc[0, 1] * w[1] + Jc[0, 2] * w[2]
+        Jw1 = Jc[1, 0] * w[0] + Jc[1, 1] * w[1] + Jc[1, 2] * w[2]
+        Jw2 = Jc[2, 0] * w[0] + Jc[2, 1] * w[1] + Jc[2, 2] * w[2]
+        t0 = (w[1] * Jw2 - w[2] * Jw1) - (Jc[0, 0] * s0 + Jc[0, 1] * s1 + Jc[0, 2] * s2)
+        t1 = (w[2] * Jw0 - w[0] * Jw2) - (Jc[1, 0] * s0 + Jc[1, 1] * s1 + Jc[1, 2] * s2)
+        t2 = (w[0] * Jw1 - w[1] * Jw0) - (Jc[2, 0] * s0 + Jc[2, 1] * s1 + Jc[2, 2] * s2)
+        n = T.shape[0]
+        out = False
+        for i in range(n):
+            T[i] = pinv[i, 0] * f + pinv[i, 1] * t0 + pinv[i, 2] * t1 + pinv[i, 3] * t2
+            if T[i] < 0.0 or T[i] > thrust_max[i]:
+                out = True
+        if not out:
+            return False, 0
+        worst = 0
+        worst_excess = -np.inf
+        for i in range(n):
+            hi = thrust_max[i]
+            excess = max(-T[i], T[i] - hi) / hi
+            if excess > worst_excess:
+                worst_excess = excess
+                worst = i
+        _prioritised(pinv, thrust_max, f, t0, t1, t2, T)
+        return True, worst
+
+    @njit(cache=True, error_model="numpy")
+    def _prioritised(pinv, thrust_max, f, t0, t1, t2, T):
+        """controller._prioritised for one vehicle: thrust, then roll/pitch, then yaw."""
+        n = T.shape[0]
+        fit = 1.0
+        any_over = False
+        for i in range(n):
+            T[i] = pinv[i, 0] * f
+            if T[i] > thrust_max[i]:
+                ratio = thrust_max[i] / T[i]
+                if not any_over or ratio < fit:
+                    fit = ratio
+                any_over = True
+        for i in range(n):
+            b = T[i] * fit if any_over else T[i]
+            T[i] = min(max(b, 0.0), thrust_max[i])
+        for stage in range(2):
+            scale = np.inf
+            for i in range(n):
+                d = pinv[i, 1] * t0 + pinv[i, 2] * t1 if stage == 0 else pinv[i, 3] * t2
+                if d > 0.0:
+                    room = (thrust_max[i] - T[i]) / d
+                    if room < scale:
+                        scale = room
+                elif d < 0.0:
+                    room = -T[i] / d
+                    if room < scale:
+                        scale = room
+            scale = min(max(scale, 0.0), 1.0)
+            for i in range(n):
+                d = pinv[i, 1] * t0 + pinv[i, 2] * t1 if stage == 0 else pinv[i, 3] * t2
+                T[i] = T[i] + scale * d
+        for i in range(n):
+            T[i] = min(max(T[i], 0.0), thrust_max[i])
+
+    @njit(cache=True, error_model="numpy")
+    def _body_wrench(pos, axis, tmap, cd, cr, k, shift, omega, R, v, w, Fb, Tb):
+        """dynamics.body_wrench_kernel for one vehicle: force and torque about the true
+        COM, body axes (thrust, yaw drag, rotor drag, rolling moment)."""
+        for a in range(3):
+            Fb[a] = 0.0
+            Tb[a] = 0.0
+        # velocity of the nominal COM, body axes: R^T v - w x shift
+        xi0 = R[0, 0] * v[0] + R[1, 0] * v[1] + R[2, 0] * v[2]
+        xi1 = R[0, 1] * v[0] + R[1, 1] * v[1] + R[2, 1] * v[2]
+        xi2 = R[0, 2] * v[0] + R[1, 2] * v[1] + R[2, 2] * v[2]
+        xi0 -= w[1] * shift[2] - w[2] * shift[1]
+        xi1 -= w[2] * shift[0] - w[0] * shift[2]
+        xi2 -= w[0] * shift[1] - w[1] * shift[0]
+        for i in range(omega.shape[0]):
+            om = omega[i]
+            Th = k[i] * om * om
+            a0, a1, a2 = axis[i, 0], axis[i, 1], axis[i, 2]
+            Fb[0] += a0 * Th
+            Fb[1] += a1 * Th
+            Fb[2] += a2 * Th
+            Tb[0] += tmap[0, i] * Th
+            Tb[1] += tmap[1, i] * Th
+            Tb[2] += tmap[2, i] * Th
+            if cd[i] != 0.0 or cr[i] != 0.0:
+                r0, r1, r2 = pos[i, 0], pos[i, 1], pos[i, 2]
+                u0 = xi0 + (w[1] * r2 - w[2] * r1)
+                u1 = xi1 + (w[2] * r0 - w[0] * r2)
+                u2 = xi2 + (w[0] * r1 - w[1] * r0)
+                along = a0 * u0 + a1 * u1 + a2 * u2
+                p0 = u0 - a0 * along
+                p1 = u1 - a1 * along
+                p2 = u2 - a2 * along
+                dc = -om * cd[i]
+                d0, d1, d2 = dc * p0, dc * p1, dc * p2
+                Fb[0] += d0
+                Fb[1] += d1
+                Fb[2] += d2
+                rc = -om * cr[i]
+                Tb[0] += r1 * d2 - r2 * d1 + rc * p0
+                Tb[1] += r2 * d0 - r0 * d2 + rc * p1
+                Tb[2] += r0 * d1 - r1 * d0 + rc * p2
+        # moments about the true COM: tau - shift x F
+        c0 = shift[1] * Fb[2] - shift[2] * Fb[1]
+        c1 = shift[2] * Fb[0] - shift[0] * Fb[2]
+        c2 = shift[0] * Fb[1] - shift[1] * Fb[0]
+        Tb[0] -= c0
+        Tb[1] -= c1
+        Tb[2] -= c2
+
+    @njit(cache=True, error_model="numpy")
+    def _rigid_body(dt, g, mass, J0, J0inv, S, R, Fb, Tb, p, v, q, w):
+        """dynamics.rigid_body_kernel for one vehicle: semi-implicit Euler, in place."""
+        f0 = Fb[0] * (dt / mass)
+        f1 = Fb[1] * (dt / mass)
+        f2 = Fb[2] * (dt / mass)
+        v[0] += R[0, 0] * f0 + R[0, 1] * f1 + R[0, 2] * f2
+        v[1] += R[1, 0] * f0 + R[1, 1] * f1 + R[1, 2] * f2
+        v[2] += R[2, 0] * f0 + R[2, 1] * f1 + R[2, 2] * f2
+        v[2] -= dt * g
+        # Euler's equations with J = S J0 S: J w' = tau - w x J w
+        sw0, sw1, sw2 = S[0] * w[0], S[1] * w[1], S[2] * w[2]
+        Jw0 = S[0] * (J0[0, 0] * sw0 + J0[0, 1] * sw1 + J0[0, 2] * sw2)
+        Jw1 = S[1] * (J0[1, 0] * sw0 + J0[1, 1] * sw1 + J0[1, 2] * sw2)
+        Jw2 = S[2] * (J0[2, 0] * sw0 + J0[2, 1] * sw1 + J0[2, 2] * sw2)
+        h0 = (Tb[0] - (w[1] * Jw2 - w[2] * Jw1)) / S[0]
+        h1 = (Tb[1] - (w[2] * Jw0 - w[0] * Jw2)) / S[1]
+        h2 = (Tb[2] - (w[0] * Jw1 - w[1] * Jw0)) / S[2]
+        w[0] += (J0inv[0, 0] * h0 + J0inv[0, 1] * h1 + J0inv[0, 2] * h2) * (dt / S[0])
+        w[1] += (J0inv[1, 0] * h0 + J0inv[1, 1] * h1 + J0inv[1, 2] * h2) * (dt / S[1])
+        w[2] += (J0inv[2, 0] * h0 + J0inv[2, 1] * h1 + J0inv[2, 2] * h2) * (dt / S[2])
+        p[0] += dt * v[0]
+        p[1] += dt * v[1]
+        p[2] += dt * v[2]
+        # q * exp(w dt / 2) as q * (|w| / tan h, w), renormalised
+        wx, wy, wz = w[0], w[1], w[2]
+        rate = math.sqrt(wx * wx + wy * wy + wz * wz)
+        tan_h = math.tan(0.5 * dt * rate)
+        a = rate / tan_h if tan_h != 0.0 else 1.0
+        qw, qx, qy, qz = q[0], q[1], q[2], q[3]
+        nw = qw * a - qx * wx - qy * wy - qz * wz
+        nx = qx * a + qw * wx + qy * wz - qz * wy
+        ny = qy * a + qw * wy + qz * wx - qx * wz
+        nz = qz * a + qw * wz + qx * wy - qy * wx
+        inv_q = 1.0 / math.sqrt(nw * nw + nx * nx + ny * ny + nz * nz)
+        q[0] = nw * inv_q
+        q[1] = nx * inv_q
+        q[2] = ny * inv_q
+        q[3] = nz * inv_q
+
+    @njit(cache=True, error_model="numpy")
+    def _advance_motors(T, inv_k, up, down, omega):
+        """motor.speed_command (the allocation keeps T in range) and the first-order lag.
+        The one place a per-rotor failure (alive mask) would zero the command and speed."""
+        for i in range(omega.shape[0]):
+            cmd = math.sqrt(T[i] * inv_k[i]) if T[i] > 0.0 else 0.0
+            omega[i] = cmd + (omega[i] - cmd) * (up[i] if cmd > omega[i] else down[i])
+
+    @njit(cache=True, error_model="numpy")
+    def _fly(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final, rec):
+        """Fly one vehicle from state0 (p, v, q, w, integral, omega) as batch.simulate_batch judges it.
+
+        Fills out_f (OUT_FIELDS), out_i (reason, longest-saturation rotor), final
+        (p, v, q, w, omega when it ended), and rec (one row per sample) when it has rows; returns the samples written.
+        """
+        pos_r, axis, tmap, cd, cr, up, down, pinv, thrust_max, inv_k, omega_max, Jc, J0, \
+            J0inv = nominal
+        dt, g = cfg[0], cfg[1]
+        ki_dt, i_max = dt, cfg[10]
+        n_steps, every = int(cfg[22]), int(cfg[23])
+        n = k.shape[0]
+        p = state0[0:3].copy()
+        v = state0[3:6].copy()
+        q = state0[6:10].copy()
+        w = state0[10:13].copy()
+        integ = state0[13:16].copy()
+        omega = state0[16:16 + n].copy()
+        e = np.zeros(3)
+        R = np.empty((3, 3))
+        T = np.empty(n)
+        Fb = np.empty(3)
+        Tb = np.empty(3)
+        sp0, sp1, sp2 = cfg[11], cfg[12], cfg[13]
+        sample_dt = every * dt
+        reason = 0
+        value = 0.0
+        end_time = cfg[19]
+        max_pos = 0.0
+        min_cos = 1.0
+        max_throttle = 0.0
+        final_pos = 0.0
+        final_cos = 1.0
+        last_out = 0.0
+        within = False
+        sat_since = np.nan
+        sat_rotor = 0
+        sat_longest = 0.0
+        sat_longest_rotor = 0
+        n_rec = 0
+        for step in range(n_steps + 1):
+            t = step * dt
+            _rotation(q, R)
+            e[0] = p[0] - sp0
+            e[1] = p[1] - sp1
+            e[2] = p[2] - sp2
+            last = step == n_steps
+            saturated, worst = _control(cfg, Jc, pinv, thrust_max, e, v, integ, R, w, T)
+            if step % every == 0 or last:
+                pos = math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
+                cos_att = min(max(0.5 * ((R[0, 0] + R[1, 1] + R[2, 2]) - 1.0), -1.0), 1.0)
+                throttle = omega[0] / omega_max[0]
+                for i in range(1, n):
+                    ratio = omega[i] / omega_max[i]
+                    if ratio > throttle:
+                        throttle = ratio
+                if pos > max_pos:
+                    max_pos = pos
+                if cos_att < min_cos:
+                    min_cos = cos_att
+                if throttle > max_throttle:
+                    max_throttle = throttle
+                final_pos = pos
+                final_cos = cos_att
+                within = pos <= cfg[14] and cos_att >= cfg[15]
+                if not within:
+                    last_out = t
+                if saturated:
+                    if math.isnan(sat_since):
+                        sat_since = t
+                        sat_rotor = worst
+                    if t - sat_since > sat_longest:
+                        sat_longest = t - sat_since
+                        sat_longest_rotor = sat_rotor
+                else:
+                    sat_since = np.nan
+                if n_rec < rec.shape[0]:
+                    rec[n_rec, 0] = t
+                    rec[n_rec, 1] = p[0]
+                    rec[n_rec, 2] = p[1]
+                    rec[n_rec, 3] = p[2]
+                    rec[n_rec, 4] = R[0, 0]
+                    rec[n_rec, 5] = R[1, 0]
+                    rec[n_rec, 6] = R[2, 0]
+                    rec[n_rec, 7] = R[2, 1]
+                    rec[n_rec, 8] = R[2, 2]
+                    rec[n_rec, 9] = pos
+                    rec[n_rec, 10] = cos_att
+                    for i in range(n):
+                        rec[n_rec, REC_FIXED + i] = omega[i]
+                    n_rec += 1
+                rate_xy = math.sqrt(w[0] * w[0] + w[1] * w[1])
+                finite = True
+                for x in (p[0], p[1], p[2], q[0], q[1], q[2], q[3], w[0], w[1], w[2]):
+                    if not math.isfinite(x):
+                        finite = False
+                if not finite:
+                    reason, value = _NON_FINITE, 0.0
+                elif R[2, 2] < 0.0:
+                    reason = _FLIPPED
+                    value = math.degrees(math.acos(max(R[2, 2], -1.0)))
+                elif p[2] < 0.0:
+                    reason, value = _GROUND, p[2]
+                elif abs(w[2]) > cfg[16]:
+                    reason, value = _YAW_SPIN, abs(w[2])
+                elif pos > cfg[17]:
+                    reason, value = _DRIFTED, pos
+                elif rate_xy > cfg[18]:
+                    reason, value = _RATE, rate_xy
+                if reason != 0:
+                    end_time = t
+                    break
+                if last:
+                    if within and last_out + sample_dt <= cfg[19] - cfg[20] + 1e-9:
+                        reason = _SETTLED
+                    elif sat_longest >= cfg[21] - 1e-9:
+                        reason = _SATURATED
+                        value = float(sat_longest_rotor)
+                    else:
+                        reason = _NOT_SETTLED
+                    break
+            # ---- advance one step: wrench at the current speeds, then the speeds respond
+            _body_wrench(pos_r, axis, tmap, cd, cr, k, shift, omega, R, v, w, Fb, Tb)
+            _advance_motors(T, inv_k, up, down, omega)
+            _rigid_body(dt, g, mass, J0, J0inv, S, R, Fb, Tb, p, v, q, w)
+            for a in range(3):
+                integ[a] += e[a] * ki_dt
+                integ[a] = min(max(integ[a], -i_max), i_max)
+        out_i[0] = reason
+        out_i[1] = sat_longest_rotor
+        out_f[0] = value
+        out_f[1] = end_time
+        reached_end = reason == _SETTLED or reason == _NOT_SETTLED or reason == _SATURATED
+        out_f[2] = last_out + sample_dt if reached_end and within else np.nan
+        out_f[3] = max_pos
+        out_f[4] = min_cos
+        out_f[5] = final_pos
+        out_f[6] = final_cos
+        out_f[7] = max_throttle
+        out_f[8] = sat_longest
+        out_f[9] = last_out
+        out_f[10] = 1.0 if within else 0.0
+        final[0:3] = p
+        final[3:6] = v
+        final[6:10] = q
+        final[10:13] = w
+        final[13:13 + n] = omega
+        return n_rec
+
+    @njit(cache=True, parallel=True, error_model="numpy")
+    def _fly_batch(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final):
+        rec = np.empty((0, 0))
+        for j in prange(mass.shape[0]):
+            _fly(cfg, nominal, mass[j], S[:, j], shift[:, j], k[:, j], state0,
+                 out_f[j], out_i[j], final[j], rec)
+
+    @njit(cache=True, error_model="numpy")
+    def _fly_one(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final, rec):
+        return _fly(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final, rec)
+
+
+# ------------------------------------------------------------------ Python side
+
+def _settings(params, gains: ControllerGains, config: HoverConfig, setpoint) -> np.ndarray:
+    values = {
+        "dt": config.dt_s, "g": params.g_m_s2, "m_ctl": gains.mass_kg, "kp": gains.kp_1_s2,
+        "kd": gains.kd_1_s, "ki": gains.ki_1_s3, "kR": gains.kR_1_s2, "kw": gains.kw_1_s,
+        "a_h": gains.max_horizontal_accel_m_s2, "a_v": gains.max_vertical_accel_m_s2,
+        "i_max": gains.max_integral_m_s, "sp_x": setpoint[0], "sp_y": setpoint[1],
+        "sp_z": setpoint[2], "pos_tol": config.position_tol_m,
+        "cos_tol": config.cos_attitude_tol, "yaw_spin": config.yaw_spin_rad_s,
+        "div_dist": config.divergence_distance_m, "div_rate": config.diverged_rate_rad_s,
+        "duration": config.duration_s, "hold": config.hold_s,
+        "sat_limit": config.saturation_limit_s, "n_steps": config.n_steps,
+        "every": config.sample_every}
+    return np.array([float(values[name]) for name in CFG_FIELDS])
+
+
+def _nominal(params, gains: ControllerGains, config: HoverConfig, plant) -> tuple:
+    """The per-rotor arrays shared by every vehicle; thrust and torque maps from `plant`
+    (tests swap them to model a rotor spinning the wrong way)."""
+    from reedtool.sim.motor import speed_filter_factors
+
+    up, down = speed_filter_factors(config.dt_s, params.time_constant_up_s,
+                                    params.time_constant_down_s)
+    J0 = np.array(params.inertia_kg_m2, dtype=float)
+
+    def c(x, dtype=float):
+        # fresh writable C arrays: numba types read-only arrays apart (a second compile)
+        return np.array(x, dtype=dtype, order="C", copy=True)
+
+    return (c(params.rotor_position_m, dtype=float), c(plant.force_map.T, dtype=float),
+            c(plant.torque_map, dtype=float),
+            c(params.rotor_drag_coefficient, dtype=float),
+            c(params.rolling_moment_coefficient, dtype=float), c(up), c(down),
+            c(gains.allocation_pinv, dtype=float),
+            c(gains.motor_constant * gains.omega_max_rad_s ** 2, dtype=float),
+            c(1.0 / gains.motor_constant, dtype=float), c(gains.omega_max_rad_s, dtype=float),
+            c(gains.inertia_kg_m2, dtype=float), J0, np.linalg.inv(J0))
+
+
+def _start(params, gains, config: HoverConfig) -> tuple[np.ndarray, tuple, np.ndarray]:
+    """(state0, setpoint, parked state) as batch.initial_state makes them: the disturbed
+    start at rest with the rotors at the controller's trim speeds."""
+    from reedtool.sim.dynamics import quat_from_rpy
+    from reedtool.sim.motor import speed_command
+
+    setpoint = np.array([0.0, 0.0, config.hover_altitude_m])
+    p0 = setpoint + np.asarray(config.offset_m, dtype=float)
+    q0 = quat_from_rpy(config.roll_rad, config.pitch_rad, config.yaw_rad)
+    omega0 = speed_command(gains.allocation_pinv @ np.array([params.weight_N, 0.0, 0.0, 0.0]),
+                           gains.motor_constant, gains.omega_max_rad_s)
+    state0 = np.concatenate([p0, np.zeros(3), q0, np.zeros(3), np.zeros(3), omega0])
+    park = np.concatenate([setpoint, np.zeros(3), [1.0, 0.0, 0.0, 0.0], np.zeros(3), omega0])
+    return state0, tuple(float(x) for x in setpoint), park
+
+
+def warm_up() -> float:
+    """Compile (or load from numba's cache) both kernels on a tiny vehicle; seconds spent."""
+    from reedtool.sim.dynamics import Plant
+    from reedtool.sim.params import symmetric_multirotor
+
+    start = time.perf_counter()
+    params = symmetric_multirotor(4)
+    config = HoverConfig(duration_s=0.02, hold_s=0.01)
+    for n_vehicles in (1, 2):
+        fly_batch(params, config, Plant.from_params(params, n_vehicles))
+    return time.perf_counter() - start
+
+
+def fly_batch(params, config: HoverConfig, plant,
+              design: ControllerDesign = ControllerDesign()) -> dict[str, np.ndarray]:
+    """Every vehicle of `plant` flown on the nominal controller, judged as
+    batch.simulate_batch judges: per-vehicle arrays "reason" (batch.REASONS index),
+    "saturation_rotor", the OUT_FIELDS and "final" (N, 13 + n: p, v, q, w, omega; the
+    parked level hover for vehicles that ended early, as the numpy batch parks them).
+    batch.simulate_batch(engine="numba") turns them into its Outcome.
+
+    One vehicle runs on the serial kernel, more on the parallel one.
+    """
+    if numba is None:
+        raise RuntimeError(unavailable_reason())
+    config.validate()
+    gains = ControllerGains.from_params(params, design)
+    state0, setpoint, park = _start(params, gains, config)
+    cfg = _settings(params, gains, config, setpoint)
+    nominal = _nominal(params, gains, config, plant)
+    N, n = plant.n_vehicles, params.n_rotors
+    mass = np.array(plant.mass_kg, dtype=float)
+    S = np.array(plant.inertia_scale_sqrt, dtype=float, order="C")
+    shift = np.array(plant.com_shift_m, dtype=float, order="C")
+    k = np.array(plant.motor_constant, dtype=float, order="C")
+    out_f = np.zeros((N, len(OUT_FIELDS)))
+    out_i = np.zeros((N, 2), dtype=np.int64)
+    final = np.zeros((N, 13 + n))
+    if N == 1:
+        _fly_one(cfg, nominal, mass[0], S[:, 0].copy(), shift[:, 0].copy(),
+                 k[:, 0].copy(), state0, out_f[0], out_i[0], final[0], np.empty((0, 0)))
+    else:
+        _fly_batch(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final)
+    reason = out_i[:, 0].copy()
+    ended = ~np.isin(reason, [_SETTLED, _NOT_SETTLED, _SATURATED])
+    final[ended] = park
+    result = {name: out_f[:, i].copy() for i, name in enumerate(OUT_FIELDS)}
+    result.update(reason=reason, saturation_rotor=out_i[:, 1].copy(), final=final)
+    return result
+
+
+def vehicle_flyer(params, gains: ControllerGains, config: HoverConfig, setpoint_m):
+    """`fly(state, rec)` with scalar.compile_vehicle's contract, on the compiled kernel:
+    run.simulate_hover flies it unchanged."""
+    from reedtool.sim.dynamics import Plant
+    from reedtool.sim.scalar import Flight
+
+    if numba is None:
+        raise RuntimeError(unavailable_reason())
+    cfg = _settings(params, gains, config, setpoint_m)
+    nominal = _nominal(params, gains, config, Plant.from_params(params, 1))
+    n = params.n_rotors
+    mass = float(params.mass_kg)
+    S, shift = np.ones(3), np.zeros(3)
+    k = np.array(params.motor_constant, dtype=float)
+    reasons = {_NON_FINITE: "non-finite", _FLIPPED: "flipped", _GROUND: "ground",
+               _YAW_SPIN: "yaw-spin", _DRIFTED: "drifted", _RATE: "rate"}
+
+    def fly(state, rec):
+        *head, omega = state
+        state0 = np.array([*head, *omega], dtype=float)
+        out_f = np.zeros(len(OUT_FIELDS))
+        out_i = np.zeros(2, dtype=np.int64)
+        final = np.zeros(13 + n)
+        rows = config.n_steps // config.sample_every + 2 if rec is not None else 0
+        buffer = np.empty((rows, REC_FIXED + n))
+        n_rec = _fly_one(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final, buffer)
+        if rec is not None:
+            for row in buffer[:n_rec]:
+                rec(tuple(float(x) for x in row))
+        col = dict(zip(OUT_FIELDS, (float(x) for x in out_f)))
+        reason = int(out_i[0])
+        # The judge's verdict at the end is run.simulate_hover's to make (as for the
+        # generated engine): hand back only the early endings.
+        early = reasons.get(reason)
+        omega_end = tuple(float(x) for x in final[13:])
+        return Flight(early, col["reason_value"] if early else 0.0, col["end_time_s"],
+                      col["max_position_error_m"], col["min_cos_attitude"],
+                      col["max_throttle"], col["last_out_s"], bool(col["within"]),
+                      col["longest_saturation_s"], int(out_i[1]),
+                      col["final_position_error_m"], col["final_cos_attitude"], omega_end)
+
+    return fly

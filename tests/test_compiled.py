@@ -1,0 +1,141 @@
+"""The compiled engine (reedtool[fast]) against the numpy engines, the reference.
+
+Same inputs, same equations: results agree to 1e-9 relative (rounding differs only in the
+order of a few sums). Relative to a quantity's scale: a value that settles near 0 (a
+position error of 1e-5 m, the difference of two ~2 m coordinates; a crash depth of 2 cm
+after a 2 m fall) keeps only the digits the flight left it in either engine, so the
+absolute tolerance is 1e-9 times the largest magnitude of that quantity in the run or
+batch.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from reedtool.sim import STATUS_CODES, ExitStatus, HoverConfig, compiled
+from reedtool.sim.batch import perturbed_plant, sample_perturbations, simulate_batch, Spreads
+from reedtool.sim.dynamics import Plant
+from reedtool.sim.params import symmetric_multirotor
+from reedtool.sim.run import simulate_hover
+from test_sim import tilted_hex
+
+pytestmark = pytest.mark.skipif(
+    not compiled.available(),
+    reason="numba is not installed (pip install 'reedtool[fast]'): no compiled engine to test")
+
+RTOL = 1e-9
+FIELDS = ("status_code", "reason", "reason_value", "end_time_s", "settle_time_s",
+          "max_position_error_m", "max_attitude_error_deg", "final_position_error_m",
+          "final_attitude_error_deg", "max_throttle", "longest_saturation_s",
+          "final_omega_rad_s")
+
+
+def assert_close(got, ref, name):
+    got, ref = np.asarray(got, dtype=float), np.asarray(ref, dtype=float)
+    scale = float(np.nanmax(np.abs(ref))) if np.isfinite(ref).any() else 0.0
+    np.testing.assert_allclose(got, ref, rtol=RTOL, atol=RTOL * scale, err_msg=name)
+
+
+def assert_same_outcome(ref, got):
+    for name in FIELDS[:-1]:
+        assert_close(getattr(got, name), getattr(ref, name), name)
+    # Final states only of the vehicles that flew to the end: the numpy batch keeps
+    # stepping the ones it parked (their "final" state is the parked hover's, which its
+    # docstring calls meaningless); the compiled one reports the park itself.
+    flew = np.isin(ref.status_code, [STATUS_CODES[s] for s in (
+        ExitStatus.PASSED, ExitStatus.NOT_SETTLED, ExitStatus.SATURATED)])
+    assert_close(got.final_omega_rad_s[:, flew], ref.final_omega_rad_s[:, flew],
+                 "final_omega_rad_s")
+    for name in ("p", "v", "q", "w", "omega"):
+        assert_close(getattr(got.final_state, name)[:, flew],
+                     getattr(ref.final_state, name)[:, flew], f"final_state.{name}")
+
+
+@pytest.mark.parametrize("make", [lambda: symmetric_multirotor(4), tilted_hex])
+def test_single_vehicle_equals_the_reference(make):
+    params = make()
+    config = HoverConfig(duration_s=2.5, offset_m=(0.3, -0.2, 0.25), roll_rad=0.15,
+                         pitch_rad=-0.1, yaw_rad=0.3)
+    ref = simulate_hover(params, config)
+    got = simulate_hover(params, config, engine="numba")
+    assert (got.engine, ref.engine) == ("numba", "numpy")
+    assert got.status is ref.status and got.reason == ref.reason
+    for name in ("end_time_s", "settle_time_s", "max_position_error_m",
+                 "max_attitude_error_deg", "final_position_error_m",
+                 "final_attitude_error_deg", "max_throttle", "longest_saturation_s"):
+        assert_close(getattr(got, name), getattr(ref, name), name)
+    np.testing.assert_allclose(got.final_omega_rad_s, ref.final_omega_rad_s, rtol=RTOL)
+    assert got.series.keys() == ref.series.keys()
+    for key in ref.series:
+        assert_close(got.series[key], ref.series[key], key)
+
+
+def test_perturbed_batch_equals_the_numpy_batch():
+    # Spreads wide enough that some vehicles crash (parked early) and others saturate
+    # for a while and recover. (Wider still, some fly at full throttle in a limit cycle
+    # through the desaturation's switches, which magnifies rounding to ~1e-6: a property
+    # of that flight, not of either engine.)
+    params = symmetric_multirotor(4)
+    config = HoverConfig(duration_s=3.0)
+    plant = perturbed_plant(params, sample_perturbations(
+        48, 4, Spreads(mass_rel=0.3, com_m=0.03, inertia_rel=0.2, motor_constant_rel=0.15), 3))
+    ref = simulate_batch(params, config, plant)
+    got = simulate_batch(params, config, plant, engine="numba")
+    assert len(set(ref.status_code.tolist())) >= 3        # not all alike
+    assert ref.longest_saturation_s.max() > 0.5
+    assert_same_outcome(ref, got)
+
+
+def test_awkward_vehicle_batch_equals_the_numpy_batch():
+    params = tilted_hex()
+    config = HoverConfig(duration_s=2.0, yaw_rad=0.2)
+    plant = perturbed_plant(params, sample_perturbations(16, 6, Spreads(), 5))
+    assert_same_outcome(simulate_batch(params, config, plant),
+                        simulate_batch(params, config, plant, engine="numba"))
+
+
+def _one(params, config, change):
+    plant = Plant.from_params(params)
+    change(plant)
+    return (simulate_batch(params, config, plant),
+            simulate_batch(params, config, plant, engine="numba"))
+
+
+@pytest.mark.parametrize("change,status", [
+    (lambda plant: setattr(plant, "mass_kg", plant.mass_kg * 3.0), ExitStatus.CRASHED),
+    (lambda plant: setattr(plant, "mass_kg", np.array([np.nan])), ExitStatus.DIVERGED),
+    (lambda plant: setattr(plant, "torque_map", symmetric_multirotor(4).with_changes(
+        turning_sign=[-1, -1, 1, -1]).allocation()[1:4].copy()), ExitStatus.YAW_SPIN),
+])
+def test_every_early_ending_is_the_same(change, status):
+    ref, got = _one(symmetric_multirotor(4), HoverConfig(duration_s=4.0), change)
+    assert ref.status(0) is status and got.status(0) is status
+    assert_same_outcome(ref, got)
+
+
+def test_saturated_climb_is_the_same():
+    base = symmetric_multirotor(4)
+    omega_max = np.sqrt(base.weight_N * 1.03 / (4 * base.motor_constant[0]))
+    params = base.with_changes(omega_max_rad_s=omega_max)
+    config = HoverConfig(duration_s=6.0, offset_m=(0.0, 0.0, -1.5), roll_rad=0.0)
+    ref = simulate_hover(params, config)
+    got = simulate_hover(params, config, engine="numba")
+    assert ref.status is got.status is ExitStatus.SATURATED
+    assert got.longest_saturation_s == pytest.approx(ref.longest_saturation_s, rel=RTOL)
+    np.testing.assert_allclose(got.series["z_m"], ref.series["z_m"], rtol=RTOL)
+
+
+def test_hover_test_says_which_engine_ran():
+    from cli_helpers import run_cli
+    from test_hover_test_cli import ARGV, SEED_MODEL
+
+    for engine in ("numpy", "numba"):
+        code, out = run_cli("hover-test", SEED_MODEL, *ARGV, "--duration", "3", "--format",
+                            "json", "--samples", "4", "--engine", engine)
+        report = json.loads(out)
+        assert report["sim"]["engine"] == engine and report["batch"]["engine"] == engine
+    code, out = run_cli("hover-test", SEED_MODEL, *ARGV, "--duration", "3", "--engine", "numba")
+    assert "engine numba" in out
