@@ -329,3 +329,15 @@ def test_world_includes_reedtool_cannot_fetch_are_skipped_unless_asked_for():
         load_robot(world, package_paths=[MODELS], model_name="Sun")
     assert (Path(info.value.file).name, info.value.line) == ("several_models.sdf", sun_line)
     assert "Fuel" in info.value.message
+
+
+def test_world_including_a_light_model_is_not_an_error(tmp_path):
+    (tmp_path / "sun").mkdir()
+    (tmp_path / "sun" / "model.sdf").write_text(
+        '<sdf version="1.6"><light name="sun" type="directional"/></sdf>')
+    world = tmp_path / "w.sdf"
+    world.write_text('<sdf version="1.9"><world name="w">'
+                     "<include><uri>model://sun</uri></include>"
+                     f"<include><uri>{MODELS / 'x500'}</uri></include></world></sdf>")
+    robots = load_robots(world)
+    assert [r.name for r in robots] == ["x500"]

@@ -232,9 +232,16 @@ def expand_includes(root: etree._Element, source: SourceFile, sources: SourceMap
         included_root, included = _read(path, sources)
         expand_includes(included_root, included, sources, package_paths, chain)
         model = included_root.find("model") if included_root.tag == "sdf" else None
+        if model is None and in_world:
+            # A world may include a light (model://sun) or an actor: nothing to check.
+            sources.unresolved.append(UnresolvedInclude(
+                (include.findtext("name") or "").strip() or None, uri, source.path, line,
+                f"{_shown(path)} holds no <model>"))
+            parent.remove(include)
+            continue
         if model is None:
-            raise ReedtoolError(f"included file {path} holds no <model>", file=source.path,
-                                line=line)
+            raise ReedtoolError(f"included file {_shown(path)} holds no <model>",
+                                file=source.path, line=line)
         sources.roots.setdefault(model, included)
         name = _apply_overrides(include, model, sources, source, line)
         merge = _is_true(include.get("merge")) or _is_true(include.findtext("merge"))
