@@ -341,3 +341,25 @@ def test_world_including_a_light_model_is_not_an_error(tmp_path):
                      f"<include><uri>{MODELS / 'x500'}</uri></include></world></sdf>")
     robots = load_robots(world)
     assert [r.name for r in robots] == ["x500"]
+
+
+@pytest.mark.parametrize("axis_xml", [
+    '<xyz expressed_in="__model__">1 0 0</xyz>',
+    "<xyz>1 0 0</xyz><use_parent_model_frame>true</use_parent_model_frame>",
+])
+def test_merged_model_frame_keeps_its_meaning_under_a_rotated_include(tmp_path, axis_xml):
+    """The included model's __model__ (written or implied) is the proxy frame, not the
+    including model's frame: an axis along the included model's x stays along it."""
+    (tmp_path / "hinge").mkdir()
+    (tmp_path / "hinge" / "model.sdf").write_text(
+        '<sdf version="1.9"><model name="hinge">' + _box_link("root", mass=1.0)
+        + _box_link("flap", "0.1 0 0 0 0 0")
+        + '<joint name="j" type="revolute"><parent>root</parent><child>flap</child>'
+        f"<axis>{axis_xml}</axis></joint></model></sdf>")
+    outer = tmp_path / "outer.sdf"
+    outer.write_text('<sdf version="1.9"><model name="o"><include merge="true">'
+                     "<uri>model://hinge</uri><pose>0 0 0 0 0 1.5707963267948966</pose>"
+                     "</include></model></sdf>")
+    robot = load_robot(outer)
+    np.testing.assert_allclose(robot.joint_map["j"].axis, [1, 0, 0], atol=1e-12)
+    np.testing.assert_allclose(link_poses(robot)["flap"][:3, 3], [0.1, 0, 0], atol=1e-12)

@@ -155,8 +155,11 @@ def _merge_into(parent: etree._Element, include: etree._Element, model: etree._E
             _retarget(child_pose, "relative_to", frame_name, if_missing=False)
         elif child.tag == "joint":
             _retarget(child_pose, "relative_to", frame_name, if_missing=False)
-            for xyz in child.iterfind("axis/xyz"):
-                _retarget(xyz, "expressed_in", frame_name, if_missing=False)
+            for axis in child.iterfind("axis"):
+                xyz = axis.find("xyz")
+                # SDF 1.6's <use_parent_model_frame> meant the included model's frame too.
+                implied = _is_true(axis.findtext("use_parent_model_frame"))
+                _retarget(xyz, "expressed_in", frame_name, if_missing=implied)
         sources.roots.setdefault(child, sources.file_of(child))
         moved.append(child)
     index = list(parent).index(include)
