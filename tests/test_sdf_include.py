@@ -75,8 +75,16 @@ def test_good_px4_models_validate_clean(model):
     assert "no findings" in output
 
 
-def test_model_directory_is_read_through_model_config():
+def test_model_directory_is_read_through_model_config(tmp_path):
     assert codes_of(load_robot(MODELS / "x500")) == []
+    # model.config lists model_1_6.sdf (0.5 kg) and model.sdf (0.06 kg, version 1.9).
+    assert load_robot(MODELS / "depth_cam").links[0].inertial.mass_kg == 0.06
+    only_old = tmp_path / "cam"
+    only_old.mkdir()
+    (only_old / "old.sdf").write_text((MODELS / "depth_cam" / "model_1_6.sdf").read_text())
+    (only_old / "model.config").write_text(
+        '<model><sdf version="1.6">old.sdf</sdf></model>')
+    assert load_robot(only_old).links[0].inertial.mass_kg == 0.5
 
 
 def test_hover_speed_is_sqrt_mg_over_4k():

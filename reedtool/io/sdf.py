@@ -412,6 +412,7 @@ class _ModelReader:
         for source, tolerated in self.sources.tolerated:
             by_file.setdefault(source.path, []).append(tolerated)
         for path, items in by_file.items():
+            items = sorted(set(items), key=lambda t: t.line)   # a file included twice
             what = "; ".join(f"line {t.line}: {t.what}" for t in items)
             self.issues.append(ParseIssue(
                 "xml-tolerated", f"Gazebo (TinyXML2) reads this file, but strict XML tools "
