@@ -371,3 +371,25 @@ def test_merged_model_frame_keeps_its_meaning_under_a_rotated_include(tmp_path, 
     robot = load_robot(outer)
     np.testing.assert_allclose(robot.joint_map["j"].axis, [1, 0, 0], atol=1e-12)
     np.testing.assert_allclose(link_poses(robot)["flap"][:3, 3], [0.1, 0, 0], atol=1e-12)
+
+
+@pytest.mark.parametrize("merge", ["false", "true"])
+def test_placement_frame_places_that_frame(tmp_path, merge):
+    """SDF 1.8: with <placement_frame>, the include's pose is the pose of that frame."""
+    (tmp_path / "leg").mkdir()
+    (tmp_path / "leg" / "model.sdf").write_text(
+        '<sdf version="1.9"><model name="leg">' + _box_link("hip", mass=1.0)
+        + '<frame name="foot" attached_to="hip"><pose>0 0 -0.3 0 0 0</pose></frame>'
+        "</model></sdf>")
+    outer = tmp_path / "outer.sdf"
+    outer.write_text(
+        '<sdf version="1.9"><model name="o">' + _box_link("body", mass=2.0)
+        + f'<include merge="{merge}"><uri>model://leg</uri><name>leg</name>'
+        "<placement_frame>foot</placement_frame><pose>0.5 0 0 0 0 0</pose></include>"
+        '<joint name="fix" type="fixed"><parent>body</parent>'
+        f"<child>{'hip' if merge == 'true' else 'leg'}</child></joint></model></sdf>")
+    robot = load_robot(outer)
+    hip = "hip" if merge == "true" else "leg::hip"
+    # The foot lands at (0.5, 0, 0), so the hip is 0.3 above it.
+    np.testing.assert_allclose(link_poses(robot)[hip][:3, 3], [0.5, 0, 0.3], atol=1e-12)
+    assert not [i for i in robot.parse_issues if i.kind == "unknown-frame"]

@@ -2,7 +2,8 @@
 
 * Without `<merge>`, an include becomes a nested `<model>` named by the include's
   `<name>` (else the included model's name), posed by the include's `<pose>` (with its
-  `relative_to`), made static by its `<static>`. The model reader scopes its names
+  `relative_to`; with `<placement_frame>` the pose places that frame of the model), made
+  static by its `<static>`. The model reader scopes its names
   (`camera::link`).
 * With `merge="true"` (SDF 1.9) inside a `<model>`, the included model's links,
   joints, frames, nested models and plugins are moved into the including model under
@@ -127,6 +128,9 @@ def _merge_into(parent: etree._Element, include: etree._Element, model: etree._E
     canonical = model.get("canonical_link") or _first_link(model)
     if canonical:
         frame.set("attached_to", canonical)
+    if model.get("placement_frame"):
+        # The include's pose places this frame of the merged model (SDF 1.8 placement_frame).
+        frame.set("placement_frame", model.get("placement_frame"))
     pose = model.find("pose")
     sources.roots[frame] = including
     if pose is None:
@@ -179,6 +183,9 @@ def _apply_overrides(include: etree._Element, model: etree._Element, sources: So
         model.insert(0, pose)
         sources.roots[pose] = including
         sources.lines[pose] = include_line
+    placement = (include.findtext("placement_frame") or "").strip()
+    if placement:
+        model.set("placement_frame", placement)
     static = include.find("static")
     if static is not None:
         for old in model.findall("static"):
