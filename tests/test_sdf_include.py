@@ -75,8 +75,16 @@ def test_good_px4_models_validate_clean(model):
     assert "no findings" in output
 
 
-def test_model_directory_is_read_through_model_config():
+def test_model_directory_is_read_through_model_config(tmp_path):
     assert codes_of(load_robot(MODELS / "x500")) == []
+    # model.config lists model_1_6.sdf (0.5 kg) and model.sdf (0.06 kg, version 1.9).
+    assert load_robot(MODELS / "depth_cam").links[0].inertial.mass_kg == 0.06
+    only_old = tmp_path / "cam"
+    only_old.mkdir()
+    (only_old / "old.sdf").write_text((MODELS / "depth_cam" / "model_1_6.sdf").read_text())
+    (only_old / "model.config").write_text(
+        '<model><sdf version="1.6">old.sdf</sdf></model>')
+    assert load_robot(only_old).links[0].inertial.mass_kg == 0.5
 
 
 def test_hover_speed_is_sqrt_mg_over_4k():
@@ -329,3 +337,59 @@ def test_world_includes_reedtool_cannot_fetch_are_skipped_unless_asked_for():
         load_robot(world, package_paths=[MODELS], model_name="Sun")
     assert (Path(info.value.file).name, info.value.line) == ("several_models.sdf", sun_line)
     assert "Fuel" in info.value.message
+
+
+def test_world_including_a_light_model_is_not_an_error(tmp_path):
+    (tmp_path / "sun").mkdir()
+    (tmp_path / "sun" / "model.sdf").write_text(
+        '<sdf version="1.6"><light name="sun" type="directional"/></sdf>')
+    world = tmp_path / "w.sdf"
+    world.write_text('<sdf version="1.9"><world name="w">'
+                     "<include><uri>model://sun</uri></include>"
+                     f"<include><uri>{MODELS / 'x500'}</uri></include></world></sdf>")
+    robots = load_robots(world)
+    assert [r.name for r in robots] == ["x500"]
+
+
+@pytest.mark.parametrize("axis_xml", [
+    '<xyz expressed_in="__model__">1 0 0</xyz>',
+    "<xyz>1 0 0</xyz><use_parent_model_frame>true</use_parent_model_frame>",
+])
+def test_merged_model_frame_keeps_its_meaning_under_a_rotated_include(tmp_path, axis_xml):
+    """The included model's __model__ (written or implied) is the proxy frame, not the
+    including model's frame: an axis along the included model's x stays along it."""
+    (tmp_path / "hinge").mkdir()
+    (tmp_path / "hinge" / "model.sdf").write_text(
+        '<sdf version="1.9"><model name="hinge">' + _box_link("root", mass=1.0)
+        + _box_link("flap", "0.1 0 0 0 0 0")
+        + '<joint name="j" type="revolute"><parent>root</parent><child>flap</child>'
+        f"<axis>{axis_xml}</axis></joint></model></sdf>")
+    outer = tmp_path / "outer.sdf"
+    outer.write_text('<sdf version="1.9"><model name="o"><include merge="true">'
+                     "<uri>model://hinge</uri><pose>0 0 0 0 0 1.5707963267948966</pose>"
+                     "</include></model></sdf>")
+    robot = load_robot(outer)
+    np.testing.assert_allclose(robot.joint_map["j"].axis, [1, 0, 0], atol=1e-12)
+    np.testing.assert_allclose(link_poses(robot)["flap"][:3, 3], [0.1, 0, 0], atol=1e-12)
+
+
+@pytest.mark.parametrize("merge", ["false", "true"])
+def test_placement_frame_places_that_frame(tmp_path, merge):
+    """SDF 1.8: with <placement_frame>, the include's pose is the pose of that frame."""
+    (tmp_path / "leg").mkdir()
+    (tmp_path / "leg" / "model.sdf").write_text(
+        '<sdf version="1.9"><model name="leg">' + _box_link("hip", mass=1.0)
+        + '<frame name="foot" attached_to="hip"><pose>0 0 -0.3 0 0 0</pose></frame>'
+        "</model></sdf>")
+    outer = tmp_path / "outer.sdf"
+    outer.write_text(
+        '<sdf version="1.9"><model name="o">' + _box_link("body", mass=2.0)
+        + f'<include merge="{merge}"><uri>model://leg</uri><name>leg</name>'
+        "<placement_frame>foot</placement_frame><pose>0.5 0 0 0 0 0</pose></include>"
+        '<joint name="fix" type="fixed"><parent>body</parent>'
+        f"<child>{'hip' if merge == 'true' else 'leg'}</child></joint></model></sdf>")
+    robot = load_robot(outer)
+    hip = "hip" if merge == "true" else "leg::hip"
+    # The foot lands at (0.5, 0, 0), so the hip is 0.3 above it.
+    np.testing.assert_allclose(link_poses(robot)[hip][:3, 3], [0.5, 0, 0.3], atol=1e-12)
+    assert not [i for i in robot.parse_issues if i.kind == "unknown-frame"]

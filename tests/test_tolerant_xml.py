@@ -46,3 +46,10 @@ def test_malformed_xml_stays_a_one_line_error(text, line):
         parse_tolerant(text, "f.sdf")
     assert info.value.line == line and "malformed XML" in info.value.message
     assert "\n" not in info.value.one_line()
+
+
+def test_colons_in_text_and_values_are_not_prefixes():
+    text = ('<sdf version="1.9">\n<!-- a -- b -->\n<model name="m">\n'
+            '<uri a="x:y=1">model://m</uri>\n<note>see: a:b = c</note>\n</model>\n</sdf>\n')
+    _root, tolerated = parse_tolerant(text, "f.sdf")
+    assert [t.what for t in tolerated] == ["'--' inside a comment"]

@@ -26,9 +26,23 @@ def load_robots(path: Path | str, mappings: Mapping[str, str] | None = None,
     return [load_robot(path, mappings, package_paths, model_name=model_name)]
 
 
+def _model_dir_sdf(path: Path) -> Path:
+    """The SDF file of a Gazebo model directory (model.config, else model.sdf)."""
+    from reedtool.io.resources import model_sdf_in_dir
+
+    if not (path / "model.config").is_file() and not (path / "model.sdf").is_file():
+        raise ReedtoolError("is a directory, expected a .urdf, .xacro or .sdf file "
+                            "(or a model directory holding model.config or model.sdf)",
+                            file=path)
+    try:
+        return model_sdf_in_dir(path)
+    except ReedtoolError as exc:
+        raise ReedtoolError(exc.message, file=path) from None
+
+
 def _sdf_path(path: Path) -> Path | None:
-    if path.is_dir() and (path / "model.sdf").is_file():
-        return path / "model.sdf"
+    if path.is_dir():
+        return _model_dir_sdf(path)
     return path if path.suffix.lower() in SDF_SUFFIXES else None
 
 
@@ -46,10 +60,7 @@ def load_robot(path: Path | str, mappings: Mapping[str, str] | None = None,
     if not path.exists():
         raise ReedtoolError("file not found", file=path, hint="check the model path")
     if path.is_dir():
-        if not (path / "model.sdf").is_file():
-            raise ReedtoolError("is a directory, expected a .urdf, .xacro or .sdf file "
-                                "(or a model directory holding model.sdf)", file=path)
-        path = path / "model.sdf"
+        path = _model_dir_sdf(path)
     if path.suffix.lower() in SDF_SUFFIXES:
         from reedtool.io.sdf import load_sdf_file
 

@@ -208,6 +208,8 @@ class _FrameEntry:
     relative_to: str          # scoped name of the frame the pose is expressed in
     T_rel_frame: np.ndarray   # pose of this frame in `relative_to`
     el: etree._Element
+    # SDF 1.8 placement_frame (scoped): the pose places this frame, not the model frame.
+    placement: str | None = None
 
 
 class _ModelReader:
@@ -307,8 +309,26 @@ class _ModelReader:
             self._resolved[name] = np.eye(4)
             return self._resolved[name]
         T = self.T_model(entry.relative_to, entry.el, subject, _seen + (name,)) @ entry.T_rel_frame
+        if entry.placement:
+            # The pose is that of the placement frame: T_rel_model = X @ inv(T_model_placement).
+            T = T @ np.linalg.inv(self._T_within(entry.placement, name, entry.el, subject))
         self._resolved[name] = T
         return T
+
+    def _T_within(self, name: str, base: str, el: etree._Element, subject: str | None,
+                  _seen: tuple[str, ...] = ()) -> np.ndarray:
+        """Pose of frame `name` in frame `base`, following relative_to inside `base`'s model."""
+        if name == base:
+            return np.eye(4)
+        entry = self.frames.get(name)
+        if entry is None and name + "::" + MODEL_FRAME in self.frames:
+            return self._T_within(name + "::" + MODEL_FRAME, base, el, subject, _seen)
+        if entry is None or name in _seen or entry.placement:
+            self._issue("unknown-frame", f"placement frame '{name}' is not posed within "
+                        f"'{base}'; the placement is ignored", el, subject)
+            return np.eye(4)
+        return self._T_within(entry.relative_to, base, el, subject, _seen + (name,)) \
+            @ entry.T_rel_frame
 
     def _node(self, el: etree._Element, scope: str = "") -> XmlNode:
         children = [self._node(c, scope) for c in el if isinstance(c.tag, str)]
@@ -368,13 +388,17 @@ class _ModelReader:
                 self.joint_els.append((scope + name, scope, el))
             elif el.tag == "frame":
                 T, rel = self._pose(el.find("pose"), name)
+                placement = el.get("placement_frame")   # set on merged-include proxy frames
                 self.frames[scope + name] = _FrameEntry(
-                    self._scoped(scope, rel or el.get("attached_to")), T, el)
+                    self._scoped(scope, rel or el.get("attached_to")), T, el,
+                    scope + placement if placement else None)
                 self.attached_to[scope + name] = self._scoped(scope, el.get("attached_to"))
             elif el.tag == "model":
                 T, rel = self._pose(el.find("pose"), name)
                 nested = scope + name + "::"
-                self.frames[nested + MODEL_FRAME] = _FrameEntry(self._scoped(scope, rel), T, el)
+                placement = el.get("placement_frame")
+                self.frames[nested + MODEL_FRAME] = _FrameEntry(
+                    self._scoped(scope, rel), T, el, nested + placement if placement else None)
                 self.model_els[nested] = el
                 self._collect(el, nested)
             elif el.tag == "plugin":
@@ -412,6 +436,7 @@ class _ModelReader:
         for source, tolerated in self.sources.tolerated:
             by_file.setdefault(source.path, []).append(tolerated)
         for path, items in by_file.items():
+            items = sorted(set(items), key=lambda t: t.line)   # a file included twice
             what = "; ".join(f"line {t.line}: {t.what}" for t in items)
             self.issues.append(ParseIssue(
                 "xml-tolerated", f"Gazebo (TinyXML2) reads this file, but strict XML tools "

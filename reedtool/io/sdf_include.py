@@ -2,7 +2,8 @@
 
 * Without `<merge>`, an include becomes a nested `<model>` named by the include's
   `<name>` (else the included model's name), posed by the include's `<pose>` (with its
-  `relative_to`), made static by its `<static>`. The model reader scopes its names
+  `relative_to`; with `<placement_frame>` the pose places that frame of the model), made
+  static by its `<static>`. The model reader scopes its names
   (`camera::link`).
 * With `merge="true"` (SDF 1.9) inside a `<model>`, the included model's links,
   joints, frames, nested models and plugins are moved into the including model under
@@ -127,6 +128,9 @@ def _merge_into(parent: etree._Element, include: etree._Element, model: etree._E
     canonical = model.get("canonical_link") or _first_link(model)
     if canonical:
         frame.set("attached_to", canonical)
+    if model.get("placement_frame"):
+        # The include's pose places this frame of the merged model (SDF 1.8 placement_frame).
+        frame.set("placement_frame", model.get("placement_frame"))
     pose = model.find("pose")
     sources.roots[frame] = including
     if pose is None:
@@ -155,8 +159,11 @@ def _merge_into(parent: etree._Element, include: etree._Element, model: etree._E
             _retarget(child_pose, "relative_to", frame_name, if_missing=False)
         elif child.tag == "joint":
             _retarget(child_pose, "relative_to", frame_name, if_missing=False)
-            for xyz in child.iterfind("axis/xyz"):
-                _retarget(xyz, "expressed_in", frame_name, if_missing=False)
+            for axis in child.iterfind("axis"):
+                xyz = axis.find("xyz")
+                # SDF 1.6's <use_parent_model_frame> meant the included model's frame too.
+                implied = _is_true(axis.findtext("use_parent_model_frame"))
+                _retarget(xyz, "expressed_in", frame_name, if_missing=implied)
         sources.roots.setdefault(child, sources.file_of(child))
         moved.append(child)
     index = list(parent).index(include)
@@ -176,6 +183,9 @@ def _apply_overrides(include: etree._Element, model: etree._Element, sources: So
         model.insert(0, pose)
         sources.roots[pose] = including
         sources.lines[pose] = include_line
+    placement = (include.findtext("placement_frame") or "").strip()
+    if placement:
+        model.set("placement_frame", placement)
     static = include.find("static")
     if static is not None:
         for old in model.findall("static"):
@@ -232,9 +242,16 @@ def expand_includes(root: etree._Element, source: SourceFile, sources: SourceMap
         included_root, included = _read(path, sources)
         expand_includes(included_root, included, sources, package_paths, chain)
         model = included_root.find("model") if included_root.tag == "sdf" else None
+        if model is None and in_world:
+            # A world may include a light (model://sun) or an actor: nothing to check.
+            sources.unresolved.append(UnresolvedInclude(
+                (include.findtext("name") or "").strip() or None, uri, source.path, line,
+                f"{_shown(path)} holds no <model>"))
+            parent.remove(include)
+            continue
         if model is None:
-            raise ReedtoolError(f"included file {path} holds no <model>", file=source.path,
-                                line=line)
+            raise ReedtoolError(f"included file {_shown(path)} holds no <model>",
+                                file=source.path, line=line)
         sources.roots.setdefault(model, included)
         name = _apply_overrides(include, model, sources, source, line)
         merge = _is_true(include.get("merge")) or _is_true(include.findtext("merge"))

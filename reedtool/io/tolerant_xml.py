@@ -29,8 +29,10 @@ from reedtool.errors import ReedtoolError
 UNDECLARED_NS = "urn:reedtool:undeclared:"
 
 _COMMENT = re.compile(r"<!--(.*?)-->", re.DOTALL)
-_PREFIXED_TAG = re.compile(r"</?([A-Za-z_][\w.-]*):[A-Za-z_][\w.-]*")
+_START_TAG = re.compile(r"<([A-Za-z_][^<>]*)>")
+_PREFIXED_TAG = re.compile(r"^([A-Za-z_][\w.-]*):[A-Za-z_]")
 _PREFIXED_ATTR = re.compile(r"\s([A-Za-z_][\w.-]*):[A-Za-z_][\w.-]*\s*=")
+_QUOTED = re.compile(r"\"[^\"]*\"|'[^']*'")
 _DECLARED = re.compile(r"xmlns:([A-Za-z_][\w.-]*)\s*=")
 _ROOT_START = re.compile(r"<(?![?!])[A-Za-z_][\w.:-]*")
 _RESERVED = {"xml", "xmlns"}
@@ -74,12 +76,15 @@ def _undeclared_prefixes(text: str) -> dict[str, int]:
     no_comments = _COMMENT.sub(lambda m: " " * len(m.group(0)), text)
     declared = set(_DECLARED.findall(no_comments)) | _RESERVED
     used: dict[str, int] = {}
-    for pattern in (_PREFIXED_TAG, _PREFIXED_ATTR):
-        for match in pattern.finditer(no_comments):
-            prefix = match.group(1)
-            if prefix not in declared:
-                line = _line_of(no_comments, match.start(1))
-                used[prefix] = min(line, used.get(prefix, line))
+    # Only element and attribute names count: text and attribute values may hold "a:b".
+    for tag in _START_TAG.finditer(no_comments):
+        inside = _QUOTED.sub(lambda m: " " * len(m.group(0)), tag.group(1))
+        for pattern in (_PREFIXED_TAG, _PREFIXED_ATTR):
+            for match in pattern.finditer(inside):
+                prefix = match.group(1)
+                if prefix not in declared:
+                    line = _line_of(no_comments, tag.start(1) + match.start(1))
+                    used[prefix] = min(line, used.get(prefix, line))
     return used
 
 
