@@ -31,6 +31,7 @@ CASES = [
     ("../vtol/vtol_motor_number_alias.sdf", ["R319"]),
     ("../rotors_neo/neo_balanced_tilt.sdf", ["R320"]),
     ("../rotors_neo/omav_tilt_servos.sdf", []),
+    ("../vtol/tailsitter_tangential_tilt.sdf", ["R320"]),
     ("../omni/omni_reversible.sdf", ["R319"]),
     # The R319/R320 pair: a pusher and a balanced tilt are information (their bad fixtures).
     ("../vtol/R319_bad_pusher.sdf", ["R319"]),
@@ -172,6 +173,30 @@ def test_neo_tilts_are_five_degrees_alternating():
         tangent = np.array([-math.sin(bearing), math.cos(bearing), 0])
         sign = -1 if i % 2 == 0 else 1
         assert float(rotor.axis @ tangent) == pytest.approx(sign * math.sin(math.radians(5)))
+
+
+def test_tailsitter_tilts_by_hand():
+    rotors = _rotors("vtol/tailsitter_tangential_tilt.sdf")
+    # z axis of Ry(pitch) Rx(roll): (cos r sin p, -sin r, cos r cos p).
+    a, b = math.cos(0.17) * math.sin(0.17), math.sin(0.17)
+    expected = [(-a, -b), (a, b), (-a, b), (a, -b)]
+    for rotor, (ax, ay) in zip(rotors, expected):
+        np.testing.assert_allclose(rotor.axis[:2], [ax, ay], atol=1e-12)
+    # Side forces cancel; tilt yaw torques x*a_y - y*a_x cancel in pairs.
+    assert sum(r.axis[0] for r in rotors) == pytest.approx(0, abs=1e-12)
+    torques = [r.position_m[0] * r.axis[1] - r.position_m[1] * r.axis[0] for r in rotors]
+    assert torques[0] == pytest.approx(-(0.145 * b + 0.23 * a))
+    assert sum(torques) == pytest.approx(0, abs=1e-12)
+
+
+def test_unbalanced_tilt_pattern_is_a_warning_per_rotor(tmp_path):
+    """Flip one tailsitter rotor's roll: the side forces no longer cancel."""
+    text = (FIXTURES / "vtol/tailsitter_tangential_tilt.sdf").read_text()
+    path = tmp_path / "ts.sdf"
+    path.write_text(text.replace("<pose>0.145 -0.23 0.1 0.17 -0.17 0</pose>",
+                                 "<pose>0.145 -0.23 0.1 -0.17 -0.17 0</pose>"))
+    codes = [f.code for f in run_checks(load_robot(path)) if f.code in ("R311", "R320")]
+    assert codes == ["R311"] * 4
 
 
 def test_omav_servos_are_not_rotors():
