@@ -24,6 +24,7 @@ CASES = [
     ("../ardupilot/iris_lift_drag.sdf", ["R317"] * 4),
     ("../ardupilot/R318_bad_multiplier_sign.sdf", ["R304"] + ["R317"] * 4 + ["R318"]),
     ("../ardupilot/R317_bad_no_blades.sdf", ["R317"] * 4),
+    ("../ardupilot/zephyr_pusher.sdf", ["R317", "R319"]),
     ("../vtol/vtol_pusher.sdf", ["R319"]),
     ("../vtol/R304_bad_flipped_direction.sdf", ["R304", "R319"]),
     ("../vtol/R301_bad_duplicate_actuator.sdf", ["R301", "R319"]),
@@ -111,6 +112,18 @@ def test_ardupilot_non_velocity_controls_are_not_rotors(tmp_path):
     path = tmp_path / "iris.sdf"
     path.write_text(text)
     assert [r.channel for r in discover_rotors(load_robot(path))] == [0, 1, 2]
+
+
+def test_ardupilot_zephyr_propeller_is_propulsion_spinning_with_its_blades():
+    (rotor,) = _rotors("ardupilot/zephyr_pusher.sdf")     # the elevons are POSITION servos
+    assert (rotor.channel, rotor.role) == (2, "propulsion")
+    # Link pitched 90°: its y is the model's y, so the blades' upward (0, -1, 0) is -y,
+    # the zephyr's forward. Joint axis (0, -1, 0) is the same; (axis x cp) . forward > 0
+    # for both blades, and the multiplier is +838: ccw about the thrust axis, as built.
+    np.testing.assert_allclose(rotor.axis, [0, -1, 0], atol=1e-9)
+    assert rotor.direction == "ccw" and rotor.blade_turning_sign == 1
+    k_f = 2 * 0.5 * 1.2041 * 0.074205 ** 2 * 0.02 * 4.25 * 0.30
+    assert rotor.motor_constant == pytest.approx(k_f, rel=1e-9)
 
 
 # ---------------------------------------------------------------------- VTOL
