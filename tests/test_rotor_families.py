@@ -174,6 +174,25 @@ def test_vtol_hover_test_uses_lift_rotors(capsys):
     assert total == pytest.approx(mass * 9.80665, rel=1e-9)
 
 
+@pytest.mark.parametrize("rpy,tilt", [("1.5707963267949 0 0", 90.0), ("3.14159265358979 0 0", 180.0)])
+def test_sideways_or_downward_rotor_on_a_wingless_quad_is_not_propulsion(tmp_path, rpy, tilt):
+    """Rolled 90° (axis along y) or 180° (down) by mistake: still a lift rotor, R311 warns."""
+    text = (FIXTURES / "vtol/vtol_pusher.sdf").read_text()
+    text = text.replace("<pose>0.35 -0.35 0.08 0 0 0</pose>", f"<pose>0.35 -0.35 0.08 {rpy}</pose>")
+    start = text.index("<!-- the wing")
+    text = text[:start] + text[text.index("\n", start) + 1:]
+    lift_drag = text.index('<plugin filename="gz-sim-lift-drag-system"')
+    text = text[:lift_drag] + text[text.index("</plugin>", lift_drag) + len("</plugin>"):]
+    path = tmp_path / "quad.sdf"
+    path.write_text(text)
+    robot = load_robot(path)
+    roles = {r.name: r.role for r in discover_rotors(robot)}
+    assert roles["rotor_0"] == "lift" and roles["rotor_puller"] == "propulsion"
+    tilt_findings = [f for f in run_checks(robot) if f.code == "R311"]
+    assert [f.subject for f in tilt_findings] == ["rotor_0"]
+    assert f"tilted {tilt:.1f}°" in tilt_findings[0].message
+
+
 # ----------------------------------------------------------------- RotorS
 
 def test_neo_tilts_are_five_degrees_alternating():

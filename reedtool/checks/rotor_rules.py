@@ -668,8 +668,9 @@ def ardupilot_spin_against_blades(ctx: CheckContext) -> Iterator[Issue]:
 @rule("R319", "rotor-role", "info",
       "Rotors that are not lift rotors, or an omnidirectional frame.")
 def rotor_role(ctx: CheckContext) -> Iterator[Issue]:
-    """A rotor whose thrust axis is more than 60° from body z on a vehicle that also has
-    lift rotors (or a wing) is propulsion: a fixed-wing puller or a VTOL pusher. It is
+    """A rotor whose thrust axis is 60-120° from body z on a vehicle that also has lift
+    rotors (or a wing), pointing along body ±x or on a vehicle with a wing, is
+    propulsion: a fixed-wing puller or a VTOL pusher. It is
     left out of the hover allocation, the trim and the lift-rotor rules (R304-R311). A
     frame with reversible motors or rotors pointing in every direction is
     omnidirectional: it is judged by the full 6-DoF force-and-torque allocation.
