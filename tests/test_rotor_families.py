@@ -100,6 +100,8 @@ def test_ardupilot_multiplier_against_blades_names_the_channel():
     (finding,) = [f for f in _findings("../ardupilot/R318_bad_multiplier_sign.sdf")
                   if f.code == "R318"]
     assert "channel 2" in finding.message and finding.severity == "error"
+    (yaw,) = [f for f in _findings("../ardupilot/R318_bad_multiplier_sign.sdf") if f.code == "R304"]
+    assert yaw.subject == "rotor_2" and "<multiplier>" in yaw.hint
 
 
 def test_ardupilot_non_velocity_controls_are_not_rotors(tmp_path):

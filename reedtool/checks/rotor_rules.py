@@ -202,7 +202,8 @@ def yaw_moment_imbalance(ctx: CheckContext) -> Iterator[Issue]:
     if best is not None:
         target = rotors[best]
         other = "cw" if target.direction == "ccw" else "ccw"
-        hint = f"set rotor '{target.name}' to {other}"
+        hint = f"set rotor '{target.name}' to {other}" if target.kind != "ardupilot" else \
+            f"flip the sign of rotor '{target.name}''s <multiplier> (it turns {other} then)"
     yield Issue(f"at equal rotor speed the yaw moments do not cancel: net {_fmt(net_N_m)} N·m "
                 f"at hover thrust ({counts['ccw']} ccw, {counts['cw']} cw; "
                 f"{100 * abs(net_N_m) / total_N_m:.0f}% of the rotors' drag torque)",
