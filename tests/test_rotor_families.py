@@ -282,8 +282,8 @@ ODD_EDITS = [
     ("<type>VELOCITY</type>", "<type>weird</type>"),
     ("<offset>0</offset>", "<offset>-1</offset>"),
     ("<link_name>rotor_0</link_name>", "<link_name>missing</link_name>"),
-    ('<control channel="0">', '<control channel="0"><rotorVelocitySlowdownSim>0'
-                              '</rotorVelocitySlowdownSim>'),
+    ('<control channel="0">', ('<control channel="0"><rotorVelocitySlowdownSim>0'
+                              '</rotorVelocitySlowdownSim>')),
 ]
 
 
