@@ -197,16 +197,27 @@ def test_sideways_or_downward_rotor_on_a_wingless_quad_is_not_propulsion(tmp_pat
 
 # ----------------------------------------------------------------- RotorS
 
+NEO_RPY = [  # rpy of neo11.xacro's six rotor joints, motor numbers 0..5
+    (5, 0, 30), (0, -5, 0), (5, 0, 150), (-5, 0, -150), (0, 5, 180), (-5, 0, -30)]
+
+
 def test_neo_tilts_are_five_degrees_alternating():
     rotors = _rotors("rotors_neo/neo_balanced_tilt.sdf")
-    assert len(rotors) == 6
-    for i, rotor in enumerate(rotors):
-        bearing = math.radians(30 + 60 * i)
-        assert rotor.tilt_deg == pytest.approx(5.0, abs=1e-9)
-        # Rolled about the arm: the axis leans tangentially, -/+ alternately.
-        tangent = np.array([-math.sin(bearing), math.cos(bearing), 0])
-        sign = -1 if i % 2 == 0 else 1
-        assert float(rotor.axis @ tangent) == pytest.approx(sign * math.sin(math.radians(5)))
+    assert len(rotors) == 6 and [r.motor_number for r in rotors] == list(range(6))
+    for i, (rotor, rpy) in enumerate(zip(rotors, NEO_RPY)):
+        r, p, y = (math.radians(v) for v in rpy)
+        # z column of Rz(y) Ry(p) Rx(r), written out.
+        expected = [math.cos(y) * math.sin(p) * math.cos(r) + math.sin(y) * math.sin(r),
+                    math.sin(y) * math.sin(p) * math.cos(r) - math.cos(y) * math.sin(r),
+                    math.cos(p) * math.cos(r)]
+        np.testing.assert_allclose(rotor.axis, expected, atol=1e-9)
+        assert rotor.tilt_deg == pytest.approx(5.0, abs=1e-6)
+        # The lean is tangential (about the arm), its sign alternating around the frame.
+        bearing = math.atan2(rotor.position_m[1], rotor.position_m[0])
+        tangential = -math.sin(bearing) * rotor.axis[0] + math.cos(bearing) * rotor.axis[1]
+        assert tangential == pytest.approx((-1) ** (i + 1) * math.sin(math.radians(5)),
+                                           abs=2e-3)
+        assert rotor.direction == ("ccw" if i % 2 == 0 else "cw")
 
 
 def test_tailsitter_tilts_by_hand():
