@@ -104,7 +104,7 @@ class Rotor:
     number_tag: str = "motorNumber"  # element (or attribute) the number was read from
     direction_tag: str = "turningDirection"
     channel: int | None = None      # ArduPilot: the SDF channel attribute as written (0-based)
-    reversible: bool = False        # gz: may spin (and push) both ways
+    reversible: bool = False        # gz, PX4 classic: may spin (and push) both ways
     role: str = "lift"              # 'lift' | 'propulsion'
     constants_estimated: bool = False  # constants derived from LiftDrag blades, not written
     blades: list[Blade] = field(default_factory=list)
@@ -252,7 +252,7 @@ def _motor_model_rotor(robot: Robot, plugin: Plugin, kind: str, poses, index: in
         rotor_drag_coefficient=_float(plugin.param("rotorDragCoefficient")),
         rolling_moment_coefficient=_float(plugin.param("rollingMomentCoefficient")),
         kind=kind, plugin=plugin, loc=plugin.loc, node=plugin.node, number_tag=number_tag,
-        reversible=kind == "gz" and _bool(plugin.param("reversible")))
+        reversible=_bool(plugin.param("reversible")))  # gz and PX4 classic read it
 
 
 def _blades_by_link(robot: Robot) -> dict[str, list[Blade]]:
