@@ -24,6 +24,7 @@ CASES = [
     ("../ardupilot/iris_lift_drag.sdf", ["R317"] * 4),
     ("../ardupilot/R318_bad_multiplier_sign.sdf", ["R304"] + ["R317"] * 4 + ["R318"]),
     ("../ardupilot/R317_bad_no_blades.sdf", ["R317"] * 4),
+    ("../ardupilot/zephyr_pusher.sdf", ["R317", "R319"]),
     ("../vtol/vtol_pusher.sdf", ["R319"]),
     ("../vtol/R304_bad_flipped_direction.sdf", ["R304", "R319"]),
     ("../vtol/R301_bad_duplicate_actuator.sdf", ["R301", "R319"]),
@@ -31,6 +32,7 @@ CASES = [
     ("../vtol/vtol_motor_number_alias.sdf", ["R319"]),
     ("../rotors_neo/neo_balanced_tilt.sdf", ["R320"]),
     ("../rotors_neo/omav_tilt_servos.sdf", []),
+    ("../vtol/tailsitter_tangential_tilt.sdf", ["R320"]),
     ("../omni/omni_reversible.sdf", ["R319"]),
     # The R319/R320 pair: a pusher and a balanced tilt are information (their bad fixtures).
     ("../vtol/R319_bad_pusher.sdf", ["R319"]),
@@ -98,6 +100,8 @@ def test_ardupilot_multiplier_against_blades_names_the_channel():
     (finding,) = [f for f in _findings("../ardupilot/R318_bad_multiplier_sign.sdf")
                   if f.code == "R318"]
     assert "channel 2" in finding.message and finding.severity == "error"
+    (yaw,) = [f for f in _findings("../ardupilot/R318_bad_multiplier_sign.sdf") if f.code == "R304"]
+    assert yaw.subject == "rotor_2" and "<multiplier>" in yaw.hint
 
 
 def test_ardupilot_non_velocity_controls_are_not_rotors(tmp_path):
@@ -110,6 +114,18 @@ def test_ardupilot_non_velocity_controls_are_not_rotors(tmp_path):
     path = tmp_path / "iris.sdf"
     path.write_text(text)
     assert [r.channel for r in discover_rotors(load_robot(path))] == [0, 1, 2]
+
+
+def test_ardupilot_zephyr_propeller_is_propulsion_spinning_with_its_blades():
+    (rotor,) = _rotors("ardupilot/zephyr_pusher.sdf")     # the elevons are POSITION servos
+    assert (rotor.channel, rotor.role) == (2, "propulsion")
+    # Link pitched 90°: its y is the model's y, so the blades' upward (0, -1, 0) is -y,
+    # the zephyr's forward. Joint axis (0, -1, 0) is the same; (axis x cp) . forward > 0
+    # for both blades, and the multiplier is +838: ccw about the thrust axis, as built.
+    np.testing.assert_allclose(rotor.axis, [0, -1, 0], atol=1e-9)
+    assert rotor.direction == "ccw" and rotor.blade_turning_sign == 1
+    k_f = 2 * 0.5 * 1.2041 * 0.074205 ** 2 * 0.02 * 4.25 * 0.30
+    assert rotor.motor_constant == pytest.approx(k_f, rel=1e-9)
 
 
 # ---------------------------------------------------------------------- VTOL
@@ -160,18 +176,72 @@ def test_vtol_hover_test_uses_lift_rotors(capsys):
     assert total == pytest.approx(mass * 9.80665, rel=1e-9)
 
 
+@pytest.mark.parametrize("rpy,tilt", [("1.5707963267949 0 0", 90.0), ("3.14159265358979 0 0", 180.0)])
+def test_sideways_or_downward_rotor_on_a_wingless_quad_is_not_propulsion(tmp_path, rpy, tilt):
+    """Rolled 90° (axis along y) or 180° (down) by mistake: still a lift rotor, R311 warns."""
+    text = (FIXTURES / "vtol/vtol_pusher.sdf").read_text()
+    text = text.replace("<pose>0.35 -0.35 0.08 0 0 0</pose>", f"<pose>0.35 -0.35 0.08 {rpy}</pose>")
+    start = text.index("<!-- the wing")
+    text = text[:start] + text[text.index("\n", start) + 1:]
+    lift_drag = text.index('<plugin filename="gz-sim-lift-drag-system"')
+    text = text[:lift_drag] + text[text.index("</plugin>", lift_drag) + len("</plugin>"):]
+    path = tmp_path / "quad.sdf"
+    path.write_text(text)
+    robot = load_robot(path)
+    roles = {r.name: r.role for r in discover_rotors(robot)}
+    assert roles["rotor_0"] == "lift" and roles["rotor_puller"] == "propulsion"
+    tilt_findings = [f for f in run_checks(robot) if f.code == "R311"]
+    assert [f.subject for f in tilt_findings] == ["rotor_0"]
+    assert f"tilted {tilt:.1f}°" in tilt_findings[0].message
+
+
 # ----------------------------------------------------------------- RotorS
+
+NEO_RPY = [  # rpy of neo11.xacro's six rotor joints, motor numbers 0..5
+    (5, 0, 30), (0, -5, 0), (5, 0, 150), (-5, 0, -150), (0, 5, 180), (-5, 0, -30)]
+
 
 def test_neo_tilts_are_five_degrees_alternating():
     rotors = _rotors("rotors_neo/neo_balanced_tilt.sdf")
-    assert len(rotors) == 6
-    for i, rotor in enumerate(rotors):
-        bearing = math.radians(30 + 60 * i)
-        assert rotor.tilt_deg == pytest.approx(5.0, abs=1e-9)
-        # Rolled about the arm: the axis leans tangentially, -/+ alternately.
-        tangent = np.array([-math.sin(bearing), math.cos(bearing), 0])
-        sign = -1 if i % 2 == 0 else 1
-        assert float(rotor.axis @ tangent) == pytest.approx(sign * math.sin(math.radians(5)))
+    assert len(rotors) == 6 and [r.motor_number for r in rotors] == list(range(6))
+    for i, (rotor, rpy) in enumerate(zip(rotors, NEO_RPY)):
+        r, p, y = (math.radians(v) for v in rpy)
+        # z column of Rz(y) Ry(p) Rx(r), written out.
+        expected = [math.cos(y) * math.sin(p) * math.cos(r) + math.sin(y) * math.sin(r),
+                    math.sin(y) * math.sin(p) * math.cos(r) - math.cos(y) * math.sin(r),
+                    math.cos(p) * math.cos(r)]
+        np.testing.assert_allclose(rotor.axis, expected, atol=1e-9)
+        assert rotor.tilt_deg == pytest.approx(5.0, abs=1e-6)
+        # The lean is tangential (about the arm), its sign alternating around the frame.
+        bearing = math.atan2(rotor.position_m[1], rotor.position_m[0])
+        tangential = -math.sin(bearing) * rotor.axis[0] + math.cos(bearing) * rotor.axis[1]
+        assert tangential == pytest.approx((-1) ** (i + 1) * math.sin(math.radians(5)),
+                                           abs=2e-3)
+        assert rotor.direction == ("ccw" if i % 2 == 0 else "cw")
+
+
+def test_tailsitter_tilts_by_hand():
+    rotors = _rotors("vtol/tailsitter_tangential_tilt.sdf")
+    # z axis of Ry(pitch) Rx(roll): (cos r sin p, -sin r, cos r cos p).
+    a, b = math.cos(0.17) * math.sin(0.17), math.sin(0.17)
+    expected = [(-a, -b), (a, b), (-a, b), (a, -b)]
+    for rotor, (ax, ay) in zip(rotors, expected):
+        np.testing.assert_allclose(rotor.axis[:2], [ax, ay], atol=1e-12)
+    # Side forces cancel; tilt yaw torques x*a_y - y*a_x cancel in pairs.
+    assert sum(r.axis[0] for r in rotors) == pytest.approx(0, abs=1e-12)
+    torques = [r.position_m[0] * r.axis[1] - r.position_m[1] * r.axis[0] for r in rotors]
+    assert torques[0] == pytest.approx(-(0.145 * b + 0.23 * a))
+    assert sum(torques) == pytest.approx(0, abs=1e-12)
+
+
+def test_unbalanced_tilt_pattern_is_a_warning_per_rotor(tmp_path):
+    """Flip one tailsitter rotor's roll: the side forces no longer cancel."""
+    text = (FIXTURES / "vtol/tailsitter_tangential_tilt.sdf").read_text()
+    path = tmp_path / "ts.sdf"
+    path.write_text(text.replace("<pose>0.145 -0.23 0.1 0.17 -0.17 0</pose>",
+                                 "<pose>0.145 -0.23 0.1 -0.17 -0.17 0</pose>"))
+    codes = [f.code for f in run_checks(load_robot(path)) if f.code in ("R311", "R320")]
+    assert codes == ["R311"] * 4
 
 
 def test_omav_servos_are_not_rotors():
@@ -223,8 +293,8 @@ ODD_EDITS = [
     ("<type>VELOCITY</type>", "<type>weird</type>"),
     ("<offset>0</offset>", "<offset>-1</offset>"),
     ("<link_name>rotor_0</link_name>", "<link_name>missing</link_name>"),
-    ('<control channel="0">', '<control channel="0"><rotorVelocitySlowdownSim>0'
-                              '</rotorVelocitySlowdownSim>'),
+    ('<control channel="0">', ('<control channel="0"><rotorVelocitySlowdownSim>0'
+                              '</rotorVelocitySlowdownSim>')),
 ]
 
 

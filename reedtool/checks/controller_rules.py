@@ -168,10 +168,10 @@ def controller_rotor_order(ctx: CheckContext) -> Iterator[Issue]:
         for entry, rotor in _pairs(ctx, table):
             if rotor.motor_number is not None and rotor.motor_number != entry.index:
                 yield Issue(f"{_entry(table, entry)} is entry {entry.index}, but the motor on "
-                            f"'{entry.joint_name}' has motorNumber {rotor.motor_number} "
-                            f"({rotor.plugin.param_loc('motorNumber')}); speed {entry.index} "
+                            f"'{entry.joint_name}' has {rotor.number_tag} {rotor.motor_number} "
+                            f"({rotor.param_loc(rotor.number_tag)}); speed {entry.index} "
                             "drives another rotor", entry.loc, entry.joint_name,
-                            hint="order the <rotor> entries by motorNumber 0, 1, 2, ...")
+                            hint=f"order the <rotor> entries by {rotor.number_tag} 0, 1, 2, ...")
 
 
 @rule("C411", "controller-entry-invalid", "error",
@@ -233,7 +233,7 @@ def controller_direction_mismatch(ctx: CheckContext) -> Iterator[Issue]:
                 yield Issue(
                     f"{_entry(table, entry)}: direction {entry.direction:+g} "
                     f"({DIRECTION_NAME[int(entry.direction)]}), but {_rotor_name(rotor)} turns "
-                    f"{model} (turningDirection at {rotor.plugin.param_loc('turningDirection')})",
+                    f"{model} ({rotor.direction_tag} at {rotor.param_loc(rotor.direction_tag)})",
                     entry.loc_of("direction"), rotor.joint or rotor.name,
                     hint=f"set direction to {rotor.turning_sign:+d} ({model}), or fix the "
                          "motor's turningDirection if the controller is right")
@@ -319,7 +319,7 @@ def _constant_issues(ctx: CheckContext, attr: str, rotor_attr: str, param: str,
                 yield Issue(
                     f"{_entry(table, entry)}: {label[table.source]} {value:.6g} {unit}, but "
                     f"{_rotor_name(rotor)} has {param} {model:.6g} {unit} "
-                    f"({rotor.plugin.param_loc(param)})",
+                    f"({rotor.param_loc(param)})",
                     entry.loc_of(attr), rotor.joint or rotor.name,
                     hint=f"use the motor's value {model:.6g}, or fix the motor plugin")
 

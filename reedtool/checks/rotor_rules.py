@@ -202,7 +202,8 @@ def yaw_moment_imbalance(ctx: CheckContext) -> Iterator[Issue]:
     if best is not None:
         target = rotors[best]
         other = "cw" if target.direction == "ccw" else "ccw"
-        hint = f"set rotor '{target.name}' to {other}"
+        hint = f"set rotor '{target.name}' to {other}" if target.kind != "ardupilot" else \
+            f"flip the sign of rotor '{target.name}''s <multiplier> (it turns {other} then)"
     yield Issue(f"at equal rotor speed the yaw moments do not cancel: net {_fmt(net_N_m)} N·m "
                 f"at hover thrust ({counts['ccw']} ccw, {counts['cw']} cw; "
                 f"{100 * abs(net_N_m) / total_N_m:.0f}% of the rotors' drag torque)",
@@ -668,8 +669,9 @@ def ardupilot_spin_against_blades(ctx: CheckContext) -> Iterator[Issue]:
 @rule("R319", "rotor-role", "info",
       "Rotors that are not lift rotors, or an omnidirectional frame.")
 def rotor_role(ctx: CheckContext) -> Iterator[Issue]:
-    """A rotor whose thrust axis is more than 60° from body z on a vehicle that also has
-    lift rotors (or a wing) is propulsion: a fixed-wing puller or a VTOL pusher. It is
+    """A rotor whose thrust axis is 60-120° from body z on a vehicle that also has lift
+    rotors (or a wing), pointing along body ±x or on a vehicle with a wing, is
+    propulsion: a fixed-wing puller or a VTOL pusher. It is
     left out of the hover allocation, the trim and the lift-rotor rules (R304-R311). A
     frame with reversible motors or rotors pointing in every direction is
     omnidirectional: it is judged by the full 6-DoF force-and-torque allocation.

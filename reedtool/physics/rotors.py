@@ -52,6 +52,8 @@ TURNING_SIGN = {"ccw": 1, "cw": -1}
 
 # A thrust axis further than this from body z is not lifting (the role 'propulsion').
 PROPULSION_MIN_ANGLE_DEG = 60.0
+# ... and, on a wingless vehicle, within this of body x (a pusher or a puller).
+PROPULSION_MAX_OFF_X_DEG = 30.0
 # The rotors' axes span every direction when the 3 x n matrix of unit axes has its
 # smallest singular value above this fraction of its largest: an omnidirectional frame.
 OMNI_MIN_SINGULAR_RATIO = 0.3
@@ -102,7 +104,7 @@ class Rotor:
     number_tag: str = "motorNumber"  # element (or attribute) the number was read from
     direction_tag: str = "turningDirection"
     channel: int | None = None      # ArduPilot: the SDF channel attribute as written (0-based)
-    reversible: bool = False        # gz: may spin (and push) both ways
+    reversible: bool = False        # gz, PX4 classic: may spin (and push) both ways
     role: str = "lift"              # 'lift' | 'propulsion'
     constants_estimated: bool = False  # constants derived from LiftDrag blades, not written
     blades: list[Blade] = field(default_factory=list)
@@ -250,7 +252,7 @@ def _motor_model_rotor(robot: Robot, plugin: Plugin, kind: str, poses, index: in
         rotor_drag_coefficient=_float(plugin.param("rotorDragCoefficient")),
         rolling_moment_coefficient=_float(plugin.param("rollingMomentCoefficient")),
         kind=kind, plugin=plugin, loc=plugin.loc, node=plugin.node, number_tag=number_tag,
-        reversible=kind == "gz" and _bool(plugin.param("reversible")))
+        reversible=_bool(plugin.param("reversible")))  # gz and PX4 classic read it
 
 
 def _blades_by_link(robot: Robot) -> dict[str, list[Blade]]:
@@ -376,21 +378,28 @@ def lift_drag_constants(blades: list[Blade], spin_axis: np.ndarray,
 # ---------------------------------------------------------------------- roles
 
 def assign_roles(rotors: list[Rotor], has_wing: bool = False) -> None:
-    """Mark nearly horizontal rotors as propulsion (see the module docstring).
+    """Mark pushers and pullers as propulsion (see the module docstring).
 
-    An omnidirectional frame (reversible motors, or axes spanning every direction) keeps
+    Propulsion: a thrust axis between 60° and 120° from body z (horizontal or nearly; a
+    rotor pointing down stays 'lift' so the tilt rule can say it points down) on a
+    vehicle that lifts otherwise, and either along body ±x (within 30°: a pusher or a
+    puller) or on a vehicle with a wing (a LiftDrag surface not on a rotor; frames such
+    as ardupilot_gazebo's zephyr fly along their y axis). A sideways rotor on a wingless
+    multirotor is a mistake, not propulsion: it stays 'lift' and R311 reports it. An
+    omnidirectional frame (reversible motors, or axes spanning every direction) keeps
     every rotor as lift: it hovers with all of them through the 6-DoF allocation. A
-    vehicle whose rotors are all horizontal is a fixed-wing aircraft only when it has a
-    wing (a LiftDrag surface not on a rotor); otherwise its rotors stay 'lift' and the
-    hover rules say why it cannot hover.
+    vehicle whose rotors are all horizontal is a fixed-wing aircraft only with a wing.
     """
     if is_omnidirectional(rotors):
         return
     cos_max = math.cos(math.radians(PROPULSION_MIN_ANGLE_DEG))
-    horizontal = [r for r in rotors if np.all(np.isfinite(r.axis))
-                  and float(_unit(r.axis)[2]) < cos_max]
-    if len(horizontal) < len(rotors) or has_wing:
-        for rotor in horizontal:
+    cos_along_x = math.cos(math.radians(PROPULSION_MAX_OFF_X_DEG))
+    horizontal = [r for r in rotors if np.all(np.isfinite(_unit(r.axis)))
+                  and abs(float(_unit(r.axis)[2])) < cos_max]
+    if len(horizontal) == len(rotors) and not has_wing:
+        return
+    for rotor in horizontal:
+        if has_wing or abs(float(_unit(rotor.axis)[0])) >= cos_along_x:
             rotor.role = "propulsion"
 
 
