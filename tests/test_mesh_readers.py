@@ -126,3 +126,21 @@ def test_import_honours_the_dae_unit_and_guesses_only_without_one(tmp_path):
                            units="auto")
     assert (unitless.units.unit, unitless.units.guessed) == ("mm", True)
     assert unitless.size_m == pytest.approx([0.3, 0.2, 0.1])
+
+
+def test_dae_nested_nodes_and_library_node_instances():
+    """A part placed twice: a nested node (translate 2 m in x) and an <instance_node> of a
+    library node (translate -2 m); the file in centimetres. Extent: 4 m + the 1 m cube."""
+    base = dae_text(box_triangles((100, 100, 100)), meter=0.01)
+    nested = ('<node id="outer"><translate>200 0 0</translate>'
+              '<node id="inner"><instance_geometry url="#g"/></node></node>'
+              '<node id="other"><translate>-200 0 0</translate>'
+              '<instance_node url="#lib"/></node>')
+    library = ('<library_nodes><node id="lib"><instance_geometry url="#g"/></node>'
+               '</library_nodes>')
+    text = base.replace('<node id="n" name="part"><instance_geometry url="#g"/></node>',
+                        nested).replace("<library_visual_scenes>",
+                                        library + "<library_visual_scenes>")
+    dae = parse_dae(text.encode())
+    assert len(dae.triangles) == 24
+    assert extent(dae.triangles_m) == pytest.approx([5.0, 1.0, 1.0])
