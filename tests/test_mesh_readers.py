@@ -79,9 +79,13 @@ def test_dae_that_is_not_collada_is_refused(data):
 
 
 def test_validate_never_imports_trimesh_or_scipy(tmp_path):
-    """Importing the command and validating a RotorS-style model with .dae visuals."""
+    """Importing the command and validating a RotorS-style model with .dae visuals (one of
+    them open, so its inertia comes from its convex hull)."""
     write_dae(tmp_path / "body.dae", box_triangles((300, 300, 80)), meter=0.001)
     write_dae(tmp_path / "prop.dae", box_triangles((200, 20, 5)), meter=0.001)
+    # An open canopy (two triangles missing) as a link's only geometry: its mass
+    # properties come from its convex hull, the 0.1 x 0.1 x 0.05 m box.
+    write_dae(tmp_path / "canopy.dae", box_triangles((100, 100, 50))[:-2], meter=0.001)
     (tmp_path / "m.urdf").write_text("""<?xml version="1.0"?>
 <robot name="m">
   <link name="base_link"><inertial><mass value="1"/>
@@ -95,6 +99,11 @@ def test_validate_never_imports_trimesh_or_scipy(tmp_path):
     <inertia ixx="1.25e-05" ixy="0" ixz="0" iyy="1.25e-05" iyz="0" izz="2.5e-05"/></inertial>
     <visual><geometry><mesh filename="prop.dae"/></geometry></visual>
     <collision><geometry><cylinder length="0.005" radius="0.1"/></geometry></collision></link>
+  <joint name="c" type="fixed"><parent link="base_link"/><child link="canopy"/>
+    <origin xyz="0 0 0.065"/></joint>
+  <link name="canopy"><inertial><mass value="0.1"/>
+    <inertia ixx="0.00010417" ixy="0" ixz="0" iyy="0.00010417" iyz="0" izz="0.00016667"/>
+    </inertial><visual><geometry><mesh filename="canopy.dae"/></geometry></visual></link>
 </robot>
 """)
     code = textwrap.dedent(f"""
@@ -126,3 +135,21 @@ def test_import_honours_the_dae_unit_and_guesses_only_without_one(tmp_path):
                            units="auto")
     assert (unitless.units.unit, unitless.units.guessed) == ("mm", True)
     assert unitless.size_m == pytest.approx([0.3, 0.2, 0.1])
+
+
+def test_dae_nested_nodes_and_library_node_instances():
+    """A part placed twice: a nested node (translate 2 m in x) and an <instance_node> of a
+    library node (translate -2 m); the file in centimetres. Extent: 4 m + the 1 m cube."""
+    base = dae_text(box_triangles((100, 100, 100)), meter=0.01)
+    nested = ('<node id="outer"><translate>200 0 0</translate>'
+              '<node id="inner"><instance_geometry url="#g"/></node></node>'
+              '<node id="other"><translate>-200 0 0</translate>'
+              '<instance_node url="#lib"/></node>')
+    library = ('<library_nodes><node id="lib"><instance_geometry url="#g"/></node>'
+               '</library_nodes>')
+    text = base.replace('<node id="n" name="part"><instance_geometry url="#g"/></node>',
+                        nested).replace("<library_visual_scenes>",
+                                        library + "<library_visual_scenes>")
+    dae = parse_dae(text.encode())
+    assert len(dae.triangles) == 24
+    assert extent(dae.triangles_m) == pytest.approx([5.0, 1.0, 1.0])

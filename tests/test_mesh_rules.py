@@ -249,3 +249,9 @@ def test_x500_shaped_sdf_two_visuals_one_mesh(tmp_path):
 </model></sdf>
 """)
     assert codes(tmp_path / "model.sdf") == []
+
+
+def test_unreadable_mass_is_s101_only(tmp_path):
+    """<mass value="one">: the 0 the reader keeps is a default, not a declared zero."""
+    path = write_model(tmp_path, body_urdf([], mass="one"))
+    assert codes(path) == ["S101"]

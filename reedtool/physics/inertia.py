@@ -389,7 +389,6 @@ def inertial_xml(props: MassProperties, indent: str = "  ", rpy: str = "0 0 0") 
 # (implausible, warning), and beyond 100x the tensor is a placeholder or a unit mistake
 # (1.0 everywhere, mm^2 for m^2) that certainly changes how the body flies (way-off, error).
 OK_REL_DIFF = 0.5
-WAY_OFF_FACTOR = 10.0            # kept for callers: the implausible threshold
 PLAUSIBLE_TRACE_RATIO = 10.0
 ORDERS_OFF_TRACE_RATIO = 100.0
 # The declared COM may sit anywhere inside the part; farther from the geometry's COM than
@@ -470,8 +469,15 @@ def rotor_slowdown_by_link(robot: Robot) -> dict[str, float]:
     return found
 
 
-def compare_link(link: Link, *, moving: bool = False,
-                 slowdown: float | None = None) -> LinkComparison:
+def unreadable_masses(robot: Robot) -> set[str]:
+    """Links whose <mass> could not be read (S101 reports it; the 0 there is a default)."""
+    bad_locs = {issue.loc for issue in robot.parse_issues}
+    return {link.name for link in robot.links
+            if link.inertial is not None and link.inertial.mass_loc in bad_locs}
+
+
+def compare_link(link: Link, *, moving: bool = False, slowdown: float | None = None,
+                 mass_unreadable: bool = False) -> LinkComparison:
     """Declared inertial beside the one its geometry implies at the same mass, with a verdict.
 
     `moving`: the link is the child of a non-fixed joint (a massless one is an error there).
@@ -494,8 +500,8 @@ def compare_link(link: Link, *, moving: bool = False,
             return result("no-inertial", "no <inertial> and no geometry (a frame-only link)")
         return result("no-inertial", f"has a {label} but no <inertial>: Gazebo ignores its mass")
     mass = declared.mass_kg
-    if not np.isfinite(mass):
-        return result("massless", f"mass {mass:g} kg: nothing to compare")
+    if not np.isfinite(mass) or mass_unreadable:
+        return result("massless", "the mass is not a number: nothing to compare")
     if mass < 0.0:
         return result("negative-mass", f"mass {mass:g} kg is negative")
     if mass == 0.0:
@@ -578,7 +584,9 @@ def compare_links(robot: Robot) -> list[LinkComparison]:
     """compare_link for every link of the robot, in document order."""
     moving = moving_links(robot)
     slowdowns = rotor_slowdown_by_link(robot)
-    return [compare_link(link, moving=link.name in moving, slowdown=slowdowns.get(link.name))
+    unreadable = unreadable_masses(robot)
+    return [compare_link(link, moving=link.name in moving, slowdown=slowdowns.get(link.name),
+                         mass_unreadable=link.name in unreadable)
             for link in robot.links]
 
 
@@ -587,6 +595,8 @@ def robot_mass_problem(robot: Robot) -> str | None:
 
     The plain sum over links with a finite declared mass: Gazebo needs a positive total.
     """
+    if unreadable_masses(robot):
+        return None          # a mass that is not a number: S101 says so, the sum is unknown
     masses = [link.inertial.mass_kg for link in robot.links
               if link.inertial is not None and math.isfinite(link.inertial.mass_kg)]
     if not masses:

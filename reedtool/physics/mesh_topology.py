@@ -1,6 +1,8 @@
 """Mesh topology: shared vertices, watertightness, winding, convex hull, decimation.
 
-trimesh is used only for the convex hull (qhull); the rest is vectorised numpy.
+The convex hull is reedtool's own Quickhull (physics.convex_hull) for meshes with up to
+LIGHT_HULL_MAX_POINTS hull candidates, so `validate` stays free of trimesh/scipy; beyond
+that qhull through trimesh is faster than the Python loop. The rest is vectorised numpy.
 """
 
 from __future__ import annotations
@@ -89,11 +91,21 @@ def topology(triangles: np.ndarray) -> Topology:
     return Topology(len(vertices), watertight, winding)
 
 
+# Candidate points up to which the numpy Quickhull beats importing trimesh + scipy (~0.5 s).
+LIGHT_HULL_MAX_POINTS = 1000
+
+
 def convex_hull_triangles(triangles: np.ndarray) -> np.ndarray:
     """Outward-wound triangles of the convex hull of the mesh's vertices."""
-    import trimesh
+    from reedtool.physics.convex_hull import convex_hull, hull_candidates
 
     vertices, _ = merge_vertices(triangles)
+    candidates = hull_candidates(vertices)
+    if len(candidates) <= LIGHT_HULL_MAX_POINTS:
+        hull_vertices, hull_faces = convex_hull(candidates)
+        return hull_vertices[hull_faces]
+    import trimesh
+
     try:
         hull = trimesh.convex.convex_hull(vertices)
     except Exception as exc:  # noqa: BLE001 - qhull errors for flat or tiny inputs
