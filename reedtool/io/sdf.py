@@ -61,7 +61,7 @@ from lxml import etree
 
 from reedtool.errors import ReedtoolError
 from reedtool.frames import make_T, matrix_to_rpy, rpy_to_matrix
-from reedtool.io.resources import RESOURCE_PATH_VARS, resolve_model_file_uri
+from reedtool.io.resources import resolve_model_file_uri
 from reedtool.io.sdf_include import SourceFile, SourceMap, expand_includes
 from reedtool.io.tolerant_xml import local_tag, parse_tolerant
 from reedtool.model import (
