@@ -122,3 +122,18 @@ def test_png_by_extension_and_no_silent_overwrite(pictures, tmp_path):
     assert code == 2 and "--force" in output and png.read_bytes() == before
     code, output = run_cli("layout", model, "-o", tmp_path / "hex.jpg")
     assert code == 2 and ".svg or .png" in output and not (tmp_path / "hex.jpg").exists()
+
+
+def test_validate_diagram_marks_the_rotor_a_finding_names(tmp_path):
+    model = Path(__file__).parent / "fixtures" / "validate" / "R303_bad_direction.urdf"
+    svg = tmp_path / "diagram.svg"
+    code, output = run_cli("validate", model, "--diagram", svg, "--format", "json")
+    assert code == 1 and '"R303"' in output
+    rotors = discover_rotors(load_robot(model, {}, []))
+    picture = Picture(svg)
+    red = sorted(number for number in range(1, len(rotors) + 1)
+                 if "#c0392b" in etree.tostring(picture.ids[f"rotor-{number}"]).decode())
+    named = [r for r in rotors if r.name == "rotor_3"]
+    assert red == [(named[0].motor_number if named[0].motor_number is not None
+                    else rotors.index(named[0])) + 1]
+    assert run_cli("validate", model, "--diagram", svg)[0] == 2      # no silent overwrite

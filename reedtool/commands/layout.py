@@ -243,6 +243,28 @@ def write_layout(robot, path: Path, force: bool, marked_names: set[str] = frozen
                                            marked_names=marked_names), force=force)
 
 
+def write_diagram(robot, path: Path, findings, force: bool) -> None:
+    """`validate --diagram`: the layout with the rotors the findings name marked red.
+
+    A finding names a rotor when its subject is the rotor's name, link or joint, or its
+    message quotes one of them.
+    """
+    from reedtool.physics.rotors import discover_rotors
+
+    output_format(path)
+    if path.exists() and not force:
+        raise ReedtoolError("refusing to overwrite an existing file", file=path,
+                            hint="pass --force to replace it")
+    marked = set()
+    for rotor in discover_rotors(robot):
+        names = {n for n in (rotor.name, rotor.link, rotor.joint) if n}
+        for f in findings:
+            if (f.subject in names
+                    or any(f"'{n}'" in f.message or f'"{n}"' in f.message for n in names)):
+                marked.add(rotor.name)
+    write_layout(robot, path, force, marked)
+
+
 def _com(robot):
     try:
         from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio

@@ -51,10 +51,14 @@ def _use_color(no_color: bool) -> bool:
               type=click.Path(path_type=Path, dir_okay=False),
               help="RotorS-style vehicle parameter YAML to cross-check against the model "
                    "(repeatable).")
+@click.option("--diagram", type=click.Path(path_type=Path, dir_okay=False), default=None,
+              help="Also draw the rotor layout (.svg/.png), rotors named by findings in red.")
+@click.option("--force", is_flag=True, help="Overwrite an existing --diagram file.")
 def command(model: Path | None, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
             fmt: str, select: tuple[str, ...], ignore: tuple[str, ...],
             explain_code: str | None, strict: bool | None, no_color: bool,
-            controller_files: tuple[Path, ...] = ()) -> int:
+            controller_files: tuple[Path, ...] = (), diagram: Path | None = None,
+            force: bool = False) -> int:
     """Check MODEL (.urdf, .xacro or .sdf, with xacro NAME:=VALUE arguments) for mistakes.
 
     Exit 0 when there is no error, 1 when there are errors (or warnings with --strict),
@@ -100,6 +104,10 @@ def command(model: Path | None, mappings: tuple[str, ...], package_paths: tuple[
 
         controllers = [load_controller_yaml(path) for path in controller_files]
     findings = run_checks(robot, selection, controllers=controllers)
+    if diagram is not None:
+        from reedtool.commands.layout import write_diagram
+
+        write_diagram(robot, diagram, findings, force)
 
     click.echo(render(findings, str(model), fmt, color=_use_color(no_color)), nl=False,
                color=_use_color(no_color))
