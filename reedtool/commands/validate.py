@@ -59,11 +59,15 @@ def _use_color(no_color: bool) -> bool:
 @click.option("--autopilot-params", "autopilot_files", multiple=True, metavar="FILE.parm",
               type=click.Path(path_type=Path, dir_okay=False),
               help="ArduPilot .parm file to cross-check (FRAME_CLASS/TYPE, SERVOn_FUNCTION).")
+@click.option("--diagram", type=click.Path(path_type=Path, dir_okay=False), default=None,
+              help="Also draw the rotor layout (.svg/.png), rotors named by findings in red.")
+@click.option("--force", is_flag=True, help="Overwrite an existing --diagram file.")
 def command(model: Path | None, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
             model_name: str | None, fmt: str, select: tuple[str, ...], ignore: tuple[str, ...],
             explain_code: str | None, strict: bool | None, no_color: bool,
             controller_files: tuple[Path, ...] = (), airframe_files: tuple[Path, ...] = (),
-            autopilot_files: tuple[Path, ...] = ()) -> int:
+            autopilot_files: tuple[Path, ...] = (), diagram: Path | None = None,
+            force: bool = False) -> int:
     """Check MODEL (.urdf, .xacro or .sdf, with xacro NAME:=VALUE arguments) for mistakes.
 
     Exit 0 when there is no error, 1 when there are errors (or warnings with --strict),
@@ -121,6 +125,13 @@ def command(model: Path | None, mappings: tuple[str, ...], package_paths: tuple[
         # A world checked model by model reports each under its name.
         label = str(model) if len(robots) == 1 else f"{model} [model {robot.name}]"
         outputs.append(render(robot_findings, label, fmt, color=_use_color(no_color)))
+        if diagram is not None:
+            from reedtool.commands.layout import write_diagram
+
+            # A world's models each get their own picture: NAME.svg -> NAME-MODEL.svg.
+            target = diagram if len(robots) == 1 else diagram.with_name(
+                f"{diagram.stem}-{robot.name}{diagram.suffix}")
+            write_diagram(robot, target, robot_findings, force)
     if fmt == "json" and len(outputs) > 1:
         text = "[\n" + ",\n".join(out.rstrip("\n") for out in outputs) + "\n]\n"
     else:
