@@ -283,7 +283,7 @@ if numba is not None:
             omega[i] = cmd + (omega[i] - cmd) * (up[i] if cmd > omega[i] else down[i])
 
     @njit(cache=True, error_model="numpy")
-    def _fly(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final, rec):
+    def _fly(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final, rec, pos_rec):
         """Fly one vehicle from state0 (p, v, q, w, integral, omega) as batch.simulate_batch judges it.
 
         Fills out_f (OUT_FIELDS), out_i (reason, longest-saturation rotor), final
@@ -359,6 +359,8 @@ if numba is not None:
                         sat_longest_rotor = sat_rotor
                 else:
                     sat_since = np.nan
+                if n_rec < pos_rec.shape[0]:
+                    pos_rec[n_rec] = pos
                 if n_rec < rec.shape[0]:
                     rec[n_rec, 0] = t
                     rec[n_rec, 1] = p[0]
@@ -373,7 +375,7 @@ if numba is not None:
                     rec[n_rec, 10] = cos_att
                     for i in range(n):
                         rec[n_rec, REC_FIXED + i] = omega[i]
-                    n_rec += 1
+                n_rec += 1
                 rate_xy = math.sqrt(w[0] * w[0] + w[1] * w[1])
                 finite = True
                 for x in (p[0], p[1], p[2], q[0], q[1], q[2], q[3], w[0], w[1], w[2]):
@@ -433,15 +435,15 @@ if numba is not None:
         return n_rec
 
     @njit(cache=True, parallel=True, error_model="numpy")
-    def _fly_batch(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final):
+    def _fly_batch(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final, pos_rec):
         rec = np.empty((0, 0))
         for j in prange(mass.shape[0]):
             _fly(cfg, nominal, mass[j], S[:, j], shift[:, j], k[:, j], state0,
-                 out_f[j], out_i[j], final[j], rec)
+                 out_f[j], out_i[j], final[j], rec, pos_rec[j])
 
     @njit(cache=True, error_model="numpy")
-    def _fly_one(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final, rec):
-        return _fly(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final, rec)
+    def _fly_one(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final, rec, pos_rec):
+        return _fly(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final, rec, pos_rec)
 
 
 # ------------------------------------------------------------------ Python side
@@ -514,11 +516,13 @@ def warm_up() -> float:
 
 
 def fly_batch(params, config: HoverConfig, plant,
-              design: ControllerDesign = ControllerDesign()) -> dict[str, np.ndarray]:
+              design: ControllerDesign = ControllerDesign(),
+              record: bool = False) -> dict[str, np.ndarray]:
     """Every vehicle of `plant` flown on the nominal controller, judged as
     batch.simulate_batch judges: per-vehicle arrays "reason" (batch.REASONS index),
     "saturation_rotor", the OUT_FIELDS and "final" (N, 13 + n: p, v, q, w, omega; the
     parked level hover for vehicles that ended early, as the numpy batch parks them).
+    With `record`, also "position_error_m" (samples, N), NaN after a vehicle ended.
     batch.simulate_batch(engine="numba") turns them into its Outcome.
 
     One vehicle runs on the serial kernel, more on the parallel one.
@@ -538,16 +542,21 @@ def fly_batch(params, config: HoverConfig, plant,
     out_f = np.zeros((N, len(OUT_FIELDS)))
     out_i = np.zeros((N, 2), dtype=np.int64)
     final = np.zeros((N, 13 + n))
+    rows = config.n_steps // config.sample_every + (config.n_steps % config.sample_every != 0) + 1
+    pos_rec = np.full((N, rows if record else 0), np.nan)
     if N == 1:
         _fly_one(cfg, nominal, mass[0], S[:, 0].copy(), shift[:, 0].copy(),
-                 k[:, 0].copy(), state0, out_f[0], out_i[0], final[0], np.empty((0, 0)))
+                 k[:, 0].copy(), state0, out_f[0], out_i[0], final[0], np.empty((0, 0)),
+                 pos_rec[0])
     else:
-        _fly_batch(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final)
+        _fly_batch(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final, pos_rec)
     reason = out_i[:, 0].copy()
     ended = ~np.isin(reason, [_SETTLED, _NOT_SETTLED, _SATURATED])
     final[ended] = park
     result = {name: out_f[:, i].copy() for i, name in enumerate(OUT_FIELDS)}
     result.update(reason=reason, saturation_rotor=out_i[:, 1].copy(), final=final)
+    if record:
+        result["position_error_m"] = pos_rec.T.copy()
     return result
 
 
@@ -576,7 +585,9 @@ def vehicle_flyer(params, gains: ControllerGains, config: HoverConfig, setpoint_
         final = np.zeros(13 + n)
         rows = config.n_steps // config.sample_every + 2 if rec is not None else 0
         buffer = np.empty((rows, REC_FIXED + n))
-        n_rec = _fly_one(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final, buffer)
+        n_rec = _fly_one(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final, buffer,
+                         np.empty(0))
+        n_rec = min(n_rec, rows)
         if rec is not None:
             for row in buffer[:n_rec]:
                 rec(tuple(float(x) for x in row))
