@@ -58,6 +58,15 @@ CFG_FIELDS = ("dt", "g", "m_ctl", "kp", "kd", "ki", "kR", "kw", "a_h", "a_v", "i
               "sp_x", "sp_y", "sp_z", "pos_tol", "cos_tol", "yaw_spin", "div_dist",
               "div_rate", "duration", "hold", "sat_limit", "n_steps", "every")
 BLOCK = 64              # vehicles per block of the batch kernel (its state fits in L1)
+# Rows of the block kernel's working memory (see _w_control); rotor rows are sized for
+# up to MAX_BLOCK_ROTORS rotors (vehicles with more fly on the per-vehicle kernel).
+MAX_BLOCK_ROTORS = 16
+_P, _V, _Q, _W, _I, _R, _E, _C = 0, 3, 6, 10, 13, 16, 25, 28
+_F, _TQ, _XI, _AQ, _DTM, _S, _SH, _IS, _DS, _OUT, _BIG = 32, 35, 38, 41, 42, 43, 46, 49, 52, 55, 56
+_OM = 57
+_T = _OM + MAX_BLOCK_ROTORS
+_K = _T + MAX_BLOCK_ROTORS
+_NROWS = _K + MAX_BLOCK_ROTORS
 REC_FIXED = 11          # t, x, y, z, R00, R10, R20, R21, R22, pos, cos_att; then omega
 
 
@@ -435,14 +444,25 @@ if numba is not None:
         final[13:13 + n] = omega
         return n_rec
 
+    # ---- the block kernel's working memory: one flat array, row r of vehicle j at
+    # r * BLOCK + j. With BLOCK and the row numbers compile-time constants, every stage's
+    # loop over vehicles touches one array at constant distances, which the compiler can
+    # prove independent and so turn into SIMD instructions (separate arrays would need
+    # run-time overlap checks, too many of them to vectorise at all).
+
     @njit(cache=True, error_model="numpy")
-    def _stage_control(cfg, Jc, p, v, q, w, integ, R, e, ctl, out):
+    def _w_control(W, cfg, Jc):
         """Rotation, position error and the control law for every vehicle of a block."""
         g, m_ctl = cfg[1], cfg[2]
         kp, kd, ki, kR, kw, a_h, a_v = cfg[3], cfg[4], cfg[5], cfg[6], cfg[7], cfg[8], cfg[9]
         sp0, sp1, sp2 = cfg[11], cfg[12], cfg[13]
-        for j in range(p.shape[1]):
-            qw, qx, qy, qz = q[0, j], q[1, j], q[2, j], q[3, j]
+        J00, J01, J02 = Jc[0, 0], Jc[0, 1], Jc[0, 2]
+        J10, J11, J12 = Jc[1, 0], Jc[1, 1], Jc[1, 2]
+        J20, J21, J22 = Jc[2, 0], Jc[2, 1], Jc[2, 2]
+        m_a_h = m_ctl * a_h
+        for j in range(BLOCK):
+            qw, qx, qy, qz = (W[(_Q + 0) * BLOCK + j], W[(_Q + 1) * BLOCK + j],
+                              W[(_Q + 2) * BLOCK + j], W[(_Q + 3) * BLOCK + j])
             x2 = qx + qx
             y2 = qy + qy
             z2 = qz + qz
@@ -464,26 +484,26 @@ if numba is not None:
             R20 = xz - yw
             R21 = yz + xw
             R22 = 1.0 - (xx + yy)
-            R[0, j] = R00
-            R[1, j] = R01
-            R[2, j] = R02
-            R[3, j] = R10
-            R[4, j] = R11
-            R[5, j] = R12
-            R[6, j] = R20
-            R[7, j] = R21
-            R[8, j] = R22
-            e0 = p[0, j] - sp0
-            e1 = p[1, j] - sp1
-            e2 = p[2, j] - sp2
-            e[0, j] = e0
-            e[1, j] = e1
-            e[2, j] = e2
-            ax = -kp * e0 - kd * v[0, j] - ki * integ[0, j]
-            ay = -kp * e1 - kd * v[1, j] - ki * integ[1, j]
-            az = -kp * e2 - kd * v[2, j] - ki * integ[2, j]
+            W[(_R + 0) * BLOCK + j] = R00
+            W[(_R + 1) * BLOCK + j] = R01
+            W[(_R + 2) * BLOCK + j] = R02
+            W[(_R + 3) * BLOCK + j] = R10
+            W[(_R + 4) * BLOCK + j] = R11
+            W[(_R + 5) * BLOCK + j] = R12
+            W[(_R + 6) * BLOCK + j] = R20
+            W[(_R + 7) * BLOCK + j] = R21
+            W[(_R + 8) * BLOCK + j] = R22
+            e0 = W[(_P + 0) * BLOCK + j] - sp0
+            e1 = W[(_P + 1) * BLOCK + j] - sp1
+            e2 = W[(_P + 2) * BLOCK + j] - sp2
+            W[(_E + 0) * BLOCK + j] = e0
+            W[(_E + 1) * BLOCK + j] = e1
+            W[(_E + 2) * BLOCK + j] = e2
+            ax = -kp * e0 - kd * W[(_V + 0) * BLOCK + j] - ki * W[(_I + 0) * BLOCK + j]
+            ay = -kp * e1 - kd * W[(_V + 1) * BLOCK + j] - ki * W[(_I + 1) * BLOCK + j]
+            az = -kp * e2 - kd * W[(_V + 2) * BLOCK + j] - ki * W[(_I + 2) * BLOCK + j]
             h = math.sqrt(ax * ax + ay * ay)
-            scale = (m_ctl * a_h) / (a_h if a_h > h else h)
+            scale = m_a_h / (a_h if a_h > h else h)
             Fx = scale * ax
             Fy = scale * ay
             Fz = (a_v if az > a_v else (-a_v if az < -a_v else az)) + g
@@ -499,257 +519,261 @@ if numba is not None:
             u = inv_n * b3x
             A1 = b3y * R11 + b3z * R21
             A2 = b3y * R12 + b3z * R22
-            ctl[0, j] = F_norm * (b3x * R02 + A2)
+            W[(_C + 0) * BLOCK + j] = F_norm * (b3x * R02 + A2)
             er0 = (b3x * R01 + A1) - inv_n * (b3z * R12 - b3y * R22)
             er1 = (b1x * R02 - u * A2) - (b3x * R00 + b3y * R10 + b3z * R20)
             er2 = inv_n * (b3z * R10 - b3y * R20) - (b1x * R01 - u * A1)
-            w0, w1, w2 = w[0, j], w[1, j], w[2, j]
+            w0, w1, w2 = (W[(_W + 0) * BLOCK + j], W[(_W + 1) * BLOCK + j],
+                          W[(_W + 2) * BLOCK + j])
             s0 = 0.5 * kR * er0 + kw * w0
             s1 = 0.5 * kR * er1 + kw * w1
             s2 = 0.5 * kR * er2 + kw * w2
-            Jw0 = Jc[0, 0] * w0 + Jc[0, 1] * w1 + Jc[0, 2] * w2
-            Jw1 = Jc[1, 0] * w0 + Jc[1, 1] * w1 + Jc[1, 2] * w2
-            Jw2 = Jc[2, 0] * w0 + Jc[2, 1] * w1 + Jc[2, 2] * w2
-            ctl[1, j] = (w1 * Jw2 - w2 * Jw1) - (Jc[0, 0] * s0 + Jc[0, 1] * s1 + Jc[0, 2] * s2)
-            ctl[2, j] = (w2 * Jw0 - w0 * Jw2) - (Jc[1, 0] * s0 + Jc[1, 1] * s1 + Jc[1, 2] * s2)
-            ctl[3, j] = (w0 * Jw1 - w1 * Jw0) - (Jc[2, 0] * s0 + Jc[2, 1] * s1 + Jc[2, 2] * s2)
-            out[j] = False
+            Jw0 = J00 * w0 + J01 * w1 + J02 * w2
+            Jw1 = J10 * w0 + J11 * w1 + J12 * w2
+            Jw2 = J20 * w0 + J21 * w1 + J22 * w2
+            W[(_C + 1) * BLOCK + j] = (w1 * Jw2 - w2 * Jw1) - (J00 * s0 + J01 * s1 + J02 * s2)
+            W[(_C + 2) * BLOCK + j] = (w2 * Jw0 - w0 * Jw2) - (J10 * s0 + J11 * s1 + J12 * s2)
+            W[(_C + 3) * BLOCK + j] = (w0 * Jw1 - w1 * Jw0) - (J20 * s0 + J21 * s1 + J22 * s2)
+            W[_OUT * BLOCK + j] = 0.0
 
     @njit(cache=True, error_model="numpy")
-    def _stage_allocate(pinv, thrust_max, ctl, T, out):
-        """The pseudo-inverse thrusts; `out` marks the vehicles with a rotor out of range."""
-        for i in range(T.shape[0]):
+    def _w_allocate(W, n, pinv, thrust_max):
+        """The pseudo-inverse thrusts; row _OUT > 0 where a rotor is out of range."""
+        for i in range(n):
             c0, c1, c2, c3, hi = pinv[i, 0], pinv[i, 1], pinv[i, 2], pinv[i, 3], thrust_max[i]
-            for j in range(T.shape[1]):
-                Ti = c0 * ctl[0, j] + c1 * ctl[1, j] + c2 * ctl[2, j] + c3 * ctl[3, j]
-                T[i, j] = Ti
-                out[j] = out[j] | (Ti < 0.0) | (Ti > hi)
+            row = (_T + i) * BLOCK
+            for j in range(BLOCK):
+                Ti = (c0 * W[(_C + 0) * BLOCK + j] + c1 * W[(_C + 1) * BLOCK + j]
+                      + c2 * W[(_C + 2) * BLOCK + j] + c3 * W[(_C + 3) * BLOCK + j])
+                W[row + j] = Ti
+                W[_OUT * BLOCK + j] += 1.0 if (Ti < 0.0) | (Ti > hi) else 0.0
 
     @njit(cache=True, error_model="numpy")
-    def _stage_wrench(pos_r, axis, tmap, cd, cr, k, shift, omega, R, v, w, xi, Fb, Tb):
-        """Body force and torque about the nominal COM (rotor loop outside, vehicles inside)."""
-        for j in range(v.shape[1]):
-            R00, R01, R02 = R[0, j], R[1, j], R[2, j]
-            R10, R11, R12 = R[3, j], R[4, j], R[5, j]
-            R20, R21, R22 = R[6, j], R[7, j], R[8, j]
-            v0, v1, v2 = v[0, j], v[1, j], v[2, j]
-            w0, w1, w2 = w[0, j], w[1, j], w[2, j]
-            s0, s1, s2 = shift[0, j], shift[1, j], shift[2, j]
-            xi[0, j] = (R00 * v0 + R10 * v1 + R20 * v2) - (w1 * s2 - w2 * s1)
-            xi[1, j] = (R01 * v0 + R11 * v1 + R21 * v2) - (w2 * s0 - w0 * s2)
-            xi[2, j] = (R02 * v0 + R12 * v1 + R22 * v2) - (w0 * s1 - w1 * s0)
-            for a in range(3):
-                Fb[a, j] = 0.0
-                Tb[a, j] = 0.0
-        for i in range(omega.shape[0]):
+    def _w_wrench(W, n, pos_r, axis, tmap, cd, cr):
+        """Body force and torque about the nominal COM (rotor loop outside, vehicles
+        inside), into rows _F and _TQ; _XI is the nominal COM's velocity, body axes."""
+        for j in range(BLOCK):
+            R00, R01, R02 = W[(_R + 0) * BLOCK + j], W[(_R + 1) * BLOCK + j], W[(_R + 2) * BLOCK + j]
+            R10, R11, R12 = W[(_R + 3) * BLOCK + j], W[(_R + 4) * BLOCK + j], W[(_R + 5) * BLOCK + j]
+            R20, R21, R22 = W[(_R + 6) * BLOCK + j], W[(_R + 7) * BLOCK + j], W[(_R + 8) * BLOCK + j]
+            v0, v1, v2 = W[(_V + 0) * BLOCK + j], W[(_V + 1) * BLOCK + j], W[(_V + 2) * BLOCK + j]
+            w0, w1, w2 = W[(_W + 0) * BLOCK + j], W[(_W + 1) * BLOCK + j], W[(_W + 2) * BLOCK + j]
+            s0, s1, s2 = W[(_SH + 0) * BLOCK + j], W[(_SH + 1) * BLOCK + j], W[(_SH + 2) * BLOCK + j]
+            W[(_XI + 0) * BLOCK + j] = (R00 * v0 + R10 * v1 + R20 * v2) - (w1 * s2 - w2 * s1)
+            W[(_XI + 1) * BLOCK + j] = (R01 * v0 + R11 * v1 + R21 * v2) - (w2 * s0 - w0 * s2)
+            W[(_XI + 2) * BLOCK + j] = (R02 * v0 + R12 * v1 + R22 * v2) - (w0 * s1 - w1 * s0)
+            W[(_F + 0) * BLOCK + j] = 0.0
+            W[(_F + 1) * BLOCK + j] = 0.0
+            W[(_F + 2) * BLOCK + j] = 0.0
+            W[(_TQ + 0) * BLOCK + j] = 0.0
+            W[(_TQ + 1) * BLOCK + j] = 0.0
+            W[(_TQ + 2) * BLOCK + j] = 0.0
+        for i in range(n):
             a0, a1, a2 = axis[i, 0], axis[i, 1], axis[i, 2]
             m0, m1, m2 = tmap[0, i], tmap[1, i], tmap[2, i]
-            drag = cd[i] != 0.0 or cr[i] != 0.0
             r0, r1, r2 = pos_r[i, 0], pos_r[i, 1], pos_r[i, 2]
             cdi, cri = cd[i], cr[i]
-            for j in range(v.shape[1]):
-                om = omega[i, j]
-                Th = k[i, j] * om * om
-                f0 = a0 * Th
-                f1 = a1 * Th
-                f2 = a2 * Th
-                q0 = m0 * Th
-                q1 = m1 * Th
-                q2 = m2 * Th
-                if drag:
-                    w0, w1, w2 = w[0, j], w[1, j], w[2, j]
-                    u0 = xi[0, j] + (w1 * r2 - w2 * r1)
-                    u1 = xi[1, j] + (w2 * r0 - w0 * r2)
-                    u2 = xi[2, j] + (w0 * r1 - w1 * r0)
+            om_row, k_row = (_OM + i) * BLOCK, (_K + i) * BLOCK
+            if cdi != 0.0 or cri != 0.0:
+                for j in range(BLOCK):
+                    om = W[om_row + j]
+                    Th = W[k_row + j] * om * om
+                    w0, w1, w2 = (W[(_W + 0) * BLOCK + j], W[(_W + 1) * BLOCK + j],
+                                  W[(_W + 2) * BLOCK + j])
+                    u0 = W[(_XI + 0) * BLOCK + j] + (w1 * r2 - w2 * r1)
+                    u1 = W[(_XI + 1) * BLOCK + j] + (w2 * r0 - w0 * r2)
+                    u2 = W[(_XI + 2) * BLOCK + j] + (w0 * r1 - w1 * r0)
                     along = a0 * u0 + a1 * u1 + a2 * u2
                     p0 = u0 - a0 * along
                     p1 = u1 - a1 * along
                     p2 = u2 - a2 * along
                     dc = -om * cdi
                     d0, d1, d2 = dc * p0, dc * p1, dc * p2
-                    f0 += d0
-                    f1 += d1
-                    f2 += d2
                     rc = -om * cri
-                    q0 += r1 * d2 - r2 * d1 + rc * p0
-                    q1 += r2 * d0 - r0 * d2 + rc * p1
-                    q2 += r0 * d1 - r1 * d0 + rc * p2
-                Fb[0, j] += f0
-                Fb[1, j] += f1
-                Fb[2, j] += f2
-                Tb[0, j] += q0
-                Tb[1, j] += q1
-                Tb[2, j] += q2
+                    W[(_F + 0) * BLOCK + j] += a0 * Th + d0
+                    W[(_F + 1) * BLOCK + j] += a1 * Th + d1
+                    W[(_F + 2) * BLOCK + j] += a2 * Th + d2
+                    W[(_TQ + 0) * BLOCK + j] += m0 * Th + (r1 * d2 - r2 * d1 + rc * p0)
+                    W[(_TQ + 1) * BLOCK + j] += m1 * Th + (r2 * d0 - r0 * d2 + rc * p1)
+                    W[(_TQ + 2) * BLOCK + j] += m2 * Th + (r0 * d1 - r1 * d0 + rc * p2)
+            else:
+                for j in range(BLOCK):
+                    om = W[om_row + j]
+                    Th = W[k_row + j] * om * om
+                    W[(_F + 0) * BLOCK + j] += a0 * Th
+                    W[(_F + 1) * BLOCK + j] += a1 * Th
+                    W[(_F + 2) * BLOCK + j] += a2 * Th
+                    W[(_TQ + 0) * BLOCK + j] += m0 * Th
+                    W[(_TQ + 1) * BLOCK + j] += m1 * Th
+                    W[(_TQ + 2) * BLOCK + j] += m2 * Th
 
     @njit(cache=True, error_model="numpy")
-    def _stage_motors(T, inv_k, up, down, omega):
-        for i in range(T.shape[0]):
+    def _w_motors(W, n, inv_k, up, down):
+        for i in range(n):
             ik, fu, fd = inv_k[i], up[i], down[i]
-            for j in range(T.shape[1]):
-                Ti = T[i, j]
+            t_row, om_row = (_T + i) * BLOCK, (_OM + i) * BLOCK
+            for j in range(BLOCK):
+                Ti = W[t_row + j]
                 cmd = math.sqrt(Ti * ik) if Ti > 0.0 else 0.0
-                om = omega[i, j]
-                omega[i, j] = cmd + (om - cmd) * (fu if cmd > om else fd)
+                om = W[om_row + j]
+                W[om_row + j] = cmd + (om - cmd) * (fu if cmd > om else fd)
 
     @njit(cache=True, error_model="numpy")
-    def _stage_body(cfg, J0, J0inv, S, shift, dt_m, Fb, Tb, R, p, v, w, e, integ, aq, big):
+    def _w_body(W, cfg, J0, J0inv):
         """Semi-implicit Euler for p, v, w and the integral; the quaternion step factor
-        into aq. Returns how many vehicles need tan for it (big)."""
+        into _AQ. Returns how many vehicles need tan for it (row _BIG)."""
         dt, g, i_max = cfg[0], cfg[1], cfg[10]
+        dt_g = dt * g
         half_dt = 0.5 * dt
         two_over_dt = 2.0 / dt
+        K00, K01, K02 = J0[0, 0], J0[0, 1], J0[0, 2]
+        K10, K11, K12 = J0[1, 0], J0[1, 1], J0[1, 2]
+        K20, K21, K22 = J0[2, 0], J0[2, 1], J0[2, 2]
+        L00, L01, L02 = J0inv[0, 0], J0inv[0, 1], J0inv[0, 2]
+        L10, L11, L12 = J0inv[1, 0], J0inv[1, 1], J0inv[1, 2]
+        L20, L21, L22 = J0inv[2, 0], J0inv[2, 1], J0inv[2, 2]
         n_big = 0
-        for j in range(v.shape[1]):
-            F0, F1, F2 = Fb[0, j], Fb[1, j], Fb[2, j]
-            s0, s1, s2 = shift[0, j], shift[1, j], shift[2, j]
-            t0 = Tb[0, j] - (s1 * F2 - s2 * F1)
-            t1 = Tb[1, j] - (s2 * F0 - s0 * F2)
-            t2 = Tb[2, j] - (s0 * F1 - s1 * F0)
-            fm = dt_m[j]
+        for j in range(BLOCK):
+            F0, F1, F2 = W[(_F + 0) * BLOCK + j], W[(_F + 1) * BLOCK + j], W[(_F + 2) * BLOCK + j]
+            s0, s1, s2 = W[(_SH + 0) * BLOCK + j], W[(_SH + 1) * BLOCK + j], W[(_SH + 2) * BLOCK + j]
+            t0 = W[(_TQ + 0) * BLOCK + j] - (s1 * F2 - s2 * F1)
+            t1 = W[(_TQ + 1) * BLOCK + j] - (s2 * F0 - s0 * F2)
+            t2 = W[(_TQ + 2) * BLOCK + j] - (s0 * F1 - s1 * F0)
+            fm = W[_DTM * BLOCK + j]
             f0 = F0 * fm
             f1 = F1 * fm
             f2 = F2 * fm
-            v0 = v[0, j] + (R[0, j] * f0 + R[1, j] * f1 + R[2, j] * f2)
-            v1 = v[1, j] + (R[3, j] * f0 + R[4, j] * f1 + R[5, j] * f2)
-            v2 = v[2, j] + (R[6, j] * f0 + R[7, j] * f1 + R[8, j] * f2)
-            v2 -= dt * g
-            v[0, j] = v0
-            v[1, j] = v1
-            v[2, j] = v2
-            S0, S1, S2 = S[0, j], S[1, j], S[2, j]
-            w0, w1, w2 = w[0, j], w[1, j], w[2, j]
+            v0 = W[(_V + 0) * BLOCK + j] + (W[(_R + 0) * BLOCK + j] * f0 + W[(_R + 1) * BLOCK + j] * f1 + W[(_R + 2) * BLOCK + j] * f2)
+            v1 = W[(_V + 1) * BLOCK + j] + (W[(_R + 3) * BLOCK + j] * f0 + W[(_R + 4) * BLOCK + j] * f1 + W[(_R + 5) * BLOCK + j] * f2)
+            v2 = W[(_V + 2) * BLOCK + j] + (W[(_R + 6) * BLOCK + j] * f0 + W[(_R + 7) * BLOCK + j] * f1 + W[(_R + 8) * BLOCK + j] * f2)
+            v2 -= dt_g
+            W[(_V + 0) * BLOCK + j] = v0
+            W[(_V + 1) * BLOCK + j] = v1
+            W[(_V + 2) * BLOCK + j] = v2
+            S0, S1, S2 = W[(_S + 0) * BLOCK + j], W[(_S + 1) * BLOCK + j], W[(_S + 2) * BLOCK + j]
+            w0, w1, w2 = W[(_W + 0) * BLOCK + j], W[(_W + 1) * BLOCK + j], W[(_W + 2) * BLOCK + j]
             sw0, sw1, sw2 = S0 * w0, S1 * w1, S2 * w2
-            Jw0 = S0 * (J0[0, 0] * sw0 + J0[0, 1] * sw1 + J0[0, 2] * sw2)
-            Jw1 = S1 * (J0[1, 0] * sw0 + J0[1, 1] * sw1 + J0[1, 2] * sw2)
-            Jw2 = S2 * (J0[2, 0] * sw0 + J0[2, 1] * sw1 + J0[2, 2] * sw2)
-            h0 = (t0 - (w1 * Jw2 - w2 * Jw1)) / S0
-            h1 = (t1 - (w2 * Jw0 - w0 * Jw2)) / S1
-            h2 = (t2 - (w0 * Jw1 - w1 * Jw0)) / S2
-            w0 += (J0inv[0, 0] * h0 + J0inv[0, 1] * h1 + J0inv[0, 2] * h2) * (dt / S0)
-            w1 += (J0inv[1, 0] * h0 + J0inv[1, 1] * h1 + J0inv[1, 2] * h2) * (dt / S1)
-            w2 += (J0inv[2, 0] * h0 + J0inv[2, 1] * h1 + J0inv[2, 2] * h2) * (dt / S2)
-            w[0, j] = w0
-            w[1, j] = w1
-            w[2, j] = w2
-            p[0, j] += dt * v0
-            p[1, j] += dt * v1
-            p[2, j] += dt * v2
+            Jw0 = S0 * (K00 * sw0 + K01 * sw1 + K02 * sw2)
+            Jw1 = S1 * (K10 * sw0 + K11 * sw1 + K12 * sw2)
+            Jw2 = S2 * (K20 * sw0 + K21 * sw1 + K22 * sw2)
+            h0 = (t0 - (w1 * Jw2 - w2 * Jw1)) * W[(_IS + 0) * BLOCK + j]
+            h1 = (t1 - (w2 * Jw0 - w0 * Jw2)) * W[(_IS + 1) * BLOCK + j]
+            h2 = (t2 - (w0 * Jw1 - w1 * Jw0)) * W[(_IS + 2) * BLOCK + j]
+            w0 += (L00 * h0 + L01 * h1 + L02 * h2) * W[(_DS + 0) * BLOCK + j]
+            w1 += (L10 * h0 + L11 * h1 + L12 * h2) * W[(_DS + 1) * BLOCK + j]
+            w2 += (L20 * h0 + L21 * h1 + L22 * h2) * W[(_DS + 2) * BLOCK + j]
+            W[(_W + 0) * BLOCK + j] = w0
+            W[(_W + 1) * BLOCK + j] = w1
+            W[(_W + 2) * BLOCK + j] = w2
+            W[(_P + 0) * BLOCK + j] += dt * v0
+            W[(_P + 1) * BLOCK + j] += dt * v1
+            W[(_P + 2) * BLOCK + j] += dt * v2
             # q * (|w| / tan h, w) with h = |w| dt / 2: for h < 0.1, |w| / tan h =
             # (2 / dt) h cot h by its series (to ~1e-16, and vectorisable); a larger h
-            # (a tumbling vehicle) gets tan in the pass below
+            # (a tumbling vehicle) gets tan in the kernel
             hh = half_dt * half_dt * (w0 * w0 + w1 * w1 + w2 * w2)
-            aq[j] = two_over_dt * (1.0 - hh * (1.0 / 3.0 + hh * (1.0 / 45.0 + hh * (
+            W[_AQ * BLOCK + j] = two_over_dt * (1.0 - hh * (1.0 / 3.0 + hh * (1.0 / 45.0 + hh * (
                 2.0 / 945.0 + hh * (1.0 / 4725.0 + hh * (2.0 / 93555.0))))))
             large = hh >= 0.01
-            big[j] = large
+            W[_BIG * BLOCK + j] = 1.0 if large else 0.0
             n_big += 1 if large else 0
             for a3 in range(3):
-                ia = integ[a3, j] + e[a3, j] * dt
-                integ[a3, j] = -i_max if ia < -i_max else (i_max if ia > i_max else ia)
+                ia = W[(_I + a3) * BLOCK + j] + W[(_E + a3) * BLOCK + j] * dt
+                W[(_I + a3) * BLOCK + j] = -i_max if ia < -i_max else (i_max if ia > i_max else ia)
         return n_big
 
     @njit(cache=True, error_model="numpy")
-    def _stage_quaternion(q, w, aq):
-        for j in range(q.shape[1]):
-            a = aq[j]
-            w0, w1, w2 = w[0, j], w[1, j], w[2, j]
-            qw, qx, qy, qz = q[0, j], q[1, j], q[2, j], q[3, j]
+    def _w_quaternion(W):
+        for j in range(BLOCK):
+            a = W[_AQ * BLOCK + j]
+            w0, w1, w2 = W[(_W + 0) * BLOCK + j], W[(_W + 1) * BLOCK + j], W[(_W + 2) * BLOCK + j]
+            qw, qx, qy, qz = (W[(_Q + 0) * BLOCK + j], W[(_Q + 1) * BLOCK + j],
+                              W[(_Q + 2) * BLOCK + j], W[(_Q + 3) * BLOCK + j])
             nw = qw * a - qx * w0 - qy * w1 - qz * w2
             nx = qx * a + qw * w0 + qy * w2 - qz * w1
             ny = qy * a + qw * w1 + qz * w0 - qx * w2
             nz = qz * a + qw * w2 + qx * w1 - qy * w0
             inv_q = 1.0 / math.sqrt(nw * nw + nx * nx + ny * ny + nz * nz)
-            q[0, j] = nw * inv_q
-            q[1, j] = nx * inv_q
-            q[2, j] = ny * inv_q
-            q[3, j] = nz * inv_q
+            W[(_Q + 0) * BLOCK + j] = nw * inv_q
+            W[(_Q + 1) * BLOCK + j] = nx * inv_q
+            W[(_Q + 2) * BLOCK + j] = ny * inv_q
+            W[(_Q + 3) * BLOCK + j] = nz * inv_q
 
     @njit(cache=True, error_model="numpy")
     def _fly_block(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final, pos_rec):
-        """_fly for a block of B vehicles at once (columns), so that each stage is a loop
-        over vehicles that the compiler turns into SIMD instructions. The same arithmetic
-        as _fly, vehicle for vehicle; vehicles that end are parked at a level hover (as
-        the numpy batch parks them) and no longer judged."""
+        """_fly for a block of up to BLOCK vehicles at once, stage by stage (the _w_*
+        functions), each stage a loop over the vehicles that compiles to SIMD. The same
+        arithmetic as _fly, vehicle for vehicle (but for the attitude step's cot by its
+        series, equal to ~1e-16); vehicles that end are parked at a level hover, as the
+        numpy batch parks them, and no longer judged. Lanes past the block's vehicles fly
+        copies of its first vehicle and are not reported."""
         pos_r, axis, tmap, cd, cr, up, down, pinv, thrust_max, inv_k, omega_max, Jc, J0, \
             J0inv = nominal
-        dt, g, m_ctl = cfg[0], cfg[1], cfg[2]
-        kp, kd, ki, kR, kw, a_h, a_v, i_max = (cfg[3], cfg[4], cfg[5], cfg[6], cfg[7],
-                                               cfg[8], cfg[9], cfg[10])
-        sp0, sp1, sp2 = cfg[11], cfg[12], cfg[13]
+        dt = cfg[0]
         n_steps, every = int(cfg[22]), int(cfg[23])
         sample_dt = every * dt
+        half_dt = 0.5 * dt
         n, B = k.shape[0], mass.shape[0]
-        p = np.empty((3, B))
-        v = np.empty((3, B))
-        q = np.empty((4, B))
-        w = np.empty((3, B))
-        integ = np.empty((3, B))
-        omega = np.empty((n, B))
-        for j in range(B):
+        W = np.zeros(_NROWS * BLOCK)
+        for j in range(BLOCK):
+            src = j if j < B else 0
             for a in range(3):
-                p[a, j] = state0[a]
-                v[a, j] = state0[3 + a]
-                w[a, j] = state0[10 + a]
-                integ[a, j] = state0[13 + a]
+                W[(_P + a) * BLOCK + j] = state0[a]
+                W[(_V + a) * BLOCK + j] = state0[3 + a]
+                W[(_W + a) * BLOCK + j] = state0[10 + a]
+                W[(_I + a) * BLOCK + j] = state0[13 + a]
+                W[(_S + a) * BLOCK + j] = S[a, src]
+                W[(_SH + a) * BLOCK + j] = shift[a, src]
+                W[(_IS + a) * BLOCK + j] = 1.0 / S[a, src]
+                W[(_DS + a) * BLOCK + j] = dt / S[a, src]
             for a in range(4):
-                q[a, j] = state0[6 + a]
+                W[(_Q + a) * BLOCK + j] = state0[6 + a]
             for i in range(n):
-                omega[i, j] = state0[16 + i]
-        R = np.empty((9, B))
-        e = np.empty((3, B))
-        ctl = np.empty((4, B))
-        T = np.empty((n, B))
-        Fb = np.empty((3, B))
-        Tb = np.empty((3, B))
-        xi = np.empty((3, B))
-        out = np.zeros(B, dtype=np.bool_)
-        big = np.zeros(B, dtype=np.bool_)
-        aq = np.empty(B)
-        dt_m = np.empty(B)
-        for j in range(B):
-            dt_m[j] = dt / mass[j]
-        running = np.ones(B, dtype=np.bool_)
+                W[(_OM + i) * BLOCK + j] = state0[16 + i]
+                W[(_K + i) * BLOCK + j] = k[i, src]
+            W[_DTM * BLOCK + j] = dt / mass[src]
+        running = np.zeros(BLOCK, dtype=np.bool_)
+        running[:B] = True
         n_running = B
-        reason = np.zeros(B, dtype=np.int64)
-        value = np.zeros(B)
-        end_time = np.full(B, cfg[19])
-        max_pos = np.zeros(B)
-        min_cos = np.ones(B)
-        max_thr = np.zeros(B)
-        final_pos = np.zeros(B)
-        final_cos = np.ones(B)
-        last_out = np.zeros(B)
-        within = np.zeros(B, dtype=np.bool_)
-        sat_since = np.full(B, np.nan)
-        sat_rotor = np.zeros(B, dtype=np.int64)
-        sat_longest = np.zeros(B)
-        sat_longest_rotor = np.zeros(B, dtype=np.int64)
-        worst = np.zeros(B, dtype=np.int64)
+        reason = np.zeros(BLOCK, dtype=np.int64)
+        value = np.zeros(BLOCK)
+        end_time = np.full(BLOCK, cfg[19])
+        max_pos = np.zeros(BLOCK)
+        min_cos = np.ones(BLOCK)
+        max_thr = np.zeros(BLOCK)
+        final_pos = np.zeros(BLOCK)
+        final_cos = np.ones(BLOCK)
+        last_out = np.zeros(BLOCK)
+        within = np.zeros(BLOCK, dtype=np.bool_)
+        sat_since = np.full(BLOCK, np.nan)
+        sat_rotor = np.zeros(BLOCK, dtype=np.int64)
+        sat_longest = np.zeros(BLOCK)
+        sat_longest_rotor = np.zeros(BLOCK, dtype=np.int64)
+        worst = np.zeros(BLOCK, dtype=np.int64)
         Tcol = np.empty(n)
         n_rec = 0
-        half_dt = 0.5 * dt
-        two_over_dt = 2.0 / dt
         for step in range(n_steps + 1):
             t = step * dt
             last = step == n_steps
             sample = step % every == 0 or last
-            # ---- rotation, error, control law (one vectorised pass)
-            _stage_control(cfg, Jc, p, v, q, w, integ, R, e, ctl, out)
-            # ---- allocation: pseudo-inverse, then desaturate the (rare) columns out of range
-            _stage_allocate(pinv, thrust_max, ctl, T, out)
-            for j in range(B):
-                if out[j]:
+            _w_control(W, cfg, Jc)
+            _w_allocate(W, n, pinv, thrust_max)
+            # desaturate the (rare) vehicles with a rotor out of range
+            for j in range(BLOCK):
+                if W[_OUT * BLOCK + j] > 0.0:
                     best = -np.inf
                     for i in range(n):
                         hi = thrust_max[i]
-                        excess = max(-T[i, j], T[i, j] - hi) / hi
+                        Ti = W[(_T + i) * BLOCK + j]
+                        excess = max(-Ti, Ti - hi) / hi
                         if excess > best:
                             best = excess
                             worst[j] = i
-                    _prioritised(pinv, thrust_max, ctl[0, j], ctl[1, j], ctl[2, j], ctl[3, j],
-                                 Tcol)
+                    _prioritised(pinv, thrust_max, W[(_C + 0) * BLOCK + j],
+                                 W[(_C + 1) * BLOCK + j], W[(_C + 2) * BLOCK + j],
+                                 W[(_C + 3) * BLOCK + j], Tcol)
                     for i in range(n):
-                        T[i, j] = Tcol[i]
+                        W[(_T + i) * BLOCK + j] = Tcol[i]
             # ---- the judge, for the vehicles still flying
             if sample:
                 for j in range(B):
@@ -757,12 +781,15 @@ if numba is not None:
                         if n_rec < pos_rec.shape[1]:
                             pos_rec[j, n_rec] = np.nan
                         continue
-                    e0, e1, e2 = e[0, j], e[1, j], e[2, j]
+                    e0, e1, e2 = (W[(_E + 0) * BLOCK + j], W[(_E + 1) * BLOCK + j],
+                                  W[(_E + 2) * BLOCK + j])
                     pos = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-                    cos_att = min(max(0.5 * ((R[0, j] + R[4, j] + R[8, j]) - 1.0), -1.0), 1.0)
-                    throttle = omega[0, j] / omega_max[0]
+                    R22 = W[(_R + 8) * BLOCK + j]
+                    cos_att = min(max(0.5 * ((W[(_R + 0) * BLOCK + j] + W[(_R + 4) * BLOCK + j]
+                                              + R22) - 1.0), -1.0), 1.0)
+                    throttle = W[_OM * BLOCK + j] / omega_max[0]
                     for i in range(1, n):
-                        ratio = omega[i, j] / omega_max[i]
+                        ratio = W[(_OM + i) * BLOCK + j] / omega_max[i]
                         if ratio > throttle:
                             throttle = ratio
                     if pos > max_pos[j]:
@@ -776,7 +803,7 @@ if numba is not None:
                     within[j] = pos <= cfg[14] and cos_att >= cfg[15]
                     if not within[j]:
                         last_out[j] = t
-                    if out[j]:
+                    if W[_OUT * BLOCK + j] > 0.0:
                         if math.isnan(sat_since[j]):
                             sat_since[j] = t
                             sat_rotor[j] = worst[j]
@@ -787,22 +814,22 @@ if numba is not None:
                         sat_since[j] = np.nan
                     if n_rec < pos_rec.shape[1]:
                         pos_rec[j, n_rec] = pos
-                    wx, wy, wz = w[0, j], w[1, j], w[2, j]
+                    wx, wy, wz = (W[(_W + 0) * BLOCK + j], W[(_W + 1) * BLOCK + j],
+                                  W[(_W + 2) * BLOCK + j])
                     rate_xy = math.sqrt(wx * wx + wy * wy)
-                    finite = (math.isfinite(p[0, j]) and math.isfinite(p[1, j])
-                              and math.isfinite(p[2, j]) and math.isfinite(q[0, j])
-                              and math.isfinite(q[1, j]) and math.isfinite(q[2, j])
-                              and math.isfinite(q[3, j]) and math.isfinite(wx)
-                              and math.isfinite(wy) and math.isfinite(wz))
+                    finite = True
+                    for r in (_P, _P + 1, _P + 2, _Q, _Q + 1, _Q + 2, _Q + 3, _W, _W + 1, _W + 2):
+                        if not math.isfinite(W[r * BLOCK + j]):
+                            finite = False
                     why = 0
                     val = 0.0
                     if not finite:
                         why = _NON_FINITE
-                    elif R[8, j] < 0.0:
+                    elif R22 < 0.0:
                         why = _FLIPPED
-                        val = math.degrees(math.acos(max(R[8, j], -1.0)))
-                    elif p[2, j] < 0.0:
-                        why, val = _GROUND, p[2, j]
+                        val = math.degrees(math.acos(max(R22, -1.0)))
+                    elif W[(_P + 2) * BLOCK + j] < 0.0:
+                        why, val = _GROUND, W[(_P + 2) * BLOCK + j]
                     elif abs(wz) > cfg[16]:
                         why, val = _YAW_SPIN, abs(wz)
                     elif pos > cfg[17]:
@@ -815,20 +842,16 @@ if numba is not None:
                         end_time[j] = t
                         running[j] = False
                         n_running -= 1
+                        _w_save(W, j, n, final[j])
                         for a in range(3):          # park: level hover at the setpoint
-                            final[j, a] = p[a, j]
-                            final[j, 3 + a] = v[a, j]
-                            final[j, 10 + a] = w[a, j]
-                            p[a, j] = cfg[11 + a]
-                            v[a, j] = 0.0
-                            w[a, j] = 0.0
-                            integ[a, j] = 0.0
+                            W[(_P + a) * BLOCK + j] = cfg[11 + a]
+                            W[(_V + a) * BLOCK + j] = 0.0
+                            W[(_W + a) * BLOCK + j] = 0.0
+                            W[(_I + a) * BLOCK + j] = 0.0
                         for a in range(4):
-                            final[j, 6 + a] = q[a, j]
-                            q[a, j] = 1.0 if a == 0 else 0.0
+                            W[(_Q + a) * BLOCK + j] = 1.0 if a == 0 else 0.0
                         for i in range(n):
-                            final[j, 13 + i] = omega[i, j]
-                            omega[i, j] = state0[16 + i]
+                            W[(_OM + i) * BLOCK + j] = state0[16 + i]
                     elif last:
                         if within[j] and last_out[j] + sample_dt <= cfg[19] - cfg[20] + 1e-9:
                             reason[j] = _SETTLED
@@ -840,21 +863,18 @@ if numba is not None:
                 n_rec += 1
                 if last or n_running == 0:
                     break
-            # ---- body wrench at the current speeds (rotor loop outside, vehicles inside)
-            _stage_wrench(pos_r, axis, tmap, cd, cr, k, shift, omega, R, v, w, xi, Fb, Tb)
-            # ---- the speeds respond
-            _stage_motors(T, inv_k, up, down, omega)
-            # ---- rigid body, semi-implicit Euler
-            any_big = _stage_body(cfg, J0, J0inv, S, shift, dt_m, Fb, Tb, R, p, v, w, e,
-                                  integ, aq, big) > 0
-            if any_big:
-                for j in range(B):
-                    if big[j]:
-                        rate = math.sqrt(w[0, j] * w[0, j] + w[1, j] * w[1, j]
-                                         + w[2, j] * w[2, j])
+            # ---- advance one step: wrench at the current speeds, then the speeds respond
+            _w_wrench(W, n, pos_r, axis, tmap, cd, cr)
+            _w_motors(W, n, inv_k, up, down)
+            if _w_body(W, cfg, J0, J0inv) > 0:
+                for j in range(BLOCK):
+                    if W[_BIG * BLOCK + j] > 0.0:
+                        w0, w1, w2 = (W[(_W + 0) * BLOCK + j], W[(_W + 1) * BLOCK + j],
+                                      W[(_W + 2) * BLOCK + j])
+                        rate = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
                         tan_h = math.tan(half_dt * rate)
-                        aq[j] = rate / tan_h if tan_h != 0.0 else 1.0
-            _stage_quaternion(q, w, aq)
+                        W[_AQ * BLOCK + j] = rate / tan_h if tan_h != 0.0 else 1.0
+            _w_quaternion(W)
         for j in range(B):
             out_i[j, 0] = reason[j]
             out_i[j, 1] = sat_longest_rotor[j]
@@ -871,18 +891,29 @@ if numba is not None:
             out_f[j, 9] = last_out[j]
             out_f[j, 10] = 1.0 if within[j] else 0.0
             if reached:
-                for a in range(3):
-                    final[j, a] = p[a, j]
-                    final[j, 3 + a] = v[a, j]
-                    final[j, 10 + a] = w[a, j]
-                for a in range(4):
-                    final[j, 6 + a] = q[a, j]
-                for i in range(n):
-                    final[j, 13 + i] = omega[i, j]
+                _w_save(W, j, n, final[j])
+
+    @njit(cache=True, error_model="numpy")
+    def _w_save(W, j, n, out):
+        """Vehicle j's state (p, v, q, w, omega) into out."""
+        for a in range(3):
+            out[a] = W[(_P + a) * BLOCK + j]
+            out[3 + a] = W[(_V + a) * BLOCK + j]
+            out[10 + a] = W[(_W + a) * BLOCK + j]
+        for a in range(4):
+            out[6 + a] = W[(_Q + a) * BLOCK + j]
+        for i in range(n):
+            out[13 + i] = W[(_OM + i) * BLOCK + j]
 
     @njit(cache=True, parallel=True, error_model="numpy")
     def _fly_batch(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final, pos_rec):
         N = mass.shape[0]
+        if k.shape[0] > MAX_BLOCK_ROTORS:
+            rec = np.empty((0, 0))
+            for j in prange(N):
+                _fly(cfg, nominal, mass[j], S[:, j], shift[:, j], k[:, j], state0,
+                     out_f[j], out_i[j], final[j], rec, pos_rec[j])
+            return
         n_blocks = (N + BLOCK - 1) // BLOCK
         for b in prange(n_blocks):
             lo = b * BLOCK
