@@ -294,10 +294,12 @@ if numba is not None:
 
     @njit(cache=True, error_model="numpy")
     def _fly(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final, rec, pos_rec):
-        """Fly one vehicle from state0 (p, v, q, w, integral, omega) as batch.simulate_batch judges it.
+        """Fly one vehicle from state0 (p, v, q, w, integral, omega) as
+        batch.simulate_batch judges it.
 
-        Fills out_f (OUT_FIELDS), out_i (reason, longest-saturation rotor), final
-        (p, v, q, w, omega when it ended), and rec (one row per sample) when it has rows; returns the samples written.
+        Fills out_f (OUT_FIELDS), out_i (reason, longest-saturation rotor), final (p, v,
+        q, w, omega when it ended), rec (one row per sample) and pos_rec (the position
+        error per sample) when they have rows; returns the samples judged.
         """
         pos_r, axis, tmap, cd, cr, up, down, pinv, thrust_max, inv_k, omega_max, Jc, J0, \
             J0inv = nominal
@@ -643,9 +645,15 @@ if numba is not None:
             f0 = F0 * fm
             f1 = F1 * fm
             f2 = F2 * fm
-            v0 = W[(_V + 0) * BLOCK + j] + (W[(_R + 0) * BLOCK + j] * f0 + W[(_R + 1) * BLOCK + j] * f1 + W[(_R + 2) * BLOCK + j] * f2)
-            v1 = W[(_V + 1) * BLOCK + j] + (W[(_R + 3) * BLOCK + j] * f0 + W[(_R + 4) * BLOCK + j] * f1 + W[(_R + 5) * BLOCK + j] * f2)
-            v2 = W[(_V + 2) * BLOCK + j] + (W[(_R + 6) * BLOCK + j] * f0 + W[(_R + 7) * BLOCK + j] * f1 + W[(_R + 8) * BLOCK + j] * f2)
+            v0 = W[(_V + 0) * BLOCK + j] + (W[(_R + 0) * BLOCK + j] * f0
+                                          + W[(_R + 1) * BLOCK + j] * f1
+                                          + W[(_R + 2) * BLOCK + j] * f2)
+            v1 = W[(_V + 1) * BLOCK + j] + (W[(_R + 3) * BLOCK + j] * f0
+                                          + W[(_R + 4) * BLOCK + j] * f1
+                                          + W[(_R + 5) * BLOCK + j] * f2)
+            v2 = W[(_V + 2) * BLOCK + j] + (W[(_R + 6) * BLOCK + j] * f0
+                                          + W[(_R + 7) * BLOCK + j] * f1
+                                          + W[(_R + 8) * BLOCK + j] * f2)
             v2 -= dt_g
             W[(_V + 0) * BLOCK + j] = v0
             W[(_V + 1) * BLOCK + j] = v1
