@@ -8,12 +8,15 @@ exact quaternion exponential (`dynamics`) and the judge of `batch.simulate_batch
 the order of a few sums differs, so results agree to rounding (tests/test_compiled.py
 holds them to 1e-9 relative).
 
-The batch runs vehicle by vehicle (`prange` over vehicles, the time loop inside): each
-vehicle's state stays in registers and cache, and vehicles that end early stop costing.
+One vehicle runs on `_fly`, its state in registers. A batch runs in blocks of BLOCK
+vehicles spread over the cores (`prange` over blocks); a block advances stage by stage,
+each stage a loop over its vehicles in one flat working array (`_w_*`), which compiles to
+SIMD instructions.
 
-Rotor failures: every per-rotor quantity goes through `_fly` as arrays indexed by rotor,
-and the rotor speed is advanced in one place (`_advance_motors`); a per-rotor "alive"
-mask or failure time belongs there (a dead rotor's command and speed set to 0).
+Rotor failures: every per-rotor quantity goes through the kernels as arrays indexed by
+rotor, and the rotor speed is advanced in one place per kernel (`_advance_motors` for one
+vehicle, `_w_motors` for a block); a per-rotor "alive" mask or failure time belongs there
+(a dead rotor's command and speed set to 0), passed like `up`/`down`.
 """
 
 from __future__ import annotations
