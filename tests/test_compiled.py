@@ -78,10 +78,12 @@ def test_perturbed_batch_equals_the_numpy_batch():
     # for a while and recover. (Wider still, some fly at full throttle in a limit cycle
     # through the desaturation's switches, which magnifies rounding to ~1e-6: a property
     # of that flight, not of either engine.)
+    # 150 vehicles: two full blocks of the compiled batch and a partial third.
     params = symmetric_multirotor(4)
     config = HoverConfig(duration_s=3.0)
+    assert 2 * compiled.BLOCK < 150 < 3 * compiled.BLOCK
     plant = perturbed_plant(params, sample_perturbations(
-        48, 4, Spreads(mass_rel=0.3, com_m=0.03, inertia_rel=0.2, motor_constant_rel=0.15), 3))
+        150, 4, Spreads(mass_rel=0.3, com_m=0.03, inertia_rel=0.2, motor_constant_rel=0.15), 3))
     ref = simulate_batch(params, config, plant)
     got = simulate_batch(params, config, plant, engine="numba")
     assert len(set(ref.status_code.tolist())) >= 3        # not all alike

@@ -23,8 +23,6 @@ quaternion convention is a difference that does not shrink with dt, and fails bo
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 
@@ -38,6 +36,7 @@ mujoco = pytest.importorskip(
 
 DT = 1e-3
 MJ_DT = 5e-5
+FULLINERTIA = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))   # MJCF's order
 COM_IN_BODY = np.array([0.012, -0.007, 0.03])     # body origin -> COM, body axes [m]
 
 
@@ -52,25 +51,30 @@ def vehicle() -> VehicleParams:
                              rotor_position_m=base.rotor_position_m + [0.0, 0.0, -0.03])
 
 
+def num(x) -> str:
+    """A float as MJCF reads it back exactly."""
+    return f"{float(x):.17g}"
+
+
 def mjcf(params: VehicleParams, mj_dt: float = MJ_DT) -> str:
     J = params.inertia_kg_m2
     sites, motors = [], []
     for i in range(params.n_rotors):
         r = params.rotor_position_m[i] + COM_IN_BODY          # rotor in the body frame
         a = params.rotor_axis[i]
-        sites.append(f'<site name="rotor{i}" pos="{float(r[0]):.17g} {float(r[1]):.17g} {float(r[2]):.17g}" '
-                     f'zaxis="{float(a[0]):.17g} {float(a[1]):.17g} {float(a[2]):.17g}"/>')
+        pos, zaxis = " ".join(map(num, r)), " ".join(map(num, a))
+        sites.append(f'<site name="rotor{i}" pos="{pos}" zaxis="{zaxis}"/>')
         yaw = -params.turning_sign[i] * params.moment_constant[i]
-        motors.append(f'<general site="rotor{i}" gear="0 0 1 0 0 {float(yaw):.17g}" '
+        motors.append(f'<general site="rotor{i}" gear="0 0 1 0 0 {num(yaw)}" '
                       f'ctrllimited="false"/>')
-    c = COM_IN_BODY
+    com = " ".join(map(num, COM_IN_BODY))
+    inertia = " ".join(num(J[i, j]) for i, j in FULLINERTIA)
     return f"""<mujoco model="oracle">
-  <option timestep="{float(mj_dt):.17g}" integrator="RK4" gravity="0 0 {float(-params.g_m_s2):.17g}"/>
+  <option timestep="{num(mj_dt)}" integrator="RK4" gravity="0 0 {num(-params.g_m_s2)}"/>
   <worldbody>
     <body name="vehicle">
       <freejoint/>
-      <inertial pos="{float(c[0]):.17g} {float(c[1]):.17g} {float(c[2]):.17g}" mass="{float(params.mass_kg):.17g}"
-        fullinertia="{float(J[0,0]):.17g} {float(J[1,1]):.17g} {float(J[2,2]):.17g} {float(J[0,1]):.17g} {float(J[0,2]):.17g} {float(J[1,2]):.17g}"/>
+      <inertial pos="{com}" mass="{num(params.mass_kg)}" fullinertia="{inertia}"/>
       {''.join(sites)}
     </body>
   </worldbody>

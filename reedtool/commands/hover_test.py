@@ -103,6 +103,9 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
         if not available():
             raise ReedtoolError(f"bad option: --engine numba: {unavailable_reason()}",
                                 hint="or use --engine numpy (the default)")
+    if plot_path is not None and plot_path.suffix.lower() not in (".png", ".svg"):
+        raise ReedtoolError(f"cannot tell the plot format from '{plot_path.suffix or plot_path.name}'",
+                            file=plot_path, hint="name the --plot file .png or .svg")
     for path in (plot_path, csv_path):
         if path is not None and path.exists() and not force:
             raise ReedtoolError("refusing to overwrite an existing file", file=path,
@@ -121,7 +124,7 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     report = hover_test(robot, config, samples=samples, seed=seed,
                         spreads=(mass_spread, com_spread_m, inertia_spread, motor_spread),
                         record=bool(plot_path or csv_path), show_progress=fmt == "text",
-                        engine=engine)
+                        engine=engine, envelope=plot_path is not None)
     batch = report.get("batch")
     if batch is not None:
         batch["min_pass_rate"] = min_pass_rate
@@ -131,15 +134,23 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
                                  f"vehicles hover, {100 * min_pass_rate:.0f}% required")
 
     run, omega_max = report.pop("_run", None), report.pop("_omega_max")
+    envelope = report.pop("_envelope", None)
     if run is not None and csv_path is not None:
         _write_csv(csv_path, run.series, force)
     if run is not None and plot_path is not None:
         from reedtool.io.fileio import atomic_write_bytes
-        from reedtool.sim.plot import render_png
+        from reedtool.sim.plot import failure_marks, render
 
-        png = render_png(run.series, omega_max, run.initial_omega_rad_s,
-                         f"{robot.name}: {run.status.value}")
-        atomic_write_bytes(plot_path, png, force=force)
+        figure = render(run.series, omega_max, run.initial_omega_rad_s,
+                        f"{robot.name}: {run.status.value}"
+                        + (f" ({batch['passed']}/{batch['samples']} of the batch passed)"
+                           if batch is not None else ""),
+                        fmt=plot_path.suffix.lower()[1:],
+                        position_tol_m=config.position_tol_m,
+                        attitude_tol_deg=config.attitude_tol_deg,
+                        settle_time_s=run.settle_time_s, failures=failure_marks(run),
+                        envelope=envelope)
+        atomic_write_bytes(plot_path, figure, force=force)
 
     if fmt == "json":
         click.echo(json.dumps(_finite(report), indent=2, allow_nan=False))
@@ -151,7 +162,7 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
 def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
                spreads: tuple[float, float, float, float] = (0.1, 0.01, 0.1, 0.05),
                record: bool = False, show_progress: bool = False,
-               engine: str = "numpy") -> dict:
+               engine: str = "numpy", envelope: bool = False) -> dict:
     """Trim, simulate and (optionally) batch one robot; the JSON-ready report.
 
     Keys: "model", "trim", "sim" (None when the trim failed), "batch" (None without
@@ -222,10 +233,12 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
             with click.progressbar(length=config.n_steps, file=sys.stderr,
                                    label=f"flying {samples} vehicles") as bar:
                 batch = robustness_batch(params, samples, config, spread, seed,
-                                         progress=bar.update, engine=engine)
+                                         progress=bar.update, engine=engine, record=envelope)
         else:
-            batch = robustness_batch(params, samples, config, spread, seed, engine=engine)
+            batch = robustness_batch(params, samples, config, spread, seed, engine=engine,
+                                     record=envelope)
         report["batch"] = batch.to_dict()
+        report["_envelope"] = batch.envelope
     return report
 
 

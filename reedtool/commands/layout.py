@@ -148,10 +148,15 @@ def render_layout(robot, rotors, com_m, fmt: str, title: str = "",
             colour = "#c0392b" if m.marked else ("#1f77b4" if m.turning_sign > 0 else
                                                  "#e67e22" if m.turning_sign < 0 else "#7f7f7f")
             arm_from = page(cx, cy)
-            ax.plot([arm_from[0], X], [arm_from[1], Y], color="#555555", linewidth=3,
-                    zorder=2, solid_capstyle="round", gid=f"arm-{m.number}")
+            # the arm stops at the disc's edge, leaving the number and index readable
+            span = math.hypot(X - arm_from[0], Y - arm_from[1])
+            keep = max(span - m.radius_m, 0.0) / span if span > 0 else 0.0
+            arm_to = (arm_from[0] + keep * (X - arm_from[0]), arm_from[1] + keep * (Y - arm_from[1]))
+            ax.plot([arm_from[0], arm_to[0]], [arm_from[1], arm_to[1]], color="#555555",
+                    linewidth=3, zorder=2, solid_capstyle="round", gid=f"arm-{m.number}")
             arm_m = math.hypot(m.x_m - cx, m.y_m - cy)
-            ax.text((arm_from[0] + X) / 2, (arm_from[1] + Y) / 2, f"{arm_m:.3g} m",
+            ax.text((arm_from[0] + arm_to[0]) / 2, (arm_from[1] + arm_to[1]) / 2,
+                    f"{arm_m:.3g} m",
                     fontsize=7, color="#333333", ha="center", va="center", zorder=6,
                     bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none",
                           "alpha": 0.8}, gid=f"armlen-{m.number}")
@@ -168,6 +173,8 @@ def render_layout(robot, rotors, com_m, fmt: str, title: str = "",
                             colour, m.number)
             dy = 0.0 if not coax else (0.3 if level == 0 else -0.3) * m.radius_m
             index = f"idx {m.index}" if m.index is not None else "no idx"
+            if coax:
+                index += ", upper" if level == 0 else ", lower"
             ax.text(X, Y + dy, f"{m.number}", fontsize=15, fontweight="bold", ha="center",
                     va="center", color="black", zorder=7, gid=f"label-{m.number}")
             ax.text(X, Y + dy - 0.28 * m.radius_m, index, fontsize=6.5, ha="center",

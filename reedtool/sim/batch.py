@@ -12,6 +12,7 @@ equations in plain floats; a test holds the two to the same trajectory.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 from typing import Callable
 
@@ -61,6 +62,9 @@ class Outcome:
     final_omega_rad_s: np.ndarray      # (n, N)
     final_state: State
     config: HoverConfig
+    # (samples, N) position error at every sample while the vehicle ran (NaN after it
+    # ended), when asked for (`record=True`); None otherwise
+    position_error_m: np.ndarray | None = None
 
     def status(self, i: int = 0) -> ExitStatus:
         return STATUS_FROM_CODE[int(self.status_code[i])]
@@ -131,7 +135,7 @@ def hover_speeds(params: VehicleParams, gains: ControllerGains) -> np.ndarray:
 def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
                    plant: Plant | None = None, design: ControllerDesign = ControllerDesign(),
                    progress: Callable[[int], None] | None = None,
-                   engine: str = "numpy") -> Outcome:
+                   engine: str = "numpy", record: bool = False) -> Outcome:
     """Fly every vehicle of `plant` (default: one nominal vehicle) on the nominal controller.
 
     `progress(steps)` is called now and then with the number of steps done since the last call.
@@ -140,7 +144,7 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
     config.validate()
     plant = plant or Plant.from_params(params, 1)
     if engine == "numba":
-        outcome = _simulate_compiled(params, config, plant, design)
+        outcome = _simulate_compiled(params, config, plant, design, record)
         if progress is not None:
             progress(config.n_steps)
         return outcome
@@ -205,6 +209,7 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
     sample_dt = every * dt
     n_steps = config.n_steps
     report_every = max(1, n_steps // 100)
+    recorded: list[np.ndarray] = []
     reported = 0
 
     for step in range(n_steps + 1):
@@ -219,6 +224,8 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
             # ---- judge every running vehicle on the state at time t
             running = status == 0
             pos = np.sqrt((p_err * p_err).sum(axis=0))
+            if record:
+                recorded.append(np.where(running, pos, np.nan))
             R22 = R[2, 2]
             # Attitude error: the angle from the level hover attitude at the setpoint
             # heading (what the trim assumes), i.e. the rotation angle of R itself.
@@ -326,15 +333,25 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
         final_attitude_error_deg=np.degrees(np.arccos(final_cos)),
         max_throttle=max_throttle, longest_saturation_s=sat_longest,
         final_omega_rad_s=state.omega.copy(),
-        final_state=state, config=config)
+        final_state=state, config=config,
+        position_error_m=_samples(recorded, config, N) if record else None)
+
+
+def _samples(recorded: list[np.ndarray], config: HoverConfig, N: int) -> np.ndarray:
+    """(samples, N): the recorded rows, NaN-padded to every sample of the full run."""
+    rows = config.n_steps // config.sample_every + (config.n_steps % config.sample_every != 0) + 1
+    out = np.full((rows, N), np.nan)
+    if recorded:
+        out[:len(recorded)] = np.array(recorded)
+    return out
 
 
 def _simulate_compiled(params: VehicleParams, config: HoverConfig, plant: Plant,
-                       design: ControllerDesign) -> Outcome:
+                       design: ControllerDesign, record: bool = False) -> Outcome:
     """simulate_batch on the compiled kernel: the same Outcome."""
     from reedtool.sim.compiled import fly_batch
 
-    out = fly_batch(params, config, plant, design)
+    out = fly_batch(params, config, plant, design, record)
     reason = out["reason"]
     status = np.array([STATUS_CODES[_STATUS_OF_REASON[REASONS[r]]] for r in reason],
                       dtype=np.int64)
@@ -349,7 +366,8 @@ def _simulate_compiled(params: VehicleParams, config: HoverConfig, plant: Plant,
         final_position_error_m=out["final_position_error_m"],
         final_attitude_error_deg=np.degrees(np.arccos(out["final_cos_attitude"])),
         max_throttle=out["max_throttle"], longest_saturation_s=out["longest_saturation_s"],
-        final_omega_rad_s=state.omega.copy(), final_state=state, config=config)
+        final_omega_rad_s=state.omega.copy(), final_state=state, config=config,
+        position_error_m=out.get("position_error_m"))
 
 
 _STATUS_OF_REASON = {
@@ -452,6 +470,9 @@ class BatchReport:
     spreads: Spreads
     seed: int | None
     engine: str = "numpy"
+    # percentiles of the position error over the vehicles still flying, per sample:
+    # {"t_s", "p5", "p50", "p95", "flying"} when recorded (for the plot), else None
+    envelope: dict[str, np.ndarray] | None = None
 
     @property
     def pass_rate(self) -> float:
@@ -471,14 +492,14 @@ def robustness_batch(params: VehicleParams, n_vehicles: int, config: HoverConfig
                      spreads: Spreads = Spreads(), seed: int | None = 0, n_worst: int = 5,
                      design: ControllerDesign = ControllerDesign(),
                      progress: Callable[[int], None] | None = None,
-                     engine: str = "numpy") -> BatchReport:
+                     engine: str = "numpy", record: bool = False) -> BatchReport:
     """Fly `n_vehicles` perturbed copies of `params`; pass rate and the worst cases.
 
     `engine`: "numpy" (this module, the reference) or "numba" (`compiled`, all cores).
     """
     perturbation = sample_perturbations(n_vehicles, params.n_rotors, spreads, seed)
     outcome = simulate_batch(params, config, perturbed_plant(params, perturbation), design,
-                             progress, engine)
+                             progress, engine, record)
     passed = outcome.status_code == STATUS_CODES[ExitStatus.PASSED]
     counts: dict[str, int] = {}
     for code in outcome.status_code:
@@ -502,7 +523,23 @@ def robustness_batch(params: VehicleParams, n_vehicles: int, config: HoverConfig
             "max_attitude_error_deg": float(outcome.max_attitude_error_deg[i]),
             "settle_time_s": _finite_or_none(float(outcome.settle_time_s[i])),
         })
-    return BatchReport(n_vehicles, int(passed.sum()), counts, worst, spreads, seed, engine)
+    return BatchReport(n_vehicles, int(passed.sum()), counts, worst, spreads, seed, engine,
+                       _envelope(outcome.position_error_m, config)
+                       if outcome.position_error_m is not None else None)
+
+
+def _envelope(position_error_m: np.ndarray, config: HoverConfig) -> dict[str, np.ndarray]:
+    """5th, 50th and 95th percentile of the position error over the vehicles still
+    flying at each sample (NaN where none is)."""
+    rows = position_error_m.shape[0]
+    steps = np.minimum(np.arange(rows) * config.sample_every, config.n_steps)
+    flying = np.isfinite(position_error_m).sum(axis=1)
+    out = {"t_s": steps * config.dt_s, "flying": flying}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)     # all-NaN rows: NaN, as meant
+        for q in (5, 50, 95):
+            out[f"p{q}"] = np.nanpercentile(position_error_m, q, axis=1)
+    return out
 
 
 def _finite_or_none(value: float) -> float | None:
