@@ -28,6 +28,9 @@ FAMILIES: dict[str, tuple[str, str]] = {
     "C": ("reedtool.checks.controller_rules", "Controller cross-check"),
 }
 
+# Rule modules beyond each family's main one (a family may span modules).
+EXTRA_MODULES: tuple[str, ...] = ("reedtool.checks.argument_rules",)
+
 _CODE = re.compile(r"^[A-Z]\d{3}$")
 _SLUG = re.compile(r"^[a-z0-9]+(-[a-z0-9]+)*$")
 
@@ -77,6 +80,8 @@ def rule(code: str, slug: str, severity: str, summary: str) -> Callable[[CheckFn
 
 def _load_families() -> None:
     for module_name, _title in FAMILIES.values():
+        importlib.import_module(module_name)
+    for module_name in EXTRA_MODULES:
         importlib.import_module(module_name)
 
 
