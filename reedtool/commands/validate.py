@@ -317,6 +317,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
     strict_any = False
     for target in targets:
         if target.path is None:
+            if len(targets) == 1:
+                raise ReedtoolError(target.error, file=target.name)
             results.append(ModelResult(target.name, error=target.error, error_file=target.name))
             continue
         results.extend(check_model(target.name, target.path, options))

@@ -106,8 +106,8 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
 
     for raw in targets:
         path = Path(raw)
-        if path.is_file():
-            add(path)
+        if path.exists() and not path.is_dir():
+            add(path)     # a device or a pipe too: the loader says what is wrong with it
         elif path.is_dir():
             if (path / "model.sdf").is_file():
                 add(path)

@@ -34,6 +34,9 @@ def format_json(results: list[ModelResult], *, show_statistics: bool = False) ->
     document = {
         **envelope(SCHEMA),
         "models": [_model(r) for r in results],
+        # Every finding of the run in one list, each naming its model, for simple consumers.
+        "findings": [{**f.to_dict(), "file": display_path(f.file), "model": r.name}
+                     for r in results for f in r.findings],
         "summary": {**severity_counts(all_findings(results)),
                     "models": len(results),
                     "input_errors": sum(1 for r in results if r.error is not None)},
