@@ -23,6 +23,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "import-stl": ("reedtool.commands.import_stl", "Import a CAD STL into a package: metres, FLU, inertia about the COM."),
     "inertia": ("reedtool.commands.inertia", "Compare declared link inertia with the geometry's; whole-robot mass properties."),
     "new-package": ("reedtool.commands.new_package", "Scaffold a ROS 1/2 package (multirotor or ground robot) that validates and hovers."),
+    "rules": ("reedtool.commands.rules", "List validate's rules (codes, names, severities), filtered by family or prefix."),
     "hover-test": ("reedtool.commands.hover_test", "Trim a multirotor for hover and fly it headless: does it settle and stay?"),
 }
 

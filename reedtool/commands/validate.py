@@ -182,6 +182,20 @@ def check_model(name: str, model: Path, options: RunOptions) -> list:
     return results
 
 
+def validation_errors(model: Path, robot) -> list:
+    """The error findings `validate` reports for an already loaded robot (its config's
+    selection, severities and suppressions): what hover-test refuses to fly."""
+    from reedtool.checks.runner import apply_suppressions, parse_selectors, run_checks
+    from reedtool.config import load_config
+
+    config = load_config(model)
+    origin = str(config.path) if config.path else "config"
+    findings = run_checks(robot, selection_for(config))
+    kept, _ = apply_suppressions(
+        findings, lambda file: parse_selectors(config.ignores_for(file or model), origin=origin))
+    return [f for f in kept if f.severity == "error"]
+
+
 def targets_of(paths: Sequence[str], options: RunOptions):
     from reedtool.config import load_config
     from reedtool.io.model_inputs import expand_targets, include_tree_of
