@@ -294,9 +294,8 @@ class _PyEval:
             return os.path.join(*(str(p) for p in parts))
         if name == "LaunchConfiguration":
             arg = self._arg(node, 0, "variable_name")
-            if arg in self.defaults:
-                return self.defaults[arg]
-            raise _Unresolved(arg)
+            # No default: given at launch time; the words using it are left out.
+            return self.defaults.get(arg, _UNKNOWN)
         if name == "Path":
             return os.path.join(*(str(self.value(a)) for a in node.args))
         if name == "str" and node.args:
@@ -319,6 +318,16 @@ def _read_python_launch(path: Path, resolver: PackageResolver) -> LaunchCall | N
     # Statements in source order: names are known once assigned, as when the file runs.
     nodes = sorted((n for n in ast.walk(tree) if isinstance(n, (ast.Assign, ast.Call))),
                    key=lambda n: (n.lineno, n.col_offset))
+    # Launch arguments first: a LaunchConfiguration is often built before its declaration.
+    for node in nodes:
+        if isinstance(node, ast.Call) and _call_name(node) == "DeclareLaunchArgument":
+            try:
+                arg = ev._arg(node, 0, "name")
+                for kw in node.keywords:
+                    if kw.arg == "default_value":
+                        ev.defaults[arg] = "".join(map(str, _flat(ev.value(kw.value))))
+            except (_Unresolved, TypeError, AttributeError, IndexError, ReedtoolError):
+                continue
     for node in nodes:
         if isinstance(node, ast.Assign):
             for target in node.targets:
@@ -328,15 +337,9 @@ def _read_python_launch(path: Path, resolver: PackageResolver) -> LaunchCall | N
                     except (_Unresolved, ReedtoolError, TypeError):
                         ev.names.pop(target.id, None)
             continue
-        func = node.func
-        name = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", "")
+        name = _call_name(node)
         try:
-            if name == "DeclareLaunchArgument":
-                arg = ev._arg(node, 0, "name")
-                for kw in node.keywords:
-                    if kw.arg == "default_value":
-                        ev.defaults[arg] = "".join(map(str, _flat(ev.value(kw.value))))
-            elif found is None and name == "Command":
+            if found is None and name == "Command":
                 parts = _flat(ev.value(node.args[0] if node.args else node.keywords[0].value))
                 call = _xacro_call("".join(map(str, parts)), {}, resolver, ev.loc(node), lines)
                 found = call or found
@@ -355,7 +358,17 @@ def _read_python_launch(path: Path, resolver: PackageResolver) -> LaunchCall | N
                 found = call
         except (_Unresolved, TypeError, AttributeError, IndexError):
             continue
+    if found is not None and found.model is not None and _UNKNOWN in str(found.model):
+        found.model = None
+    for name in [k for k, v in (found.mappings.items() if found else ()) if _UNKNOWN in v]:
+        del found.mappings[name]
+        found.locs.pop(name, None)
     return found
+
+
+def _call_name(node: ast.Call) -> str:
+    func = node.func
+    return func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", "")
 
 
 def _flat(value) -> list:
