@@ -217,6 +217,9 @@ def print_settings(targets, options: RunOptions) -> int:
 
     for target in targets:
         click.echo(f"{target.name}:")
+        if target.skipped is not None:
+            click.echo(f"  skipped: {target.skipped}")
+            continue
         if target.path is None:
             click.echo(f"  error: {target.error}")
             continue
@@ -330,6 +333,9 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
     results = []
     strict_any = False
     for target in targets:
+        if target.skipped is not None:
+            results.append(ModelResult(target.name, skipped=target.skipped))
+            continue
         if target.path is None:
             if len(targets) == 1:
                 raise ReedtoolError(target.error, file=target.name)

@@ -41,6 +41,7 @@ class Target:
     name: str                # as shown to the user
     path: Path | None
     error: str | None = None
+    skipped: str | None = None   # why a named file is not checked (a macro library)
 
 
 def _root_and_children(path: Path) -> tuple[str | None, list[str]]:
@@ -107,6 +108,12 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
     for raw in targets:
         path = Path(raw)
         if path.exists() and not path.is_dir():
+            if path.is_file() and path.suffix.lower() == ".xacro" and is_macro_library(path):
+                # pre-commit passes every changed file: a macro library has no robot of its
+                # own; the models that include it are where its mistakes show.
+                out.append(Target(display(path), None, skipped="a xacro macro library (no "
+                                  "robot of its own); validate the models that include it"))
+                continue
             add(path)     # a device or a pipe too: the loader says what is wrong with it
         elif path.is_dir():
             if (path / "model.sdf").is_file():

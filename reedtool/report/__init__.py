@@ -28,6 +28,7 @@ class ModelResult:
     error_file: str | None = None
     error_line: int | None = None
     suppressed: int = 0                         # findings silenced inline or per file
+    skipped: str | None = None                  # why the file was not checked
 
 
 def display_path(file: str | None, cwd: Path | None = None) -> str | None:

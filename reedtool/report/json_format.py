@@ -23,6 +23,7 @@ def _model(result: ModelResult) -> dict:
         "summary": severity_counts(result.findings),
         "suppressed": result.suppressed,
         "error": None,
+        "skipped": result.skipped,
     }
     if result.error is not None:
         entry["error"] = {"message": result.error, "file": display_path(result.error_file),

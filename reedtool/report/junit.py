@@ -24,6 +24,10 @@ def format_junit(results: list[ModelResult], failing: frozenset[str] = frozenset
             ET.SubElement(case, "error", message=result.error, type="input-error").text = (
                 f"{display_path(result.error_file) or result.name}"
                 f"{':' + str(result.error_line) if result.error_line else ''}: {result.error}")
+        elif result.skipped is not None:
+            tests = 1
+            case = ET.SubElement(suite, "testcase", classname=result.name, name="validate")
+            ET.SubElement(case, "skipped", message=result.skipped)
         elif not result.findings:
             tests = 1
             ET.SubElement(suite, "testcase", classname=result.name, name="validate")

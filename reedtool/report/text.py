@@ -29,6 +29,9 @@ def _model_block(result: ModelResult, style) -> list[str]:
     if result.error is not None:
         lines.append(style(f"{result.name}: error: {result.error}", fg="red", bold=True))
         return lines
+    if result.skipped is not None:
+        lines.append(style(f"{result.name}: skipped: {result.skipped}", dim=True))
+        return lines
     for file, group in groupby(result.findings, key=lambda f: f.file):
         lines.append(style(display_path(file) or "<model>", bold=True))
         for finding in group:
