@@ -301,3 +301,14 @@ def test_every_rule_name_is_a_selector():
     for rule in all_rules():
         assert parse_selectors([rule.slug], origin="test") == (rule.code,)
         assert get_rule(rule.slug) is rule
+
+
+def test_macro_library_named_by_pre_commit_is_skipped_not_failed(capsys, tmp_path):
+    library = tmp_path / "macros.xacro"
+    library.write_text('<?xml version="1.0"?>\n<robot xmlns:xacro="http://ros.org/wiki/xacro">\n'
+                       '  <xacro:macro name="leg" params="n"><link name="${n}"/></xacro:macro>\n'
+                       '</robot>\n')
+    code, doc = run_json([library], capsys)
+    assert code == 0 and doc["models"][0]["skipped"].startswith("a xacro macro library")
+    code, doc = run_json([library, TRIANGLE], capsys)
+    assert code == 1 and [f["code"] for f in doc["findings"]] == ["I203"]
