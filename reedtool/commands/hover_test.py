@@ -118,6 +118,12 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     robot = load_robot(model, parse_mappings(mappings), list(package_paths))
     require_sound_model(robot)
     errors = validation_errors(model, robot)
+    if errors and not ignore_validation:
+        # Unreadable rotor parameters are bad input (exit 2), whatever else is wrong.
+        from reedtool.physics.rotors import discover_rotors
+        from reedtool.sim.params import check_rotor_dynamics
+
+        check_rotor_dynamics(discover_rotors(robot))
     if errors:
         from reedtool.report import ModelResult, render
 
