@@ -148,3 +148,16 @@ def test_launch_without_xacro_call_is_one_line_exit_2(capsys, tmp_path):
         main(["validate", "--launch", str(launch)])
     err = capsys.readouterr().err
     assert exc.value.code == 2 and err.count("\n") == 1 and "no xacro call" in err
+
+
+def test_include_with_pass_all_args(tmp_path):
+    (tmp_path / "inner.launch").write_text(
+        '<launch>\n  <arg name="mav_name"/>\n'
+        '  <param name="robot_description" command="xacro model.xacro mav_name:=$(arg mav_name)"/>\n'
+        '</launch>\n')
+    (tmp_path / "outer.launch").write_text(
+        '<launch>\n  <arg name="mav_name" default="outer_quad"/>\n'
+        '  <include file="$(dirname)/inner.launch" pass_all_args="true"/>\n</launch>\n')
+    call = read_launch(tmp_path / "outer.launch")
+    assert call.mappings == {"mav_name": "outer_quad"}
+    assert call.locs["mav_name"].line == 3 and call.locs["mav_name"].file.endswith("inner.launch")

@@ -218,6 +218,8 @@ def _read_xml_launch(path: Path, given: dict[str, str], resolver: PackageResolve
             except (_Unresolved, ReedtoolError):
                 continue     # e.g. gazebo_ros's empty_world.launch: not needed, not here
             passed: dict[str, str] = {}
+            if element.get("pass_all_args", "").lower() == "true":
+                passed.update({k: v for k, v in values.items() if v is not None})
             for arg in element.findall("arg"):
                 try:
                     passed[arg.get("name")] = _substitute(arg.get("value", arg.get("default", "")),
