@@ -311,3 +311,14 @@ def test_macro_library_named_by_pre_commit_is_skipped_not_failed(capsys, tmp_pat
     assert code == 0 and doc["models"][0]["skipped"].startswith("a xacro macro library")
     code, doc = run_json([library, TRIANGLE], capsys)
     assert code == 1 and [f["code"] for f in doc["findings"]] == ["I203"]
+
+
+def test_strict_is_per_model_configuration(capsys, tmp_path):
+    (tmp_path / "strict").mkdir()
+    (tmp_path / "lax").mkdir()
+    shutil.copy(WARNING_ONLY, tmp_path / "strict" / "w.urdf")
+    shutil.copy(WARNING_ONLY, tmp_path / "lax" / "w.urdf")
+    (tmp_path / "strict" / "reedtool.toml").write_text("strict = true\n")
+    assert run([tmp_path / "lax" / "w.urdf", CLEAN], capsys)[0] == 0
+    assert run([tmp_path / "lax" / "w.urdf", tmp_path / "strict" / "w.urdf"], capsys)[0] == 1
+    assert run([tmp_path / "strict" / "w.urdf", "--no-strict"], capsys)[0] == 0

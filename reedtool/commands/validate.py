@@ -331,6 +331,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
     from reedtool.report import ModelResult, render
 
     results = []
+    failed = False       # a finding at its model's failing severity
     strict_any = False
     for target in targets:
         if target.skipped is not None:
@@ -341,13 +342,18 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
                 raise ReedtoolError(target.error, file=target.name)
             results.append(ModelResult(target.name, error=target.error, error_file=target.name))
             continue
-        results.extend(check_model(target.name, target.path, options))
+        model_results = check_model(target.name, target.path, options)
+        results.extend(model_results)
         if len(targets) == 1 and results[-1].error is not None:
             # One model: its input error is the one-line error of every command.
             raise ReedtoolError(results[-1].error)
-        strict_any = strict_any or load_config(target.path).strict
-    strict = strict_any if strict is None else strict
-    failing = frozenset({"error", "warning"} if strict else {"error"})
+        # Each model fails by its own configuration's `strict`, unless the command line says.
+        model_strict = load_config(target.path).strict if strict is None else strict
+        strict_any = strict_any or model_strict
+        model_failing = {"error", "warning"} if model_strict else {"error"}
+        failed = failed or any(f.severity in model_failing
+                               for r in model_results for f in r.findings)
+    failing = frozenset({"error", "warning"} if strict_any else {"error"})   # junit
     color = _use_color(no_color) and output_file is None
     text = render(results, fmt, color=color, show_statistics=show_statistics, failing=failing)
     if output_file is not None:
@@ -360,5 +366,5 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
         return 2
     if exit_zero:
         return 0
-    return 1 if any(f.severity in failing for r in results for f in r.findings) else 0
+    return 1 if failed else 0
 
