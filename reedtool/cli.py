@@ -19,10 +19,11 @@ from reedtool import __version__
 # name -> (module, one-line summary). Only subcommands that exist are listed here.
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "expand": ("reedtool.commands.expand", "Expand a xacro model to URDF without ROS ($(find), package://, source lines)."),
-    "validate": ("reedtool.commands.validate", "Check a URDF/xacro model for mistakes that break it in Gazebo."),
+    "validate": ("reedtool.commands.validate", "Check URDF/xacro/SDF models (files, dirs, packages, globs) for mistakes that break them in Gazebo."),
     "import-stl": ("reedtool.commands.import_stl", "Import a CAD STL into a package: metres, FLU, inertia about the COM."),
     "inertia": ("reedtool.commands.inertia", "Compare declared link inertia with the geometry's; whole-robot mass properties."),
     "new-package": ("reedtool.commands.new_package", "Scaffold a ROS 1/2 package (multirotor or ground robot) that validates and hovers."),
+    "rules": ("reedtool.commands.rules", "List validate's rules (codes, names, severities), filtered by family or prefix."),
     "hover-test": ("reedtool.commands.hover_test", "Trim a multirotor for hover and fly it headless: does it settle and stay?"),
     "layout": ("reedtool.commands.layout", "Draw the rotor layout seen from above (SVG/PNG): numbers, spin, COM, arms."),
 }

@@ -3,24 +3,35 @@
 The nearest configuration above the model wins, found by walking up from the model's
 directory: in each directory a reedtool.toml (top-level keys) is taken first, then a
 pyproject.toml that has a `[tool.reedtool]` table (one without it is skipped, as ruff
-does). Keys:
+does). Configurations further up are not merged; `--show-settings` lists every one found
+and says which won. Keys:
 
-    select = ["S", "I", "R"]          # code prefixes to run (default: all)
-    ignore = ["I205"]                 # code prefixes to skip
+    select = ["S", "I", "R"]          # codes, prefixes or rule names to run (default: all)
+    ignore = ["I205"]                 # codes, prefixes or rule names to skip
     strict = false                    # warnings fail the run too
+    args = {mav_name = "reed_quad_x"} # xacro name:=value arguments for every model
     [tool.reedtool.severity]          # or [severity] in reedtool.toml
     I204 = "error"                    # per-prefix severity overrides
+    [tool.reedtool.per-file-args]     # more xacro arguments for models matching a glob
+    "urdf/*.gazebo" = {namespace = "reed_quad_x"}
+    [tool.reedtool.per-file-ignores]  # rules to skip for findings in files matching a glob
+    "urdf/legacy_*.xacro" = ["S120"]
+
+Globs are matched against the path relative to the directory of the configuration file;
+a glob without a `/` also matches the file name alone (`"*.gazebo"`).
 """
 
 from __future__ import annotations
 
+import fnmatch
+import os
 import sys
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from reedtool.errors import ReedtoolError
 
-KEYS = ("select", "ignore", "severity", "strict")
+KEYS = ("select", "ignore", "severity", "strict", "args", "per-file-args", "per-file-ignores")
 
 
 @dataclass(frozen=True)
@@ -30,6 +41,50 @@ class Config:
     ignore: tuple[str, ...] = ()
     severity: dict[str, str] = field(default_factory=dict)
     strict: bool = False
+    args: dict[str, str] = field(default_factory=dict)
+    per_file_args: dict[str, dict[str, str]] = field(default_factory=dict)
+    per_file_ignores: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    # Every configuration found walking up from the model, nearest first (path[0] won).
+    candidates: tuple[Path, ...] = ()
+
+    @property
+    def root(self) -> Path | None:
+        return self.path.parent if self.path else None
+
+    def matches(self, pattern: str, file: str | Path) -> bool:
+        """Does `file` match a per-file glob of this configuration?"""
+        path = Path(file).resolve()
+        if self.root is not None:
+            try:
+                relative = path.relative_to(self.root.resolve()).as_posix()
+            except ValueError:
+                relative = path.as_posix()
+        else:
+            relative = path.as_posix()
+        if fnmatch.fnmatchcase(relative, pattern):
+            return True
+        return "/" not in pattern and fnmatch.fnmatchcase(path.name, pattern)
+
+    def args_for(self, model: str | Path) -> tuple[dict[str, str], list[str]]:
+        """The xacro arguments for `model`: `args`, then every matching `per-file-args` table.
+
+        Also returns where each came from, for the unknown-argument warning and
+        --show-settings.
+        """
+        out = dict(self.args)
+        origins = [f"{self.path} args"] if self.args else []
+        for pattern, table in self.per_file_args.items():
+            if self.matches(pattern, model):
+                out.update(table)
+                origins.append(f"{self.path} per-file-args \"{pattern}\"")
+        return out, origins
+
+    def ignores_for(self, file: str | Path) -> tuple[str, ...]:
+        found: list[str] = []
+        for pattern, selectors in self.per_file_ignores.items():
+            if self.matches(pattern, file):
+                found.extend(selectors)
+        return tuple(found)
 
 
 def _load_toml(path: Path) -> dict:
@@ -47,19 +102,27 @@ def _load_toml(path: Path) -> dict:
                             hint="fix the syntax or remove the file") from exc
 
 
-def find_config(start: Path) -> tuple[Path, dict] | None:
-    """The nearest reedtool configuration at or above `start` and its table."""
+def find_configs(start: Path) -> list[tuple[Path, dict]]:
+    """Every reedtool configuration at or above `start`, nearest first, with its table."""
     directory = start if start.is_dir() else start.parent
+    found: list[tuple[Path, dict]] = []
     for folder in [directory.resolve(), *directory.resolve().parents]:
         candidate = folder / "reedtool.toml"
         if candidate.is_file():
-            return candidate, _load_toml(candidate)
+            found.append((candidate, _load_toml(candidate)))
+            continue      # in one directory, reedtool.toml shadows pyproject.toml
         candidate = folder / "pyproject.toml"
         if candidate.is_file():
             table = _load_toml(candidate).get("tool", {}).get("reedtool")
             if table is not None:
-                return candidate, table
-    return None
+                found.append((candidate, table))
+    return found
+
+
+def find_config(start: Path) -> tuple[Path, dict] | None:
+    """The nearest reedtool configuration at or above `start` and its table."""
+    found = find_configs(start)
+    return found[0] if found else None
 
 
 def _string_list(value, key: str, path: Path) -> tuple[str, ...]:
@@ -70,11 +133,45 @@ def _string_list(value, key: str, path: Path) -> tuple[str, ...]:
     return tuple(value)
 
 
+def _scalar(value) -> str | None:
+    # TOML booleans become xacro's spelling; numbers keep their text.
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (str, int, float)):
+        return str(value)
+    return None
+
+
+def _args_table(value, key: str, path: Path) -> dict[str, str]:
+    if not isinstance(value, dict):
+        raise ReedtoolError(f"'{key}' must be a table of name = value xacro arguments",
+                            file=path, hint='e.g. args = {mav_name = "reed_quad_x"}')
+    out: dict[str, str] = {}
+    for name, raw in value.items():
+        text = _scalar(raw)
+        if text is None:
+            raise ReedtoolError(f"xacro argument '{name}' in '{key}' must be a string, number "
+                                "or boolean", file=path)
+        out[str(name)] = text
+    return out
+
+
+def _glob_table(value, key: str, path: Path) -> dict:
+    if not isinstance(value, dict):
+        raise ReedtoolError(f"'{key}' must be a table keyed by file glob", file=path,
+                            hint=f'e.g. [tool.reedtool.{key}] "urdf/*.xacro" = ...')
+    return value
+
+
 def parse_config(table: dict, path: Path) -> Config:
     unknown = sorted(set(table) - set(KEYS))
     if unknown:
-        raise ReedtoolError(f"unknown reedtool setting '{unknown[0]}'", file=path,
-                            hint=f"known settings: {', '.join(KEYS)}")
+        from difflib import get_close_matches
+
+        close = get_close_matches(unknown[0], KEYS, n=1)
+        hint = (f"did you mean '{close[0]}'? " if close else "") + \
+            f"known settings: {', '.join(KEYS)}"
+        raise ReedtoolError(f"unknown reedtool setting '{unknown[0]}'", file=path, hint=hint)
     severity = table.get("severity", {})
     if not isinstance(severity, dict):
         raise ReedtoolError("'severity' must be a table of CODE = \"error|warning|info\"",
@@ -82,21 +179,38 @@ def parse_config(table: dict, path: Path) -> Config:
     strict = table.get("strict", False)
     if not isinstance(strict, bool):
         raise ReedtoolError("'strict' must be true or false", file=path)
+    per_file_args = {str(glob): _args_table(args, f"per-file-args \"{glob}\"", path)
+                     for glob, args in _glob_table(table.get("per-file-args", {}),
+                                                   "per-file-args", path).items()}
+    per_file_ignores = {str(glob): _string_list(codes, f"per-file-ignores \"{glob}\"", path)
+                        for glob, codes in _glob_table(table.get("per-file-ignores", {}),
+                                                       "per-file-ignores", path).items()}
     return Config(
         path=path,
         select=_string_list(table["select"], "select", path) if "select" in table else None,
         ignore=_string_list(table.get("ignore", []), "ignore", path),
         severity={str(k): str(v) for k, v in severity.items()},
         strict=strict,
+        args=_args_table(table.get("args", {}), "args", path),
+        per_file_args=per_file_args,
+        per_file_ignores=per_file_ignores,
     )
 
 
 def load_config(model_path: Path) -> Config:
     """The configuration that applies to `model_path`; defaults when there is none."""
-    found = find_config(Path(model_path))
-    if found is None:
+    found = find_configs(Path(model_path))
+    if not found:
         return Config()
-    path, table = found
+    path, table = found[0]
     if not isinstance(table, dict):
         raise ReedtoolError("[tool.reedtool] must be a table", file=path)
-    return parse_config(table, path)
+    config = parse_config(table, path)
+    return replace(config, candidates=tuple(p for p, _ in found))
+
+
+def relative_to_cwd(path: Path) -> str:
+    try:
+        return os.path.relpath(path)
+    except ValueError:
+        return str(path)

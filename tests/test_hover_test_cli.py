@@ -21,7 +21,9 @@ LAUNCH_ARGS = {"mav_name": "reed_quad_x", "namespace": "reed_quad_x",
                "enable_mavlink_interface": "true", "enable_ground_truth": "true",
                "enable_logging": "false", "log_file": "reed_quad_x",
                "wait_to_record_bag": "false"}
-ARGV = [f"{k}:={v}" for k, v in LAUNCH_ARGS.items()]
+# The seed quad has validate errors (I203, S115, R312): the flight physics tests below
+# fly it anyway; the refusal itself is tested at the end.
+ARGV = [f"{k}:={v}" for k, v in LAUNCH_ARGS.items()] + ["--ignore-validation"]
 G = 9.80665
 
 
@@ -244,3 +246,28 @@ def test_bad_input_is_one_line_and_exit_2(capsys, tmp_path, args, needle):
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and needle in err
     assert "Traceback" not in err
+
+
+# ------------------------------------------------------------------ validation first
+
+def test_seed_with_validate_errors_is_refused_not_passed(capsys):
+    """The seed quad hovers, but validate reports errors: hover-test must not say PASSED."""
+    argv = [a for a in ARGV if a != "--ignore-validation"]
+    assert run_cli("hover-test", str(SEED_MODEL), *argv, "--duration", "2") == 1
+    out = capsys.readouterr().out
+    assert "PASSED" not in out
+    assert "I203" in out and "--ignore-validation" in out
+    assert out.rstrip().splitlines()[-1].startswith("FAILED: validate reports 3 errors")
+
+    code, report = run_json(capsys, str(SEED_MODEL), *argv, "--duration", "2")
+    assert code == 1 and report["status"] == "refused" and report["passed"] is False
+    assert report["schema"] == "reedtool.hover-test/1" and report["tool"] == "reedtool"
+    assert sorted(e["code"] for e in report["validation"]["errors"]) == ["I203", "R312",
+                                                                         "S115"]
+
+
+def test_ignore_validation_flies_and_lists_the_errors(capsys):
+    assert run_cli("hover-test", str(SEED_MODEL), *ARGV, "--duration", "5") == 0
+    out = capsys.readouterr().out
+    assert "I203" in out and "flying it anyway" in out
+    assert out.rstrip().endswith("PASSED")

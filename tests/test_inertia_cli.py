@@ -159,3 +159,18 @@ def test_imported_mesh_snippet_is_consistent_with_inertia_check(tmp_path, capsys
     assert link["derived"]["mass_kg"] == 0.05
     hull_volume_m3 = (60 * 5 + 5 * 25 + 0.5 * 55 * 25) * 40 * 1e-9
     assert link["derived"]["volume_m3"] == pytest.approx(hull_volume_m3, rel=1e-6)
+
+
+def test_json_carries_schema_tool_and_version(capsys):
+    """Every command's JSON starts with the same envelope (issue 13)."""
+    import json as _json
+
+    from reedtool import __version__
+    from reedtool.cli import main
+
+    model = Path(__file__).parent / "fixtures" / "validate" / "clean_quad_x.urdf"
+    with pytest.raises(SystemExit):
+        main(["inertia", str(model), "--format", "json"])
+    doc = _json.loads(capsys.readouterr().out)
+    assert (doc["schema"], doc["tool"], doc["version"]) == ("reedtool.inertia/1", "reedtool",
+                                                            __version__)

@@ -89,14 +89,15 @@ def test_json_schema_and_determinism(capsys):
     code, out, _ = run([TWO_ERRORS, "--format", "json"], capsys)
     assert code == 1
     doc = json.loads(out)
-    assert doc["schema"] == 1 and doc["tool"] == "reedtool" and doc["version"]
-    assert doc["model"].endswith("S105_bad_child_missing.urdf")
+    assert doc["schema"] == "reedtool.validate/1" and doc["tool"] == "reedtool" and doc["version"]
+    assert [Path(m["model"]).resolve() for m in doc["models"]] == [TWO_ERRORS.resolve()]
     assert [f["code"] for f in doc["findings"]] == ["S105", "S104"]  # by line: joint, link
     for finding in doc["findings"]:
         assert list(finding) == ["code", "slug", "severity", "message", "subject", "file",
-                                 "line", "hint"]
+                                 "line", "hint", "model"]
         assert isinstance(finding["line"], int)
-    assert doc["summary"] == {"error": 2, "warning": 0, "info": 0}
+    assert doc["summary"] == {"error": 2, "warning": 0, "info": 0, "models": 1,
+                              "input_errors": 0}
     assert run([TWO_ERRORS, "--format", "json"], capsys)[1] == out
 
 
@@ -113,11 +114,12 @@ def test_github_annotations(capsys):
 def test_text_has_no_colour_unless_a_terminal(capsys):
     _, out, _ = run([TWO_ERRORS], capsys)
     assert "\x1b[" not in out
-    from reedtool import report
     from reedtool.checks.runner import run_checks
     from reedtool.io.loader import load_robot
+    from reedtool.report import ModelResult, render
 
-    coloured = report.format_text(run_checks(load_robot(TWO_ERRORS)), str(TWO_ERRORS), color=True)
+    result = ModelResult(str(TWO_ERRORS), run_checks(load_robot(TWO_ERRORS)))
+    coloured = render([result], "text", color=True)
     assert "\x1b[" in coloured
 
 

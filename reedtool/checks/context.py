@@ -66,13 +66,16 @@ def build_tree(robot: Robot) -> Tree:
 
 class CheckContext:
     def __init__(self, robot: Robot, controllers: Sequence[Any] = (),
-                 flight_params: Sequence[Any] = ()):
+                 flight_params: Sequence[Any] = (), arguments: Any = None):
         self.robot = robot
         # Autopilot parameter files (validate --airframe / --autopilot-params):
         # reedtool.flightstack.px4.Px4Params and .ardupilot.ArduPilotParams.
         self.flight_params = list(flight_params)
         # Controller tables read from files (validate --controller), reedtool.flightstack.controller_tables.
         self.controllers = list(controllers)
+        # reedtool.io.xacro_args.ArgumentUse: the xacro arguments given and known; None
+        # when the caller did not say (the argument rules then find nothing).
+        self.arguments = arguments
         self._geometry_props: dict[str, Any] = {}
         self._mesh_bounds: dict[str, Any] = {}
         self._mesh_errors: dict[str, str] = {}     # path -> why it is not a usable mesh

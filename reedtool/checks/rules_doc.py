@@ -32,9 +32,12 @@ def render() -> str:
         "do not edit by hand. -->",
         "",
         "Every finding carries one of these codes. Codes are stable and never reused. "
-        "Select or ignore rules by code prefix (`--select S,I2 --ignore I205`), change a "
-        "rule's severity in `[tool.reedtool.severity]`, and print one rule's documentation "
-        "with `reedtool validate --explain CODE`. See [validate.md](validate.md).",
+        "Select or ignore rules by code prefix or name (`--select S,I2 --ignore I205`, "
+        "`--ignore mesh-unresolved`), change a rule's severity in "
+        "`[tool.reedtool.severity]`, silence one finding with "
+        "`<!-- reedtool: ignore[CODE] -->` on or above its line, list the rules with "
+        "`reedtool rules` and print one rule's documentation with "
+        "`reedtool validate --explain CODE`. See [validate.md](validate.md).",
         "",
         "| Code | Name | Severity | Summary |",
         "| --- | --- | --- | --- |",

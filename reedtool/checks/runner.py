@@ -1,8 +1,11 @@
 """Run the selected rules over one robot and collect findings.
 
-Selection follows ruff: `select` and `ignore` are code prefixes and, for each rule, the
-longest prefix that matches it decides (an ignore wins a tie). Severity overrides are
-prefixes too, longest match wins.
+Selection follows ruff: `select` and `ignore` are code prefixes (or rule names, which
+stand for their code) and, for each rule, the longest prefix that matches it decides (an
+ignore wins a tie). Severity overrides are prefixes too, longest match wins.
+
+After the rules ran, `apply_suppressions` drops findings silenced by an inline XML comment
+(reedtool.checks.suppressions) or by a per-file ignore of the configuration.
 """
 
 from __future__ import annotations
@@ -47,19 +50,24 @@ def parse_selectors(values: Iterable[str], *, origin: str) -> tuple[str, ...]:
 
     `origin` names where they came from (an option or a config file) for the error.
     """
-    codes = [r.code for r in all_rules()]
+    rules = all_rules()
+    codes = [r.code for r in rules]
+    by_slug = {r.slug: r.code for r in rules}
     out: list[str] = []
     for raw in values:
         for part in str(raw).split(","):
             selector = part.strip().upper()
             if not selector:
                 continue
-            if selector == "ALL":
+            if part.strip().lower() in by_slug:      # a rule name stands for its code
+                selector = by_slug[part.strip().lower()]
+            elif selector == "ALL":
                 selector = ""
             elif not _SELECTOR.match(selector) or not any(c.startswith(selector) for c in codes):
                 raise ReedtoolError(f"unknown rule selector '{part.strip()}' in {origin}",
-                                    hint="use a code or code prefix such as S1, I203 or R; "
-                                         "see `reedtool validate --explain CODE`")
+                                    hint="use a code, code prefix or rule name such as S1, I203, R or "
+                                         "inertia-triangle-inequality; "
+                                         "`reedtool rules` lists them")
             out.append(selector)
     return tuple(out)
 
@@ -77,13 +85,15 @@ def parse_severity_overrides(values: Mapping[str, str], *, origin: str) -> dict[
 
 
 def run_checks(robot: Robot, selection: Selection | None = None, *,
-               controllers: Sequence = (), flight_params: Sequence = ()) -> list[Finding]:
+               controllers: Sequence = (), flight_params: Sequence = (),
+               arguments=None) -> list[Finding]:
     """Every finding of every selected rule, in deterministic order, duplicates removed.
 
     `controllers`: controller rotor tables read from files (reedtool.flightstack.controller_tables).
+    `arguments`: the xacro arguments given and known (reedtool.io.xacro_args.ArgumentUse).
     """
     selection = selection or Selection()
-    ctx = CheckContext(robot, controllers, flight_params)
+    ctx = CheckContext(robot, controllers, flight_params, arguments)
     findings: set[Finding] = set()
     for rule in all_rules():
         if not selection.enabled(rule.code):
@@ -97,3 +107,24 @@ def run_checks(robot: Robot, selection: Selection | None = None, *,
                                  line=loc.line if loc else None, hint=issue.hint,
                                  macro=loc.macro if loc else None))
     return sorted(findings, key=Finding.sort_key)
+
+
+def apply_suppressions(findings: Sequence[Finding], ignores_for=None
+                       ) -> tuple[list[Finding], int]:
+    """Findings left after inline comments and per-file ignores; and how many were dropped.
+
+    `ignores_for(file) -> selectors` gives the per-file ignore selectors (already parsed
+    by `parse_selectors`) that apply to a file; None: no per-file ignores.
+    """
+    from reedtool.checks.suppressions import is_suppressed
+
+    kept: list[Finding] = []
+    for finding in findings:
+        if is_suppressed(finding.code, finding.slug, finding.file, finding.line):
+            continue
+        if ignores_for is not None:
+            selectors = ignores_for(finding.file)
+            if any(finding.code.startswith(s) for s in selectors):
+                continue
+        kept.append(finding)
+    return kept, len(findings) - len(kept)

@@ -25,6 +25,11 @@ MAX_COM_SPREAD_M = 1.0
 # 10^7 fixed steps is 10,000 s at 1 kHz, far beyond any hover test; more is a typo
 # (`--duration 1e9`) that would keep the machine busy for days.
 MAX_STEPS = 10_000_000
+SCHEMA = "reedtool.hover-test/1"
+
+
+def _validation_json(errors, refused: bool) -> dict:
+    return {"errors": [f.to_dict() for f in errors], "refused": refused}
 
 
 @click.command(name="hover-test")
@@ -71,17 +76,23 @@ MAX_STEPS = 10_000_000
                    "needs pip install 'reedtool[fast]').")
 @click.option("--min-pass-rate", type=FiniteFloatRange(0.0, 1.0), default=0.95,
               show_default=True, help="Batch pass rate needed to exit 0.")
+@click.option("--ignore-validation", is_flag=True,
+              help="Fly a model that `validate` reports errors for (by default it is "
+                   "refused: exit 1 without flying).")
 def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
             model_name: str | None,
             duration_s: float, rate_hz: float, offset_m: tuple[float, float, float],
             roll_rad: float, pitch_rad: float, yaw_rad: float, plot_path: Path | None,
             csv_path: Path | None, force: bool, fmt: str, samples: int | None, seed: int,
             mass_spread: float, com_spread_m: float, inertia_spread: float,
-            motor_spread: float, engine: str, min_pass_rate: float) -> int:
+            motor_spread: float, engine: str, min_pass_rate: float,
+            ignore_validation: bool = False) -> int:
     """Trim MODEL (.urdf or .xacro, with xacro NAME:=VALUE arguments) for hover and fly it.
 
     Starts from a disturbance (default 0.5 m off the setpoint, rolled 0.2 rad) and passes
-    when it settles within 5 cm and 2 deg and stays there.
+    when it settles within 5 cm and 2 deg and stays there. A model `validate` reports
+    errors for is not flown (exit 1) unless --ignore-validation is given: a hover of a
+    model Gazebo would simulate differently is not a pass.
     """
     from reedtool.sim import HoverConfig
 
@@ -118,9 +129,37 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     from reedtool.io.loader import load_robot
     from reedtool.io.mappings import parse_mappings
 
+    from reedtool.commands.validate import validation_errors
+
     robot = load_robot(model, parse_mappings(mappings), list(package_paths),
                        model_name=model_name)
     require_sound_model(robot)
+    errors = validation_errors(model, robot)
+    if errors and not ignore_validation:
+        # Unreadable rotor parameters are bad input (exit 2), whatever else is wrong.
+        from reedtool.physics.rotors import discover_rotors
+        from reedtool.sim.params import check_rotor_dynamics
+
+        check_rotor_dynamics(discover_rotors(robot))
+    if errors:
+        from reedtool.report import ModelResult, render
+
+        refused = not ignore_validation
+        why = (f"validate reports {len(errors)} error{'s' if len(errors) != 1 else ''} for "
+               f"this model; " + ("not flying it (--ignore-validation flies it anyway)"
+                                  if refused else "flying it anyway (--ignore-validation)"))
+        if fmt == "text":
+            click.echo(render([ModelResult(str(model), errors)], "text"), nl=False)
+            click.echo(why if not refused else f"FAILED: {why}")
+        if refused:
+            if fmt == "json":
+                from reedtool.report.json_format import envelope
+
+                click.echo(json.dumps({**envelope(SCHEMA), "model": {"file": str(model)},
+                                       "validation": _validation_json(errors, True),
+                                       "passed": False, "status": "refused",
+                                       "message": why}, indent=2))
+            return 1
     report = hover_test(robot, config, samples=samples, seed=seed,
                         spreads=(mass_spread, com_spread_m, inertia_spread, motor_spread),
                         record=bool(plot_path or csv_path), show_progress=fmt == "text",
@@ -153,7 +192,11 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
         atomic_write_bytes(plot_path, figure, force=force)
 
     if fmt == "json":
-        click.echo(json.dumps(_finite(report), indent=2, allow_nan=False))
+        from reedtool.report.json_format import envelope
+
+        document = {**envelope(SCHEMA), **report,
+                    "validation": _validation_json(errors, False)}
+        click.echo(json.dumps(_finite(document), indent=2, allow_nan=False))
     else:
         click.echo(render_text(report))
     return 0 if report["passed"] else 1

@@ -115,7 +115,10 @@ def format_text(model: Path, robot, comparisons, whole, own, findings=()) -> str
 
 
 def format_json(model: Path, robot, comparisons, whole, own, findings=()) -> str:
+    from reedtool.report.json_format import envelope
+
     doc = {
+        **envelope("reedtool.inertia/1"),
         "model": str(model),
         "base_link": robot.base_link,
         "links": [{
