@@ -272,11 +272,13 @@ def test_world_model_option_picks_one():
     assert code == 2 and "'x500_0', 'x500_1', 'cart'" in output
 
 
-def test_world_json_with_several_models_is_a_list():
+def test_world_json_reports_each_model():
     code, output = run_cli("validate", WORLDS / "several_models.sdf", "--package-path", MODELS,
                            "--format", "json")
     assert code == 0
-    assert [doc["findings"] for doc in json.loads(output)] == [[], []]
+    models = json.loads(output)["models"]
+    assert [m["model"].rsplit(" ", 1)[-1] for m in models] == ["x500_0]", "x500_1]"]
+    assert [m["findings"] for m in models] == [[], []]
 
 
 def test_inertia_and_hover_test_take_model_option():
