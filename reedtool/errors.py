@@ -6,6 +6,8 @@ else that escapes is a bug in reedtool and is reported as such.
 
 from __future__ import annotations
 
+import errno
+import re
 from pathlib import Path
 
 
@@ -23,9 +25,56 @@ class ReedtoolError(Exception):
     def one_line(self) -> str:
         where = ""
         if self.file:
-            where = f"{self.file}:{self.line}: " if self.line else f"{self.file}: "
-        text = f"{where}{self.message}"
+            file = shorten(self.file, MAX_SHOWN_PATH)
+            where = f"{file}:{self.line}: " if self.line else f"{file}: "
+        text = f"{where}{shorten_names(self.message)}"
         if self.hint:
-            text += f" ({self.hint})"
+            text += f" ({shorten_names(self.hint)})"
         # Messages are one line by contract; embedded newlines from libraries are folded.
         return " ".join(text.split())
+
+
+# A name the user wrote (a link, a path, a value) is shown at most this long in a message:
+# a 1 MB link name echoed whole makes the message useless (issue 14).
+MAX_SHOWN_NAME = 80
+MAX_SHOWN_PATH = 240
+_QUOTED = re.compile(r"'([^']{%d,})'" % (MAX_SHOWN_NAME + 1))
+
+
+def shorten(text: str, limit: int = MAX_SHOWN_NAME) -> str:
+    """`text` cut to `limit` characters with an ellipsis in the middle (both ends stay)."""
+    text = str(text)
+    if len(text) <= limit:
+        return text
+    keep = limit - 1
+    return f"{text[:keep - keep // 3]}\u2026{text[len(text) - keep // 3:]}"
+
+
+def shorten_names(message: str) -> str:
+    """Every quoted name in a message shortened; an overlong message cut as a whole."""
+    message = _QUOTED.sub(lambda m: f"'{shorten(m.group(1))}'", message)
+    return shorten(message, 4 * MAX_SHOWN_PATH)
+
+
+_ERRNO_HINTS = {
+    errno.ENOSPC: "the disk is full: free some space and run again",
+    errno.EDQUOT: "the disk quota is exceeded: free some space and run again",
+    errno.ENAMETOOLONG: "the file name is too long for the filesystem: choose a shorter name",
+    errno.EACCES: "check the permissions, or choose another path",
+    errno.EPERM: "check the permissions, or choose another path",
+    errno.EROFS: "the filesystem is read-only: choose another path",
+    errno.EPIPE: "the reader of the output went away",
+    errno.EISDIR: "pass a file's path, not a directory",
+    errno.ENOTDIR: "a part of the path is not a directory",
+    errno.ELOOP: "too many symbolic links: check the path",
+    errno.EIO: "the device reported an input/output error",
+}
+
+
+def os_error(exc: OSError, file: str | Path | None = None, *,
+             action: str | None = None) -> ReedtoolError:
+    """An OSError from the user's environment as one ReedtoolError naming the file."""
+    file = file if file is not None else exc.filename
+    reason = exc.strerror or type(exc).__name__
+    message = f"cannot {action} file: {reason}" if action else reason
+    return ReedtoolError(message, file=file, hint=_ERRNO_HINTS.get(exc.errno))

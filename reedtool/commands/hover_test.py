@@ -48,7 +48,7 @@ MAX_STEPS = 10_000_000
 @click.option("--plot", "plot_path", type=click.Path(path_type=Path, dir_okay=False),
               help="Write a PNG of position, attitude and rotor speeds.")
 @click.option("--csv", "csv_path", type=click.Path(path_type=Path, dir_okay=False),
-              help="Write the sampled time series (100 Hz) as CSV.")
+              help="Write the sampled time series (100 Hz) as CSV ('-': standard output).")
 @click.option("--force", is_flag=True, help="Overwrite existing --plot/--csv files.")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
               show_default=True, help="Output format.")
@@ -91,10 +91,12 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
                             f"is {steps:.3g} steps, more than {MAX_STEPS:.0e}",
                             hint="a hover test settles in seconds; the defaults are 10 s at "
                                  "1000 Hz")
-    for path in (plot_path, csv_path):
-        if path is not None and path.exists() and not force:
-            raise ReedtoolError("refusing to overwrite an existing file", file=path,
-                                hint="pass --force to replace it")
+    from reedtool.io.fileio import check_writable
+
+    if plot_path is not None:   # fail before flying, not after
+        check_writable(plot_path, force)
+    if csv_path is not None:
+        check_writable(csv_path, force, stdout_ok=True)
     if not model.is_file():
         raise ReedtoolError("model file not found", file=model,
                             hint="pass the path of a .urdf or .xacro file")
@@ -258,7 +260,7 @@ def render_text(report: dict) -> str:
 
 
 def _write_csv(path: Path, series: dict, force: bool) -> None:
-    from reedtool.io.fileio import atomic_write_text
+    from reedtool.io.fileio import atomic_write_text, is_stdout, write_stdout
 
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
@@ -266,7 +268,10 @@ def _write_csv(path: Path, series: dict, force: bool) -> None:
     writer.writerow(keys)
     for row in zip(*(series[k] for k in keys)):
         writer.writerow([f"{float(v):.9g}" for v in row])
-    atomic_write_text(path, buffer.getvalue(), force=force)
+    if is_stdout(path):
+        write_stdout(buffer.getvalue())
+    else:
+        atomic_write_text(path, buffer.getvalue(), force=force)
 
 
 def _num(value, spec: str) -> str:
