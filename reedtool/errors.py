@@ -52,7 +52,11 @@ def shorten(text: str, limit: int = MAX_SHOWN_NAME) -> str:
 
 def shorten_names(message: str) -> str:
     """Every quoted name in a message shortened; an overlong message cut as a whole."""
-    message = _QUOTED.sub(lambda m: f"'{shorten(m.group(1))}'", message)
+    def cut(match: re.Match) -> str:
+        name = match.group(1)   # a path may be longer than a name and still be useful
+        return f"'{shorten(name, MAX_SHOWN_PATH if '/' in name else MAX_SHOWN_NAME)}'"
+
+    message = _QUOTED.sub(cut, message)
     return shorten(message, 4 * MAX_SHOWN_PATH)
 
 

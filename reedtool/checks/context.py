@@ -180,6 +180,7 @@ class CheckContext:
         key = str(mesh.path)
         if key not in self._mesh_errors:
             from reedtool.errors import ReedtoolError
+            from reedtool.io.fileio import MAX_MESH_COORDINATE
             from reedtool.io.meshes import check_triangles, triangle_areas
             from reedtool.io.stl import read_stl
 
@@ -187,7 +188,8 @@ class CheckContext:
             try:
                 triangles = read_stl(key).triangles
                 if len(triangles) == 0 or not np.isfinite(triangles).all() \
-                        or float(triangle_areas(triangles).sum()) == 0.0:
+                        or float(triangle_areas(triangles).sum()) == 0.0 \
+                        or float(np.abs(triangles).max()) > MAX_MESH_COORDINATE:
                     check_triangles(triangles, key)   # raises with the reason
             except ReedtoolError as exc:
                 error = exc.message

@@ -66,6 +66,27 @@ def open_regular_input(path: Path, *, what: str = "file", max_bytes: int | None 
     return os.fdopen(fd, "rb")
 
 
+# Meshes: 256 MB is a 5-million-triangle binary STL (84 + 50 bytes per facet), about
+# 1 GB of float64 work arrays downstream; robot part exports are far below that.
+MAX_MESH_BYTES = 256 * 1024 * 1024
+# Coordinates beyond 1e9 file units (1000 km in mm) are a damaged file, not a part:
+# 6e37 (a float32 bit pattern read as a coordinate) gives a 1e106 kg inertial.
+MAX_MESH_COORDINATE = 1e9
+
+
+def check_mesh_coordinates(triangles, source) -> None:
+    """Refuse a mesh whose coordinates are astronomically large (a damaged export)."""
+    import numpy as np
+
+    finite = np.abs(np.where(np.isfinite(triangles), triangles, 0.0))
+    largest = float(finite.max()) if finite.size else 0.0
+    if largest > MAX_MESH_COORDINATE:
+        raise ReedtoolError(f"mesh has a coordinate of {largest:.3g}, beyond the "
+                            f"{MAX_MESH_COORDINATE:.0e} (file units) a robot part can span",
+                            file=source, hint="the file is damaged or not a part; export it "
+                                              "again")
+
+
 # Text inputs (models, configs, specs) larger than this are not hand-written robot files.
 MAX_TEXT_BYTES = 256 * 1024 * 1024
 

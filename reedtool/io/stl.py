@@ -88,15 +88,12 @@ def _all_floats(words) -> bool:
 
 
 def read_stl(path: str | Path) -> StlFile:
+    from reedtool.io.fileio import MAX_MESH_BYTES, open_regular_input
+
     path = Path(path)
-    try:
-        data = path.read_bytes()
-    except FileNotFoundError as exc:
-        raise ReedtoolError("mesh file not found", file=path) from exc
-    except IsADirectoryError as exc:
-        raise ReedtoolError("is a directory, not a mesh file", file=path) from exc
-    except OSError as exc:
-        raise ReedtoolError(f"cannot read mesh: {exc.strerror}", file=path) from exc
+    # Type and size are checked on the open file before its body is read (issue 14).
+    with open_regular_input(path, what="mesh file", max_bytes=MAX_MESH_BYTES) as handle:
+        data = handle.read()
     return parse_stl(data, path)
 
 

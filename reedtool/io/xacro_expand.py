@@ -750,6 +750,7 @@ def expand_xacro(path: Path, mappings: dict[str, str] | None = None,
             sys.setrecursionlimit(old_limit)
 
     st.warnings.extend(line for line in captured.getvalue().splitlines() if line.strip())
+    st.warnings.extend(resolver.notes)
     element_locs = _with_urdf_lines(urdf_xml, sites, path)
     return Expansion(urdf_xml, element_locs, legacy.tags, resolver, st.warnings, st.files)
 
