@@ -82,3 +82,35 @@ def os_error(exc: OSError, file: str | Path | None = None, *,
     reason = exc.strerror or type(exc).__name__
     message = f"cannot {action} file: {reason}" if action else reason
     return ReedtoolError(message, file=file, hint=_ERRNO_HINTS.get(exc.errno))
+
+
+# ------------------------------------------------------------------ plausible ranges
+# One table of the physical ranges reedtool accepts from a user (command line and
+# new-package specs), SI units. Outside them the value is a typo or a unit slip
+# (`--arm-length 1e9`, `--rate 1e-3`), refused with exit 2 before any work, instead of
+# being flown and "failing" or generating a package that cannot hover.
+PLAUSIBLE: dict[str, tuple[float, float, str]] = {
+    # quantity: (lowest, highest, unit)
+    "mass": (1e-6, 1e4, "kg"),                 # a 1 mg part .. a 10 t vehicle
+    "length": (1e-5, 100.0, "m"),              # 10 um .. 100 m
+    "time": (1e-5, 100.0, "s"),                # motor time constants
+    "angular_velocity": (1.0, 1e5, "rad/s"),   # rotor speeds
+    "rate": (50.0, 1e5, "Hz"),                 # fixed-step integration; below 50 Hz a
+                                               # multirotor's attitude loop is not resolved
+    "duration": (0.1, 1e5, "s"),
+    "offset": (0.0, 1000.0, "m"),              # |start - setpoint| per axis
+    "angle": (0.0, 2 * 3.141592653589793, "rad"),  # |roll|, |pitch|, |yaw|
+}
+
+
+def check_plausible(quantity: str, value: float, what: str, *,
+                    file: str | Path | None = None, magnitude: bool = False) -> float:
+    """`value` if it lies in PLAUSIBLE[quantity] (its absolute value if `magnitude`)."""
+    low, high, unit = PLAUSIBLE[quantity]
+    number = abs(value) if magnitude else value
+    if not (low <= number <= high):    # NaN fails too
+        span = f"|{what}|" if magnitude else what
+        raise ReedtoolError(f"{span} = {value:g} {unit} is outside the plausible range "
+                            f"{low:g} .. {high:g} {unit}", file=file,
+                            hint="check the value and its unit")
+    return value
