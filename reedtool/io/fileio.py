@@ -55,8 +55,8 @@ def open_regular_input(path: Path, *, what: str = "file", max_bytes: int | None 
             raise ReedtoolError(f"is {kind}, not a regular file; refusing to read it as a "
                                 f"{what}", file=path, hint="pass the path of a file on disk")
         if max_bytes is not None and info.st_size > max_bytes:
-            raise ReedtoolError(f"{what} is {info.st_size / 1e6:.1f} MB, more than the "
-                                f"{max_bytes / 1e6:.0f} MB reedtool reads", file=path,
+            raise ReedtoolError(f"{what} is {info.st_size / 2**20:.1f} MB, more than the "
+                                f"{max_bytes / 2**20:.0f} MB reedtool reads", file=path,
                                 hint="is this the right file? simplify or split it")
         os.set_blocking(fd, True)
     except BaseException:
@@ -66,9 +66,13 @@ def open_regular_input(path: Path, *, what: str = "file", max_bytes: int | None 
     return os.fdopen(fd, "rb")
 
 
-# Meshes: 256 MB is a 5-million-triangle binary STL (84 + 50 bytes per facet), about
-# 1 GB of float64 work arrays downstream; robot part exports are far below that.
-MAX_MESH_BYTES = 256 * 1024 * 1024
+# Meshes: a robot part exports to well under a million triangles. Each triangle costs
+# ~72 bytes as float64 and several times that in topology/hull/inertia work arrays, so
+# 2 million (~1 GB of work) is the ceiling; a binary STL says its count in the header, so
+# it is refused without reading the body. Any mesh file above 512 MB is refused by size
+# (an ASCII STL at 2 M triangles is ~500 MB).
+MAX_MESH_TRIANGLES = 2_000_000
+MAX_MESH_BYTES = 512 * 1024 * 1024
 # Coordinates beyond 1e9 file units (1000 km in mm) are a damaged file, not a part:
 # 6e37 (a float32 bit pattern read as a coordinate) gives a 1e106 kg inertial.
 MAX_MESH_COORDINATE = 1e9

@@ -6,6 +6,7 @@ so every step is a vectorised numpy operation.
 
 from __future__ import annotations
 
+import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -93,8 +94,23 @@ def read_stl(path: str | Path) -> StlFile:
     path = Path(path)
     # Type and size are checked on the open file before its body is read (issue 14).
     with open_regular_input(path, what="mesh file", max_bytes=MAX_MESH_BYTES) as handle:
-        data = handle.read()
+        head = handle.read(84)
+        check_facet_count(head, os.fstat(handle.fileno()).st_size, path)
+        data = head + handle.read()
     return parse_stl(data, path)
+
+
+def check_facet_count(head: bytes, size: int, source) -> None:
+    """Refuse a binary STL whose header announces more facets than reedtool handles."""
+    from reedtool.io.fileio import MAX_MESH_TRIANGLES
+
+    if len(head) < 84:
+        return
+    count = int.from_bytes(head[80:84], "little")
+    if size == 84 + 50 * count and count > MAX_MESH_TRIANGLES:
+        raise ReedtoolError(f"binary STL with {count:,} triangles, more than the "
+                            f"{MAX_MESH_TRIANGLES:,} reedtool handles", file=source,
+                            hint="decimate the mesh in your CAD or mesh tool first")
 
 
 def stl_bytes(triangles: np.ndarray, header: str = "reedtool") -> bytes:
