@@ -80,7 +80,7 @@ def os_error(exc: OSError, file: str | Path | None = None, *,
     """An OSError from the user's environment as one ReedtoolError naming the file."""
     file = file if file is not None else exc.filename
     reason = exc.strerror or type(exc).__name__
-    message = f"cannot {action} file: {reason}" if action else reason
+    message = f"cannot {action}: {reason}" if action else reason
     return ReedtoolError(message, file=file, hint=_ERRNO_HINTS.get(exc.errno))
 
 

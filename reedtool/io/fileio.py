@@ -44,7 +44,7 @@ def open_regular_input(path: Path, *, what: str = "file", max_bytes: int | None 
     except OSError as exc:
         from reedtool.errors import os_error
 
-        raise os_error(exc, path, action="read") from exc
+        raise os_error(exc, path, action="read file") from exc
     try:
         info = os.fstat(fd)
         kind = _kind(info.st_mode)
@@ -107,7 +107,7 @@ def read_bytes(path: Path, *, what: str = "file", max_bytes: int | None = MAX_TE
         except OSError as exc:
             from reedtool.errors import os_error
 
-            raise os_error(exc, path, action="read") from exc
+            raise os_error(exc, path, action="read file") from exc
         except MemoryError:
             raise ReedtoolError(f"out of memory reading {what}", file=path,
                                 hint="is this the right file?") from None
@@ -316,7 +316,7 @@ def write_error(exc: OSError, path: Path | str | None) -> ReedtoolError:
     """An OSError while writing as one line naming the file and what to do."""
     from reedtool.errors import os_error
 
-    return os_error(exc, path, action="write")
+    return os_error(exc, path, action="write file")
 
 
 def free_backup_name(path: Path) -> Path:
