@@ -219,7 +219,9 @@ def command(mesh, package_dir, name, units, from_frame, mass_kg, density_kg_m3, 
     prints the <link> snippet (visual, collision and <inertial>) to paste into a URDF or
     xacro. Existing files are never overwritten without --force.
     """
-    big = mesh.is_file() and mesh.stat().st_size >= PROGRESS_MIN_BYTES
+    # Progress is for a person watching a terminal; in a pipe it is one more stderr line.
+    big = (sys.stderr.isatty() and mesh.is_file()
+           and mesh.stat().st_size >= PROGRESS_MIN_BYTES)
     kwargs = dict(name=name, units=units, from_frame=from_frame, mass_kg=mass_kg,
                   density_kg_m3=density_kg_m3, recenter=recenter, collision=collision,
                   snippet_file=snippet_file, force=force)
