@@ -40,6 +40,7 @@ import xacro
 from xacro import substitution_args
 
 from reedtool.errors import ReedtoolError
+from reedtool.io.fileio import MAX_TEXT_BYTES, note_input
 from reedtool.io.legacy_xacro import LegacyScan, LegacyTag, scan_tree
 from reedtool.io.packages import PackageResolver, is_bundled
 from reedtool.model import SourceLoc
@@ -484,7 +485,11 @@ def _patched(st: _Tracker):
             if path.exists() and not path.is_file() and not path.is_dir():
                 # /dev/zero or a pipe would be read forever.
                 raise OSError(errno.EINVAL, "not a regular file (a device or pipe?)", filename)
+            if path.is_file() and path.stat().st_size > MAX_TEXT_BYTES:
+                raise OSError(errno.EFBIG, f"larger than the {MAX_TEXT_BYTES >> 20} MB "
+                                           "reedtool reads", filename)
             data = path.read_bytes()
+            note_input(path)
         except OSError as exc:
             xacro.filestack.pop()   # as xacro does: the missing file is not "being processed"
             raise xacro.XacroException(f"{exc.strerror}: {filename}", exc=exc) from None
