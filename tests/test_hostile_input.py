@@ -450,3 +450,66 @@ def test_backups_are_numbered_and_never_replaced(tmp_path):
         == ["v0", "v1", "v2"]
     assert sorted(p.name for p in tmp_path.iterdir()) == \
         ["f.txt", "f.txt.bak", "f.txt.bak.1", "f.txt.bak.2"]   # no temporary left
+
+
+# ------------------------------------------------------------------ the building blocks
+
+def test_shorten_keeps_both_ends_within_the_limit():
+    from reedtool.errors import MAX_SHOWN_NAME, shorten, shorten_names
+
+    name = "head_" + "x" * 1000 + "_tail"
+    short = shorten(name)
+    assert len(short) == MAX_SHOWN_NAME and short.startswith("head_") and short.endswith("_tail")
+    assert shorten("base_link") == "base_link"
+    message = shorten_names(f"link '{name}' has no inertia")
+    assert message == f"link '{short}' has no inertia"
+
+
+@pytest.mark.parametrize("quantity, value, ok", [
+    ("rate", 1000.0, True), ("rate", 1e-3, False), ("rate", float("nan"), False),
+    ("length", 0.18738, True), ("length", 1e9, False), ("mass", 1.5, True),
+    ("mass", 0.0, False), ("offset", -5.0, True), ("offset", 1e300, False),
+])
+def test_plausible_ranges(quantity, value, ok):
+    from reedtool.errors import ReedtoolError, check_plausible
+
+    magnitude = quantity == "offset"
+    if ok:
+        assert check_plausible(quantity, value, "x", magnitude=magnitude) == value
+    else:
+        with pytest.raises(ReedtoolError, match="outside the plausible range"):
+            check_plausible(quantity, value, "x", magnitude=magnitude)
+
+
+def test_create_without_force_fails_if_the_name_appears_meanwhile(tmp_path, monkeypatch):
+    """The check-then-publish race: the name is taken between the check and the write."""
+    import reedtool.io.fileio as fileio
+    from reedtool.errors import ReedtoolError
+
+    target = tmp_path / "out.urdf"
+    real_stage = fileio._stage
+
+    def stage_then_competitor_writes(path, data, created):
+        name = real_stage(path, data, created)
+        target.write_text("the other writer's file")
+        return name
+
+    monkeypatch.setattr(fileio, "_stage", stage_then_competitor_writes)
+    with pytest.raises(ReedtoolError, match="created meanwhile"):
+        fileio.atomic_write_text(target, "mine")
+    assert target.read_text() == "the other writer's file"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.urdf"]
+
+
+def test_open_regular_input_refuses_without_blocking(tmp_path):
+    from reedtool.errors import ReedtoolError
+    from reedtool.io.fileio import open_regular_input
+
+    os.mkfifo(tmp_path / "pipe")       # no writer: a blocking open would never return
+    with pytest.raises(ReedtoolError, match="FIFO"):
+        open_regular_input(tmp_path / "pipe")
+    (tmp_path / "big").write_bytes(b"x" * 2000)
+    with pytest.raises(ReedtoolError, match="more than"):
+        open_regular_input(tmp_path / "big", max_bytes=1000)
+    with open_regular_input(tmp_path / "big", max_bytes=2000) as handle:
+        assert len(handle.read()) == 2000
