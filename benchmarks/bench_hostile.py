@@ -21,7 +21,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT))
 
-from test_hostile_input import CASES, make_tree  # noqa: E402  (the one table of cases)
+from test_hostile_input import CASES, make_tree  # the one table of cases
 
 TARGET_PEAK_MB = 200.0
 TARGET_WALL_S = 5.0

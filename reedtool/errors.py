@@ -38,7 +38,7 @@ class ReedtoolError(Exception):
 # a 1 MB link name echoed whole makes the message useless (issue 14).
 MAX_SHOWN_NAME = 80
 MAX_SHOWN_PATH = 240
-_QUOTED = re.compile(r"'([^']{%d,})'" % (MAX_SHOWN_NAME + 1))
+_QUOTED = re.compile(rf"'([^']{{{MAX_SHOWN_NAME + 1},}})'")
 
 
 def shorten(text: str, limit: int = MAX_SHOWN_NAME) -> str:

@@ -23,9 +23,9 @@ import stat
 import struct
 import subprocess
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
 
 import pytest
 
@@ -69,9 +69,9 @@ def sparse_stl(path: Path, facets: int, header_count: int | None = None) -> None
 
 def many_rotor_urdf(n: int) -> str:
     """n RotorS rotors on a circle, alternating directions (a generated-wrongly model)."""
-    parts = ['<?xml version="1.0"?>\n<robot name="many">\n  <link name="base_link">\n'
-             '    <inertial><mass value="1.5"/><inertia ixx="0.03" ixy="0" ixz="0" iyy="0.03" '
-             'iyz="0" izz="0.06"/></inertial>\n  </link>\n']
+    parts = [('<?xml version="1.0"?>\n<robot name="many">\n  <link name="base_link">\n'
+              '    <inertial><mass value="1.5"/><inertia ixx="0.03" ixy="0" ixz="0" iyy="0.03" '
+              'iyz="0" izz="0.06"/></inertial>\n  </link>\n')]
     for i in range(n):
         a = 2 * math.pi * (i + 0.5) / n
         parts.append(
@@ -181,7 +181,7 @@ def run_subprocess(args, cwd: Path, **kwargs) -> tuple[int, str, str]:
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     proc = subprocess.run([sys.executable, "-c", "from reedtool.cli import main; main()",
                            *map(str, args)], cwd=cwd, env=env, capture_output=True,
-                          text=True, timeout=TIMEOUT_S, **kwargs)
+                          text=True, timeout=TIMEOUT_S, check=False, **kwargs)
     return proc.returncode, proc.stdout, proc.stderr
 
 
@@ -371,7 +371,7 @@ def test_inertia_fix_through_a_symlink_keeps_the_link(tmp_path, capsys):
     link = tmp_path / "install" / "quad.urdf"
     link.parent.mkdir()
     link.symlink_to(real)
-    code, out, err = run_inprocess(["inertia", link, "--fix"], capsys)
+    code, _out, err = run_inprocess(["inertia", link, "--fix"], capsys)
     assert code == 0, err
     assert link.is_symlink() and os.readlink(link) == str(real)
     assert real.read_bytes() != QUAD.read_bytes()                  # the real file was fixed
@@ -394,13 +394,13 @@ def _run_to(stdout, cwd: Path) -> tuple[int, str, str]:
     proc = subprocess.run([sys.executable, "-c", "from reedtool.cli import main; main()",
                            "expand", "smartcar_description/urdf/smartcar.urdf.xacro"],
                           cwd=cwd, env=env, stdout=stdout, stderr=subprocess.PIPE, text=True,
-                          timeout=TIMEOUT_S)
+                          timeout=TIMEOUT_S, check=False)
     return proc.returncode, "", proc.stderr
 
 
 def test_long_link_name_is_shortened_in_findings(scratch, monkeypatch, capsys):
     monkeypatch.chdir(scratch)
-    code, out, err = run_inprocess(["validate", "longname.urdf"], capsys)
+    code, out, _err = run_inprocess(["validate", "longname.urdf"], capsys)
     assert code == 1 and "S104" in out               # the second root is reported ...
     assert max(len(line) for line in out.splitlines()) < 400   # ... without 1 MB of 'L'
     assert "\u2026" in out
@@ -426,7 +426,7 @@ def test_environment_errors_are_one_line_not_internal(exc, fragment, monkeypatch
 
 
 def test_package_scan_is_bounded(tmp_path, monkeypatch, capsys):
-    import reedtool.io.packages as packages
+    from reedtool.io import packages
 
     monkeypatch.setattr(packages, "MAX_CRAWL_DIRS", 30)
     for i in range(40):
@@ -483,8 +483,8 @@ def test_plausible_ranges(quantity, value, ok):
 
 def test_create_without_force_fails_if_the_name_appears_meanwhile(tmp_path, monkeypatch):
     """The check-then-publish race: the name is taken between the check and the write."""
-    import reedtool.io.fileio as fileio
     from reedtool.errors import ReedtoolError
+    from reedtool.io import fileio
 
     target = tmp_path / "out.urdf"
     real_stage = fileio._stage

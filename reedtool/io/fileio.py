@@ -17,8 +17,8 @@ import re
 import shutil
 import stat
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 from reedtool.errors import ReedtoolError
 
