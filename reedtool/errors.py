@@ -93,6 +93,7 @@ PLAUSIBLE: dict[str, tuple[float, float, str]] = {
     # quantity: (lowest, highest, unit)
     "mass": (1e-6, 1e4, "kg"),                 # a 1 mg part .. a 10 t vehicle
     "length": (1e-5, 100.0, "m"),              # 10 um .. 100 m
+    "density": (0.1, 1e5, "kg/m^3"),           # aerogel .. beyond osmium (22,590)
     "time": (1e-5, 100.0, "s"),                # motor time constants
     "angular_velocity": (1.0, 1e5, "rad/s"),   # rotor speeds
     "rate": (50.0, 1e5, "Hz"),                 # fixed-step integration; below 50 Hz a
@@ -110,7 +111,8 @@ def check_plausible(quantity: str, value: float, what: str, *,
     number = abs(value) if magnitude else value
     if not (low <= number <= high):    # NaN fails too
         span = f"|{what}|" if magnitude else what
-        raise ReedtoolError(f"{span} = {value:g} {unit} is outside the plausible range "
+        where = "must be positive and within" if value <= 0 < low else "is outside"
+        raise ReedtoolError(f"{span} = {value:g} {unit} {where} the plausible range "
                             f"{low:g} .. {high:g} {unit}", file=file,
                             hint="check the value and its unit")
     return value

@@ -98,6 +98,12 @@ def run_import(mesh: Path, package_dir: Path, *, name: str | None = None, units:
     from reedtool.physics.mesh_import import import_mesh
 
     axis_convention(from_frame)  # an unknown frame is the error to report, not a refusal
+    from reedtool.errors import check_plausible
+
+    if mass_kg is not None:
+        check_plausible("mass", mass_kg, "--mass")
+    if density_kg_m3 is not None:
+        check_plausible("density", density_kg_m3, "--density")
     package = package_name(package_dir)
     name = name or default_name(mesh)
     if not NAME_RE.match(name):
