@@ -119,8 +119,9 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
                             f"is {steps:.3g} steps, more than {MAX_STEPS:.0e}",
                             hint="a hover test settles in seconds; the defaults are 10 s at "
                                  "1000 Hz")
-    from reedtool.io.fileio import check_writable
+    from reedtool.io.fileio import check_writable, note_input
 
+    note_input(model)           # the model is never an output of its own test
     if plot_path is not None:   # fail before flying, not after
         check_writable(plot_path, force)
     if csv_path is not None:
