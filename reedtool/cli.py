@@ -57,15 +57,19 @@ def cli() -> None:
 
 def _usage_error_line(exc: click.UsageError) -> str:
     """A click usage error as one line, like every other reedtool error."""
-    text = " ".join(exc.format_message().split())
+    from reedtool.errors import shorten_names
+
+    text = shorten_names(" ".join(exc.format_message().split()))
     command = exc.ctx.command_path if exc.ctx is not None else "reedtool"
     return f"reedtool: error: {text} (see '{command} --help')"
 
 
 def main(argv: list[str] | None = None) -> None:
     """Console-script entry: user errors become one line and exit 2, never a traceback."""
-    from reedtool.errors import ReedtoolError
+    from reedtool.errors import ReedtoolError, os_error, shorten
+    from reedtool.io.fileio import reset_inputs
 
+    reset_inputs()
     try:
         with warnings.catch_warnings():
             if not os.environ.get("REEDTOOL_DEBUG"):
@@ -75,6 +79,7 @@ def main(argv: list[str] | None = None) -> None:
             # Commands return their exit code (0 ok, 1 findings/failed check); --help and
             # --version return None through click's Exit.
             exit_code = cli.main(args=argv, prog_name="reedtool", standalone_mode=False)
+            sys.stdout.flush()   # a full disk or closed pipe on stdout is reported here
     except click.exceptions.Abort:
         click.echo("reedtool: aborted", err=True)
         sys.exit(130)
@@ -92,6 +97,25 @@ def main(argv: list[str] | None = None) -> None:
         sys.exit(2)
     except KeyboardInterrupt:
         sys.exit(130)
+    except BrokenPipeError:
+        # `reedtool expand M | head`: the reader has what it wanted; not an error.
+        _quiet_stdout()
+        sys.exit(141 if argv is None else 2)
+    except OSError as exc:
+        # The user's environment (full disk, long name, permissions, read-only fs), not a bug.
+        target = exc.filename if exc.filename is not None else "<standard output>"
+        click.echo(f"reedtool: error: {os_error(exc, target).one_line()}", err=True)
+        _quiet_stdout()
+        sys.exit(2)
+    except UnicodeDecodeError as exc:
+        click.echo(f"reedtool: error: cannot decode a file as text: {shorten(str(exc), 200)} "
+                   "(is a binary file where a text file is expected? save it as UTF-8)",
+                   err=True)
+        sys.exit(2)
+    except MemoryError:
+        click.echo("reedtool: error: out of memory (the input or the options ask for more "
+                   "than this machine has: use a smaller model, mesh or --samples)", err=True)
+        sys.exit(2)
     except Exception as exc:  # noqa: BLE001 - the last line of defence against tracebacks
         if os.environ.get("REEDTOOL_DEBUG"):
             raise
@@ -101,3 +125,13 @@ def main(argv: list[str] | None = None) -> None:
                    "and report it)", err=True)
         sys.exit(2)
     sys.exit(exit_code if isinstance(exit_code, int) else 0)
+
+
+def _quiet_stdout() -> None:
+    """Point stdout at /dev/null so the interpreter's final flush of a dead stdout is silent."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError):
+        pass

@@ -92,9 +92,14 @@ def _load_toml(path: Path) -> dict:
         import tomllib
     else:  # pragma: no cover - exercised on 3.10 only
         import tomli as tomllib
+    from reedtool.io.fileio import open_regular_input
+
     try:
-        with open(path, "rb") as handle:
+        with open_regular_input(path, what="config file", max_bytes=1 << 20) as handle:
             return tomllib.load(handle)
+    except UnicodeDecodeError:
+        raise ReedtoolError("not a text file (bytes that are not UTF-8)", file=path,
+                            hint="is this the right file? save it as UTF-8 text") from None
     except OSError as exc:
         raise ReedtoolError(f"cannot read config: {exc.strerror}", file=path) from exc
     except tomllib.TOMLDecodeError as exc:

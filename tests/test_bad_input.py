@@ -171,7 +171,9 @@ CASES = [
      2, "--com-spread"),
     ("hover-nan-pass-rate", ["hover-test", "model.urdf", "--min-pass-rate", "nan"],
      2, "--min-pass-rate"),
-    ("hover-endless-duration", ["hover-test", "model.urdf", "--duration", "1e9"], 2, "steps"),
+    ("hover-endless-duration", ["hover-test", "model.urdf", "--duration", "1e9"], 2, "--duration"),
+    ("hover-too-many-steps", ["hover-test", "model.urdf", "--duration", "1e4", "--rate", "1e4"],
+     2, "steps"),
     ("hover-zero-rate", ["hover-test", "model.urdf", "--rate", "0"], 2, "rate"),
     ("hover-negative-duration", ["hover-test", "model.urdf", "--duration", "-1"], 2, "duration"),
     # --- import-stl

@@ -90,15 +90,15 @@ def test_fix_rewrites_a_urdf_with_backup(tmp_path, capsys):
     assert code == 0 and "nothing to change" in out
 
 
-def test_fix_refuses_to_overwrite_a_backup(tmp_path, capsys):
+def test_fix_never_overwrites_an_older_backup(tmp_path, capsys):
     model = tmp_path / "smartcar.urdf"
-    model.write_text((FIXTURES / "smartcar_wheel.urdf").read_text())
+    original = (FIXTURES / "smartcar_wheel.urdf").read_text()
+    model.write_text(original)
     (tmp_path / "smartcar.urdf.bak").write_text("precious")
     code, out, err = run([model, "--fix"], capsys)
-    assert code == 2 and "backup" in err
+    assert code == 0 and "smartcar.urdf.bak.1" in out + err
     assert (tmp_path / "smartcar.urdf.bak").read_text() == "precious"
-    code, out, err = run([model, "--fix", "--force"], capsys)
-    assert code == 0
+    assert (tmp_path / "smartcar.urdf.bak.1").read_text() == original
 
 
 def test_fix_on_xacro_prints_blocks_with_their_lines(capsys):

@@ -78,6 +78,7 @@ def test_packages_do_not_nest(tmp_path):
 
 
 def test_missing_package_error_names_package_requester_and_places(tmp_path):
+    (tmp_path / "extra").mkdir()
     resolver = PackageResolver([tmp_path / "extra"])
     with pytest.raises(ReedtoolError) as info:
         resolver.find("nope", requested_by=SourceLoc("robot.xacro", 12))

@@ -255,13 +255,15 @@ class CheckContext:
             return read.message
         key = str(mesh.path)
         if key not in self._mesh_errors:
+            from reedtool.io.fileio import MAX_MESH_COORDINATE
             from reedtool.io.meshes import check_triangles, triangle_areas
 
             error = ""
             triangles = read.triangles
             try:
                 if len(triangles) == 0 or not np.isfinite(triangles).all() \
-                        or float(triangle_areas(triangles).sum()) == 0.0:
+                        or float(triangle_areas(triangles).sum()) == 0.0 \
+                        or float(np.abs(triangles).max()) > MAX_MESH_COORDINATE:
                     check_triangles(triangles, key)   # raises with the reason
             except ReedtoolError as exc:
                 error = exc.message

@@ -17,7 +17,7 @@ from typing import Iterable, Mapping, Sequence
 from reedtool.checks.context import CheckContext
 from reedtool.checks.finding import SEVERITIES, Finding
 from reedtool.checks.registry import Rule, all_rules
-from reedtool.errors import ReedtoolError
+from reedtool.errors import ReedtoolError, shorten, shorten_names
 from reedtool.model import Robot
 
 _SELECTOR = re.compile(r"^[A-Z]\d{0,3}$")
@@ -101,10 +101,14 @@ def run_checks(robot: Robot, selection: Selection | None = None, *,
         severity = selection.severity_of(rule)
         for issue in rule.check(ctx):
             loc = issue.loc or robot.loc
+            # Names the user wrote are shown at most ~80 characters long (a 1 MB link name
+            # would otherwise be echoed whole); errors.shorten is the one place for that.
             findings.add(Finding(code=rule.code, slug=rule.slug, severity=severity,
-                                 message=issue.message, subject=issue.subject,
+                                 message=shorten_names(issue.message),
+                                 subject=shorten(issue.subject) if issue.subject else None,
                                  file=loc.file if loc else None,
-                                 line=loc.line if loc else None, hint=issue.hint,
+                                 line=loc.line if loc else None,
+                                 hint=shorten_names(issue.hint) if issue.hint else None,
                                  macro=loc.macro if loc else None))
     return sorted(findings, key=Finding.sort_key)
 

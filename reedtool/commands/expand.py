@@ -19,7 +19,7 @@ def _fix_legacy(model: Path, mappings: dict[str, str], package_paths: list[Path]
         if is_bundled(path):
             continue  # reedtool's own files are never rewritten
         count = sum(1 for tag in scan.tags if tag.file == display_path(path))
-        backup = atomic_write_text(path, text, force=True, backup=True)
+        backup = atomic_write_text(path, text, force=True, backup=True, in_place=True)
         click.echo(f"reedtool: rewrote {count} legacy xacro tag(s) in {display_path(path)} "
                    f"(backup: {display_path(backup) if backup else 'none'})", err=True)
 
@@ -28,7 +28,7 @@ def _fix_legacy(model: Path, mappings: dict[str, str], package_paths: list[Path]
 @click.argument("model", type=click.Path(path_type=Path, dir_okay=False))
 @click.argument("args", nargs=-1, metavar="[NAME:=VALUE]...")
 @click.option("-o", "--output", type=click.Path(path_type=Path, dir_okay=False),
-              help="Write the URDF here instead of standard output.")
+              help="Write the URDF here instead of standard output ('-': standard output).")
 @click.option("--package-path", "package_paths", multiple=True,
               type=click.Path(path_type=Path, file_okay=False),
               help="Directory searched first for ROS packages (repeatable).")
@@ -42,11 +42,14 @@ def command(model: Path, args: tuple[str, ...], output: Path | None,
 
     Arguments NAME:=VALUE set $(arg NAME), as roslaunch and xacro take them.
     """
-    from reedtool.io.fileio import atomic_write_text, check_writable
+    from reedtool.io.fileio import atomic_write_text, check_writable, is_stdout, note_input
     from reedtool.io.mappings import parse_mappings
     from reedtool.io.xacro_expand import expand_xacro
 
     mappings = parse_mappings(args)
+    if is_stdout(output):
+        output = None
+    note_input(model)
     if output is not None:
         check_writable(output, force)   # fail before the work, not after
     if fix_legacy:
@@ -67,6 +70,8 @@ def command(model: Path, args: tuple[str, ...], output: Path | None,
     if output is None:
         click.echo(expansion.urdf_xml, nl=False)
     else:
+        for source in expansion.files:
+            note_input(source)   # every xacro the model pulled in is off limits as output
         atomic_write_text(output, expansion.urdf_xml, force=force)
         click.echo(f"reedtool: wrote {output}", err=True)
     return 0

@@ -7,6 +7,7 @@ Exit 0 when the model hovers (and the batch meets --min-pass-rate), 1 when it do
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import json
@@ -32,6 +33,24 @@ def _validation_json(errors, refused: bool) -> dict:
     return {"errors": [f.to_dict() for f in errors], "refused": refused}
 
 
+# The robustness batch flies all vehicles at once as (k, N) float64 arrays: about 200 state,
+# command and bookkeeping values per vehicle plus ~20 per rotor (measured: 10^7 quads took
+# 22 GB). Estimated before allocating, against --max-memory.
+BATCH_BYTES_PER_VEHICLE = 8 * 200
+BATCH_BYTES_PER_VEHICLE_ROTOR = 8 * 20
+DEFAULT_MAX_MEMORY_MB = 2048
+# Real multirotors have 3 to 16 rotors; a model with hundreds is generated wrongly, and its
+# (rotors x rotors) allocation work is what ran out of memory at 2000.
+MAX_ROTORS = 64
+# A run longer than this on a terminal shows that it is still working.
+PROGRESS_AFTER_S = 2.0
+
+
+def batch_memory_bytes(samples: int, n_rotors: int) -> int:
+    """Estimated peak memory of flying `samples` perturbed vehicles together."""
+    return samples * (BATCH_BYTES_PER_VEHICLE + n_rotors * BATCH_BYTES_PER_VEHICLE_ROTOR)
+
+
 @click.command(name="hover-test")
 @click.argument("model", type=click.Path(path_type=Path, dir_okay=False))
 @click.argument("mappings", nargs=-1)
@@ -54,12 +73,15 @@ def _validation_json(errors, refused: bool) -> dict:
 @click.option("--plot", "plot_path", type=click.Path(path_type=Path, dir_okay=False),
               help="Write a PNG of position, attitude and rotor speeds.")
 @click.option("--csv", "csv_path", type=click.Path(path_type=Path, dir_okay=False),
-              help="Write the sampled time series (100 Hz) as CSV.")
+              help="Write the sampled time series (100 Hz) as CSV ('-': standard output).")
 @click.option("--force", is_flag=True, help="Overwrite existing --plot/--csv files.")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
               show_default=True, help="Output format.")
 @click.option("--samples", type=click.IntRange(min=1), default=None,
               help="Also fly N perturbed vehicles (robustness batch).")
+@click.option("--max-memory", "max_memory_mb", type=click.IntRange(min=16),
+              default=DEFAULT_MAX_MEMORY_MB, show_default=True, metavar="MB",
+              help="Refuse a robustness batch estimated to need more memory than this.")
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Random seed of the robustness batch.")
 @click.option("--mass-spread", type=FiniteFloatRange(0.0, 0.9), default=0.10,
@@ -83,7 +105,8 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
             model_name: str | None,
             duration_s: float, rate_hz: float, offset_m: tuple[float, float, float],
             roll_rad: float, pitch_rad: float, yaw_rad: float, plot_path: Path | None,
-            csv_path: Path | None, force: bool, fmt: str, samples: int | None, seed: int,
+            csv_path: Path | None, force: bool, fmt: str, samples: int | None,
+            max_memory_mb: int, seed: int,
             mass_spread: float, com_spread_m: float, inertia_spread: float,
             motor_spread: float, engine: str, min_pass_rate: float,
             ignore_validation: bool = False) -> int:
@@ -94,8 +117,15 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     errors for is not flown (exit 1) unless --ignore-validation is given: a hover of a
     model Gazebo would simulate differently is not a pass.
     """
+    from reedtool.errors import check_plausible
     from reedtool.sim import HoverConfig
 
+    check_plausible("rate", rate_hz, "--rate")
+    check_plausible("duration", duration_s, "--duration")
+    for axis, value in zip("xyz", offset_m):
+        check_plausible("offset", value, f"--offset {axis}", magnitude=True)
+    for option, value in (("--roll", roll_rad), ("--pitch", pitch_rad), ("--yaw", yaw_rad)):
+        check_plausible("angle", value, option, magnitude=True)
     config = HoverConfig(duration_s=duration_s, rate_hz=rate_hz, offset_m=tuple(offset_m),
                          roll_rad=roll_rad, pitch_rad=pitch_rad, yaw_rad=yaw_rad)
     try:
@@ -117,10 +147,13 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     if plot_path is not None and plot_path.suffix.lower() not in (".png", ".svg"):
         raise ReedtoolError(f"cannot tell the plot format from '{plot_path.suffix or plot_path.name}'",
                             file=plot_path, hint="name the --plot file .png or .svg")
-    for path in (plot_path, csv_path):
-        if path is not None and path.exists() and not force:
-            raise ReedtoolError("refusing to overwrite an existing file", file=path,
-                                hint="pass --force to replace it")
+    from reedtool.io.fileio import check_writable, note_input
+
+    note_input(model)           # the model is never an output of its own test
+    if plot_path is not None:   # fail before flying, not after
+        check_writable(plot_path, force)
+    if csv_path is not None:
+        check_writable(csv_path, force, stdout_ok=True)
     if not model.is_file():
         raise ReedtoolError("model file not found", file=model,
                             hint="pass the path of a .urdf or .xacro file")
@@ -163,7 +196,8 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     report = hover_test(robot, config, samples=samples, seed=seed,
                         spreads=(mass_spread, com_spread_m, inertia_spread, motor_spread),
                         record=bool(plot_path or csv_path), show_progress=fmt == "text",
-                        engine=engine, envelope=plot_path is not None)
+                        engine=engine, envelope=plot_path is not None,
+                        max_memory_bytes=max_memory_mb * 1024 * 1024)
     batch = report.get("batch")
     if batch is not None:
         batch["min_pass_rate"] = min_pass_rate
@@ -205,7 +239,8 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
 def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
                spreads: tuple[float, float, float, float] = (0.1, 0.01, 0.1, 0.05),
                record: bool = False, show_progress: bool = False,
-               engine: str = "numpy", envelope: bool = False) -> dict:
+               engine: str = "numpy", envelope: bool = False,
+               max_memory_bytes: int = DEFAULT_MAX_MEMORY_MB * 1024 * 1024) -> dict:
     """Trim, simulate and (optionally) batch one robot; the JSON-ready report.
 
     Keys: "model", "trim", "sim" (None when the trim failed), "batch" (None without
@@ -222,6 +257,20 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
     # Hover is held by the lift rotors: a VTOL's pusher or a plane's puller stays off.
     every_rotor = discover_rotors(robot)
     rotors = lift_rotors(every_rotor)
+    if len(every_rotor) > MAX_ROTORS:
+        raise ReedtoolError(f"{len(every_rotor)} rotors: more than the {MAX_ROTORS} a multirotor "
+                            "hover test handles", file=robot.source_file,
+                            hint="is the model generated wrongly? real multirotors have 3 to "
+                                 "16 rotors")
+    if samples:
+        need = batch_memory_bytes(samples, len(rotors))
+        if need > max_memory_bytes:
+            fit = max_memory_bytes // batch_memory_bytes(1, len(rotors))
+            raise ReedtoolError(f"--samples {samples} needs about {need / 2**20:,.0f} MB for "
+                                f"{len(rotors)} rotors, more than --max-memory "
+                                f"{max_memory_bytes // 2**20} MB",
+                                hint=f"use --samples {fit} or fewer (a few hundred give the "
+                                     "pass rate to a few percent), or raise --max-memory")
     props = whole_robot_pinocchio(robot)
     trim = solve_trim(props.mass_kg, props.com_m, rotors)
     report: dict = {
@@ -256,7 +305,9 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
 
     from reedtool.sim.run import simulate_hover
 
-    run = simulate_hover(params, config, record=record, engine=engine)
+    with _still_working(f"flying {config.duration_s:g} s at {config.rate_hz:g} Hz",
+                        show_progress):
+        run = simulate_hover(params, config, record=record, engine=engine)
     sim = run.to_dict()
     sim["trim_omega_rad_s"] = dict(zip(params.rotor_names,
                                        (float(w) for w in trim.omega_rad_s)))
@@ -283,6 +334,40 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
         report["batch"] = batch.to_dict()
         report["_envelope"] = batch.envelope
     return report
+
+
+@contextlib.contextmanager
+def _still_working(label: str, enabled: bool):
+    """On a terminal, after PROGRESS_AFTER_S, say on stderr every second that work goes on.
+
+    The single flight runs inside one compiled call that reports nothing; a thread prints
+    the elapsed time so a long run (--duration 10000) is not mistaken for a hang.
+    """
+    if not (enabled and sys.stderr.isatty()):
+        yield
+        return
+    import threading
+    import time
+
+    done = threading.Event()
+    start = time.monotonic()
+
+    def tick() -> None:
+        if done.wait(PROGRESS_AFTER_S):
+            return
+        while not done.wait(1.0):
+            sys.stderr.write(f"\r{label}: {time.monotonic() - start:.0f} s elapsed")
+            sys.stderr.flush()
+        sys.stderr.write("\r\033[K")
+        sys.stderr.flush()
+
+    thread = threading.Thread(target=tick, daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        done.set()
+        thread.join()
 
 
 # ------------------------------------------------------------------ output
@@ -342,7 +427,7 @@ def render_text(report: dict) -> str:
 
 
 def _write_csv(path: Path, series: dict, force: bool) -> None:
-    from reedtool.io.fileio import atomic_write_text
+    from reedtool.io.fileio import atomic_write_text, is_stdout, write_stdout
 
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
@@ -350,7 +435,10 @@ def _write_csv(path: Path, series: dict, force: bool) -> None:
     writer.writerow(keys)
     for row in zip(*(series[k] for k in keys)):
         writer.writerow([f"{float(v):.9g}" for v in row])
-    atomic_write_text(path, buffer.getvalue(), force=force)
+    if is_stdout(path):
+        write_stdout(buffer.getvalue())
+    else:
+        atomic_write_text(path, buffer.getvalue(), force=force)
 
 
 def _num(value, spec: str) -> str:

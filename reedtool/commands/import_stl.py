@@ -98,6 +98,12 @@ def run_import(mesh: Path, package_dir: Path, *, name: str | None = None, units:
     from reedtool.physics.mesh_import import import_mesh
 
     axis_convention(from_frame)  # an unknown frame is the error to report, not a refusal
+    from reedtool.errors import check_plausible
+
+    if mass_kg is not None:
+        check_plausible("mass", mass_kg, "--mass")
+    if density_kg_m3 is not None:
+        check_plausible("density", density_kg_m3, "--density")
     package = package_name(package_dir)
     name = name or default_name(mesh)
     if not NAME_RE.match(name):
@@ -219,7 +225,9 @@ def command(mesh, package_dir, name, units, from_frame, mass_kg, density_kg_m3, 
     prints the <link> snippet (visual, collision and <inertial>) to paste into a URDF or
     xacro. Existing files are never overwritten without --force.
     """
-    big = mesh.is_file() and mesh.stat().st_size >= PROGRESS_MIN_BYTES
+    # Progress is for a person watching a terminal; in a pipe it is one more stderr line.
+    big = (sys.stderr.isatty() and mesh.is_file()
+           and mesh.stat().st_size >= PROGRESS_MIN_BYTES)
     kwargs = dict(name=name, units=units, from_frame=from_frame, mass_kg=mass_kg,
                   density_kg_m3=density_kg_m3, recenter=recenter, collision=collision,
                   snippet_file=snippet_file, force=force)

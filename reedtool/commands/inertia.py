@@ -185,10 +185,6 @@ def apply_fix_urdf(model: Path, comparisons, force: bool) -> list[str]:
     todo = [(c, props) for c, props in todo if props is not None]
     if not todo:
         return ["--fix: nothing to change"]
-    backup = model.with_name(model.name + ".bak")
-    if backup.exists() and not force:
-        raise ReedtoolError("refusing to overwrite the existing backup", file=backup,
-                            hint="move it away, or pass --force to replace it")
     text, encoding = read_xml_file(model, what="URDF file")
     fixes = []
     for c, props in todo:
@@ -205,7 +201,8 @@ def apply_fix_urdf(model: Path, comparisons, force: bool) -> list[str]:
                                    rtol=1e-8, atol=1e-12 * np.abs(props.inertia_kg_m2).max())):
             raise ReedtoolError(f"internal check failed rewriting link '{c.link}'; "
                                 "the file was left unchanged", file=model)
-    atomic_write_text(model, new_text, force=True, backup=True, encoding=encoding)
+    backup = atomic_write_text(model, new_text, force=True, backup=True, encoding=encoding,
+                               in_place=True)
     return [f"--fix: rewrote <inertial> of {', '.join(c.link for c, _ in todo)} in {model} "
             f"(backup: {backup})"]
 
@@ -241,7 +238,9 @@ def print_fix_xacro(comparisons) -> list[str]:
 @click.option("--fix", is_flag=True,
               help="Write the geometry's inertia into a .urdf (with a .bak backup); for a "
                    ".xacro, print the blocks to paste and where.")
-@click.option("--force", is_flag=True, help="With --fix, replace an existing .bak backup.")
+@click.option("--force", is_flag=True,
+              help="Kept for compatibility: --fix never overwrites a backup (it picks the first "
+                   "free NAME.bak, NAME.bak.1, ...).")
 def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
             model_name: str | None, fmt: str,
             fix: bool, force: bool) -> int:

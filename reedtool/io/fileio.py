@@ -11,41 +11,106 @@ do, whatever it is (missing, a directory, a device, binary, another encoding).
 from __future__ import annotations
 
 import codecs
+import errno
 import os
 import re
 import shutil
 import stat
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 from reedtool.errors import ReedtoolError
 
 # ------------------------------------------------------------------ reading
 
 
-def read_bytes(path: Path, *, what: str = "file") -> bytes:
+def open_regular_input(path: Path, *, what: str = "file", max_bytes: int | None = None):
+    """A binary handle on a regular file, checked before a byte is read.
+
+    Opened non-blocking, so a FIFO cannot hang the open, then fstat-ed (the file itself,
+    not whatever the name pointed to a moment earlier): a FIFO, device, socket or
+    directory is refused, and a file larger than `max_bytes` is refused without reading.
+    The path is noted as an input of this run (no output may replace it).
+    """
+    path = Path(path)
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except FileNotFoundError as exc:
+        raise ReedtoolError(f"{what} not found", file=path, hint="check the path") from exc
+    except IsADirectoryError as exc:
+        raise ReedtoolError(f"is a directory, not a {what}", file=path,
+                            hint="pass the file's path") from exc
+    except OSError as exc:
+        from reedtool.errors import os_error
+
+        raise os_error(exc, path, action="read file") from exc
+    try:
+        info = os.fstat(fd)
+        kind = _kind(info.st_mode)
+        if kind == "a directory":
+            raise ReedtoolError(f"is a directory, not a {what}", file=path,
+                                hint="pass the file's path")
+        if kind is not None:
+            raise ReedtoolError(f"is {kind}, not a regular file; refusing to read it as a "
+                                f"{what}", file=path, hint="pass the path of a file on disk")
+        if max_bytes is not None and info.st_size > max_bytes:
+            raise ReedtoolError(f"{what} is {info.st_size / 2**20:.1f} MB, more than the "
+                                f"{max_bytes / 2**20:.0f} MB reedtool reads", file=path,
+                                hint="is this the right file? simplify or split it")
+        os.set_blocking(fd, True)
+    except BaseException:
+        os.close(fd)
+        raise
+    note_input(path)
+    return os.fdopen(fd, "rb")
+
+
+# Meshes: a robot part exports to well under a million triangles. Each triangle costs
+# ~72 bytes as float64 and several times that in topology/hull/inertia work arrays, so
+# 2 million (~1 GB of work) is the ceiling; a binary STL says its count in the header, so
+# it is refused without reading the body. Any mesh file above 512 MB is refused by size
+# (an ASCII STL at 2 M triangles is ~500 MB).
+MAX_MESH_TRIANGLES = 2_000_000
+MAX_MESH_BYTES = 512 * 1024 * 1024
+# Coordinates beyond 1e9 file units (1000 km in mm) are a damaged file, not a part:
+# 6e37 (a float32 bit pattern read as a coordinate) gives a 1e106 kg inertial.
+MAX_MESH_COORDINATE = 1e9
+
+
+def check_mesh_coordinates(triangles, source) -> None:
+    """Refuse a mesh whose coordinates are astronomically large (a damaged export)."""
+    import numpy as np
+
+    finite = np.abs(np.where(np.isfinite(triangles), triangles, 0.0))
+    largest = float(finite.max()) if finite.size else 0.0
+    if largest > MAX_MESH_COORDINATE:
+        raise ReedtoolError(f"mesh has a coordinate of {largest:.3g}, beyond the "
+                            f"{MAX_MESH_COORDINATE:.0e} (file units) a robot part can span",
+                            file=source, hint="the file is damaged or not a part; export it "
+                                              "again")
+
+
+# Text inputs (models, configs, specs) larger than this are not hand-written robot files.
+MAX_TEXT_BYTES = 256 * 1024 * 1024
+
+
+def read_bytes(path: Path, *, what: str = "file", max_bytes: int | None = MAX_TEXT_BYTES) -> bytes:
     """The bytes of a regular file; ReedtoolError for anything else.
 
     A FIFO or device (/dev/zero, /dev/stdin) is refused before reading: it may never end.
     """
     path = Path(path)
-    try:
-        mode = path.stat().st_mode
-    except FileNotFoundError as exc:
-        raise ReedtoolError(f"{what} not found", file=path, hint="check the path") from exc
-    except OSError as exc:
-        raise ReedtoolError(f"cannot read {what}: {exc.strerror}", file=path) from exc
-    if stat.S_ISDIR(mode):
-        raise ReedtoolError(f"is a directory, not a {what}", file=path,
-                            hint="pass the file's path")
-    if not stat.S_ISREG(mode):
-        raise ReedtoolError(f"is not a regular file (a device or pipe?), not a {what}",
-                            file=path, hint="pass the path of a file on disk")
-    try:
-        return path.read_bytes()
-    except OSError as exc:
-        raise ReedtoolError(f"cannot read {what}: {exc.strerror}", file=path) from exc
+    with open_regular_input(path, what=what, max_bytes=max_bytes) as handle:
+        try:
+            return handle.read()
+        except OSError as exc:
+            from reedtool.errors import os_error
+
+            raise os_error(exc, path, action="read file") from exc
+        except MemoryError:
+            raise ReedtoolError(f"out of memory reading {what}", file=path,
+                                hint="is this the right file?") from None
 
 
 def _decode(data: bytes, encoding: str, path: Path, what: str) -> str:
@@ -98,11 +163,84 @@ def read_xml_file(path: Path, *, what: str = "file") -> tuple[str, str]:
 
 
 # ------------------------------------------------------------------ writing
+#
+# The rules every output obeys (issue 14):
+# - only a regular file is ever replaced: a device, FIFO, socket or directory is refused,
+#   even with --force (replacing /dev/full with a CSV is never what the user meant);
+# - never a file this run read (the model, an included xacro): `-o robot.urdf.xacro`
+#   would destroy the source; only the in-place fixers (--fix, --fix-legacy) may;
+# - a symlink is followed: the real file gets the new content, the link stays a link;
+# - without --force, creation is race-free: the data is staged in a temporary file and
+#   published with os.link, which fails if the name exists (two concurrent runs: one wins);
+# - with --force, os.replace swaps the new file in atomically; a backup is a hard link to
+#   the old file under the first free name of NAME.bak, NAME.bak.1, ... (never clobbered);
+# - data is fsynced before it is published, and the directory after.
+
+STDOUT = "-"
+_run_inputs: set[str] = set()
 
 
-def check_writable(path: Path, force: bool) -> None:
-    """Refuse to overwrite an existing file unless forced."""
-    if path.exists() and not force:
+def note_input(path: Path | str) -> None:
+    """Remember that this run read `path`, so that no output may replace it."""
+    try:
+        _run_inputs.add(os.path.realpath(path))
+    except (OSError, ValueError):
+        pass
+
+
+def reset_inputs() -> None:
+    """Forget the inputs noted so far (a new run in the same process)."""
+    _run_inputs.clear()
+
+
+def is_stdout(path: Path | str | None) -> bool:
+    return path is not None and str(path) == STDOUT
+
+
+def real_target(path: Path) -> Path:
+    """The file a write to `path` lands in: symlinks followed, the link itself kept."""
+    return Path(os.path.realpath(path)) if os.path.islink(path) else Path(path)
+
+
+def _kind(mode: int) -> str | None:
+    """What a non-regular file is, or None for a regular file."""
+    for test, name in ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
+                       (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+                       (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return name
+    return None if stat.S_ISREG(mode) else "not a regular file"
+
+
+def check_writable(path: Path, force: bool, *, in_place: bool = False,
+                   stdout_ok: bool = False) -> None:
+    """Refuse an output we must not write, before any work is done.
+
+    Called again at write time (the run's inputs are only known then).
+    """
+    if is_stdout(path):
+        if stdout_ok:
+            return
+        raise ReedtoolError("'-' (standard output) is not supported for this output",
+                            hint="pass a file name; write ./- for a file named '-'")
+    path = Path(path)
+    target = real_target(path)
+    try:
+        mode = target.stat().st_mode
+    except FileNotFoundError:
+        if os.path.islink(path):   # a dangling link: its target would be created
+            return
+        return
+    except OSError as exc:
+        raise ReedtoolError(f"cannot write file: {exc.strerror}", file=path) from exc
+    kind = _kind(mode)
+    if kind is not None:
+        raise ReedtoolError(f"is {kind}, not a regular file; reedtool writes regular files only",
+                            file=path, hint="choose a file path for the output")
+    if not in_place and os.path.realpath(target) in _run_inputs:
+        raise ReedtoolError("refusing to overwrite a file this run reads (an input of the model)",
+                            file=path, hint="choose another output path")
+    if not force:
         raise ReedtoolError("refusing to overwrite an existing file", file=path,
                             hint="pass --force to replace it")
 
@@ -134,13 +272,27 @@ def _make_parent(path: Path, created: list[Path]) -> None:
         created.append(directory)
 
 
+def _fsync_dir(directory: Path) -> None:
+    try:
+        fd = os.open(directory, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass   # some filesystems cannot sync a directory; the data itself is synced
+    finally:
+        os.close(fd)
+
+
 def _stage(path: Path, data: bytes, created: list[Path]) -> str:
-    """Write `data` to a temporary file beside `path`; returns its name."""
+    """Write `data` to a temporary file beside `path` (the real file); returns its name."""
     _make_parent(path, created)
     try:
-        fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name[:64]}.", suffix=".tmp",
+                                        dir=path.parent)
     except OSError as exc:
-        raise ReedtoolError(f"cannot write file: {exc.strerror}", file=path) from exc
+        raise write_error(exc, path) from exc
     try:
         with os.fdopen(fd, "wb") as handle:
             handle.write(data)
@@ -153,36 +305,112 @@ def _stage(path: Path, data: bytes, created: list[Path]) -> str:
             os.chmod(tmp_name, 0o666 & ~_umask())
     except OSError as exc:
         Path(tmp_name).unlink(missing_ok=True)
-        raise ReedtoolError(f"cannot write file: {exc.strerror}", file=path) from exc
+        raise write_error(exc, path) from exc
     except BaseException:
         Path(tmp_name).unlink(missing_ok=True)
         raise
     return tmp_name
 
 
+def write_error(exc: OSError, path: Path | str | None) -> ReedtoolError:
+    """An OSError while writing as one line naming the file and what to do."""
+    from reedtool.errors import os_error
+
+    return os_error(exc, path, action="write file")
+
+
+def free_backup_name(path: Path) -> Path:
+    """The first of NAME.bak, NAME.bak.1, ... that does not exist (an older one is kept)."""
+    candidate = path.with_name(path.name + ".bak")
+    n = 1
+    while candidate.exists() or candidate.is_symlink():
+        candidate = path.with_name(f"{path.name}.bak.{n}")
+        n += 1
+    return candidate
+
+
+def _make_backup(path: Path) -> Path:
+    """Keep the current `path` under a free backup name, never replacing an older backup."""
+    for _ in range(1000):
+        backup = free_backup_name(path)
+        try:
+            os.link(path, backup)        # fails if the name was taken meanwhile
+            return backup
+        except FileExistsError:
+            continue
+        except OSError:
+            try:                         # no hard links here (e.g. a FAT stick): copy, O_EXCL
+                with open(path, "rb") as src, open(backup, "xb") as dst:
+                    shutil.copyfileobj(src, dst)
+                    dst.flush()
+                    os.fsync(dst.fileno())
+                shutil.copystat(path, backup)
+                return backup
+            except FileExistsError:
+                continue
+    raise ReedtoolError("no free backup name (NAME.bak.N up to 1000 taken)", file=path,
+                        hint="remove old backups")
+
+
+def _publish(tmp_name: str, path: Path, force: bool) -> None:
+    """Move the staged file to `path`: atomically replacing it with force, else create-or-fail."""
+    if force:
+        os.replace(tmp_name, path)
+        return
+    try:
+        os.link(tmp_name, path)          # atomic create-or-fail: no check-then-rename race
+    except FileExistsError:
+        raise ReedtoolError("refusing to overwrite an existing file (created meanwhile)",
+                            file=path, hint="pass --force to replace it") from None
+    except OSError as exc:
+        if exc.errno not in (errno.EPERM, errno.ENOTSUP, errno.EOPNOTSUPP, errno.EXDEV):
+            raise
+        # No hard links on this filesystem: O_EXCL creation is the race-free fallback.
+        with open(tmp_name, "rb") as src:
+            data = src.read()
+        try:
+            fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+        except FileExistsError:
+            raise ReedtoolError("refusing to overwrite an existing file (created meanwhile)",
+                                file=path, hint="pass --force to replace it") from None
+        with os.fdopen(fd, "wb") as handle:
+            handle.write(data)
+            handle.flush()
+            os.fsync(handle.fileno())
+    os.unlink(tmp_name)
+
+
 def atomic_write_many(items: Sequence[tuple[Path, bytes]], *, force: bool = False) -> None:
-    """Write several files all or nothing: every one is staged before any is replaced.
+    """Write several files all or nothing: every one is staged before any is published.
 
     A failure while staging (a read-only or missing directory, a full disk) leaves the
-    user's tree as it was, including directories that would have been created.
+    user's tree as it was, including directories that would have been created; a failure
+    while publishing without --force removes the files this call created.
     """
     items = [(Path(path), data) for path, data in items]
     for path, _ in items:
         check_writable(path, force)
+    targets = [(real_target(path), data) for path, data in items]
     created: list[Path] = []
     staged: list[tuple[str, Path]] = []
+    published: list[Path] = []
     try:
-        for path, data in items:
+        for path, data in targets:
             staged.append((_stage(path, data, created), path))
         for tmp_name, path in staged:
-            os.replace(tmp_name, path)
+            _publish(tmp_name, path, force)
+            published.append(path)
+        for directory in {path.parent for _, path in staged}:
+            _fsync_dir(directory)
     except OSError as exc:
-        raise ReedtoolError(f"cannot write file: {exc.strerror}",
-                            file=staged[-1][1] if staged else None) from exc
+        raise write_error(exc, staged[-1][1] if staged else None) from exc
     finally:
         leftovers = [Path(tmp) for tmp, _ in staged if Path(tmp).exists()]
         for tmp in leftovers:
             tmp.unlink(missing_ok=True)
+        if not force and len(published) < len(items):
+            for path in published:
+                path.unlink(missing_ok=True)
         if leftovers or len(staged) < len(items):
             for directory in reversed(created):
                 try:
@@ -192,30 +420,40 @@ def atomic_write_many(items: Sequence[tuple[Path, bytes]], *, force: bool = Fals
 
 
 def atomic_write_bytes(path: Path, data: bytes, *, force: bool = False,
-                       backup: bool = False) -> Path | None:
+                       backup: bool = False, in_place: bool = False) -> Path | None:
     """Write `data` to `path` atomically; returns the backup path when one was made.
 
     The data goes to a temporary file in the same directory and is renamed over the
-    target, so a crash leaves either the old file or the new one, never a mix.
+    target, so a crash leaves either the old file or the new one, never a mix. `in_place`
+    allows replacing a file this run read (the fixers that edit the user's model).
     """
     path = Path(path)
-    check_writable(path, force)
+    check_writable(path, force, in_place=in_place)
+    target = real_target(path)
     created: list[Path] = []
-    tmp_name = _stage(path, data, created)
+    tmp_name = _stage(target, data, created)
     try:
         backup_path = None
-        if backup and path.exists():
-            backup_path = path.with_name(path.name + ".bak")
-            shutil.copy2(path, backup_path)
-        os.replace(tmp_name, path)
+        if backup and target.exists():
+            backup_path = _make_backup(target)
+        _publish(tmp_name, target, force)
+        _fsync_dir(target.parent)
     except OSError as exc:
-        raise ReedtoolError(f"cannot write file: {exc.strerror}", file=path) from exc
+        raise write_error(exc, path) from exc
     finally:
         Path(tmp_name).unlink(missing_ok=True)
     return backup_path
 
 
 def atomic_write_text(path: Path, text: str, *, force: bool = False,
-                      backup: bool = False, encoding: str = "utf-8") -> Path | None:
+                      backup: bool = False, encoding: str = "utf-8",
+                      in_place: bool = False) -> Path | None:
     data = text.encode("utf-8" if encoding == "utf-8-sig" else encoding)
-    return atomic_write_bytes(path, data, force=force, backup=backup)
+    return atomic_write_bytes(path, data, force=force, backup=backup, in_place=in_place)
+
+
+def write_stdout(text: str) -> None:
+    """Text to standard output, as `-o -` asks."""
+    import click
+
+    click.echo(text, nl=False)

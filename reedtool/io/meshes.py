@@ -65,8 +65,9 @@ def load_triangles(path: str | Path) -> np.ndarray:
 def _load_with_trimesh(path: Path) -> np.ndarray:
     import trimesh
 
-    if not path.is_file():
-        raise ReedtoolError("mesh file not found", file=path)
+    from reedtool.io.fileio import MAX_MESH_BYTES, open_regular_input
+
+    open_regular_input(path, what="mesh file", max_bytes=MAX_MESH_BYTES).close()
     try:
         loaded = trimesh.load(str(path), force="mesh", process=False)
     except Exception as exc:  # noqa: BLE001 - trimesh raises many types for bad files
@@ -101,6 +102,9 @@ def check_triangles(triangles: np.ndarray, source: str | Path) -> MeshCheck:
         raise ReedtoolError(f"{int((~finite).sum())} of {len(triangles)} triangles have NaN or "
                             f"infinite coordinates (first: triangle {first})", file=source,
                             hint="export the part again; the file is damaged")
+    from reedtool.io.fileio import check_mesh_coordinates
+
+    check_mesh_coordinates(triangles, source)
     areas = triangle_areas(triangles)
     total_area = float(areas.sum())
     vertices = triangles.reshape(-1, 3)

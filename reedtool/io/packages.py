@@ -32,6 +32,9 @@ BUNDLED_PACKAGES_DIR = Path(__file__).resolve().parents[1] / "ros_packages"
 
 # How deep below a root a package.xml is looked for: root/src/repo/group/pkg is 4.
 MAX_CRAWL_DEPTH = 5
+# How many directories one root may make us visit: a workspace has hundreds; `/` has
+# millions, and scanning them silently took seconds (issue 14). Past this, stop and say so.
+MAX_CRAWL_DIRS = 20_000
 _IGNORE_MARKERS = ("CATKIN_IGNORE", "COLCON_IGNORE", "AMENT_IGNORE")
 
 
@@ -80,28 +83,54 @@ def _is_bundled(path: str, cwd: str) -> bool:
     return True
 
 
-def _crawl(root: Path) -> dict[str, Path]:
+def _is_dir(entry: os.DirEntry) -> bool:
+    try:
+        return entry.is_dir()
+    except OSError:
+        return False
+
+
+def bundled_package_names() -> set[str]:
+    """Names of the packages reedtool bundles (a new package must not shadow them)."""
+    return set(_crawl(BUNDLED_PACKAGES_DIR))
+
+
+def _crawl(root: Path, duplicates: list[tuple[str, Path, Path]] | None = None,
+           origin: str = "") -> dict[str, Path]:
     """All packages under `root` (root included), first found per name wins."""
     found: dict[str, Path] = {}
     if not root.is_dir():
         return found
+    visited = [0]
 
     def visit(directory: Path, depth: int) -> None:
-        if any((directory / marker).exists() for marker in _IGNORE_MARKERS):
+        visited[0] += 1
+        if visited[0] > MAX_CRAWL_DIRS:
+            raise ReedtoolError(f"searching {origin or 'a package root'} {root} for packages "
+                                f"visited more than {MAX_CRAWL_DIRS} directories; stopped",
+                                hint="point --package-path (or ROS_PACKAGE_PATH) at a "
+                                     "workspace's src directory, not a whole filesystem")
+        # One directory listing per visit (scandir's entry types need no extra stat).
+        try:
+            with os.scandir(directory) as listing:
+                entries = list(listing)
+        except OSError:
             return
-        manifest = directory / "package.xml"
-        if manifest.is_file():
-            name = package_name(manifest)
+        names = {entry.name: entry for entry in entries}
+        if any(marker in names for marker in _IGNORE_MARKERS):
+            return
+        manifest = names.get("package.xml")
+        if manifest is not None and manifest.is_file():
+            name = package_name(directory / "package.xml")
             if name:
+                if name in found and duplicates is not None:
+                    duplicates.append((name, found[name], directory))
                 found.setdefault(name, directory)
             return  # packages do not nest (rospack/catkin rule)
         if depth >= MAX_CRAWL_DEPTH:
             return
-        try:
-            children = sorted(p for p in directory.iterdir()
-                              if p.is_dir() and not p.name.startswith("."))
-        except OSError:
-            return
+        children = sorted(Path(entry.path) for entry in entries
+                          if not entry.name.startswith(".") and _is_dir(entry))
         for child in children:
             visit(child, depth + 1)
 
@@ -114,6 +143,12 @@ class PackageResolver:
 
     def __init__(self, package_paths: Sequence[Path] = (), model_path: Path | None = None):
         self.package_paths = [Path(p) for p in package_paths]
+        for directory in self.package_paths:
+            if not directory.is_dir():
+                raise ReedtoolError("--package-path directory " + (
+                    "not found" if not directory.exists() else "is not a directory"),
+                    file=directory, hint="check the path")
+        self.notes: list[str] = []   # e.g. two packages with one name: which one is used
         self.model_path = Path(model_path) if model_path is not None else None
         self._roots: list[SearchRoot] | None = None
         self._index: dict[SearchRoot, dict[str, Path]] = {}
@@ -149,7 +184,11 @@ class PackageResolver:
                 return candidate
             return None
         if root not in self._index:
-            self._index[root] = _crawl(root.path)
+            duplicates: list[tuple[str, Path, Path]] = []
+            self._index[root] = _crawl(root.path, duplicates, root.origin)
+            for dup_name, used, ignored in duplicates:
+                self.notes.append(f"two packages named '{dup_name}' under {root.describe()}: "
+                                  f"using {used}, ignoring {ignored}")
         return self._index[root].get(name)
 
     # ------------------------------------------------------------ api

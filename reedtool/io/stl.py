@@ -6,6 +6,7 @@ so every step is a vectorised numpy operation.
 
 from __future__ import annotations
 
+import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -88,16 +89,28 @@ def _all_floats(words) -> bool:
 
 
 def read_stl(path: str | Path) -> StlFile:
+    from reedtool.io.fileio import MAX_MESH_BYTES, open_regular_input
+
     path = Path(path)
-    try:
-        data = path.read_bytes()
-    except FileNotFoundError as exc:
-        raise ReedtoolError("mesh file not found", file=path) from exc
-    except IsADirectoryError as exc:
-        raise ReedtoolError("is a directory, not a mesh file", file=path) from exc
-    except OSError as exc:
-        raise ReedtoolError(f"cannot read mesh: {exc.strerror}", file=path) from exc
+    # Type and size are checked on the open file before its body is read (issue 14).
+    with open_regular_input(path, what="mesh file", max_bytes=MAX_MESH_BYTES) as handle:
+        head = handle.read(84)
+        check_facet_count(head, os.fstat(handle.fileno()).st_size, path)
+        data = head + handle.read()
     return parse_stl(data, path)
+
+
+def check_facet_count(head: bytes, size: int, source) -> None:
+    """Refuse a binary STL whose header announces more facets than reedtool handles."""
+    from reedtool.io.fileio import MAX_MESH_TRIANGLES
+
+    if len(head) < 84:
+        return
+    count = int.from_bytes(head[80:84], "little")
+    if size == 84 + 50 * count and count > MAX_MESH_TRIANGLES:
+        raise ReedtoolError(f"binary STL with {count:,} triangles, more than the "
+                            f"{MAX_MESH_TRIANGLES:,} reedtool handles", file=source,
+                            hint="decimate the mesh in your CAD or mesh tool first")
 
 
 def stl_bytes(triangles: np.ndarray, header: str = "reedtool") -> bytes:

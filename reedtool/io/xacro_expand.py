@@ -40,6 +40,7 @@ import xacro
 from xacro import substitution_args
 
 from reedtool.errors import ReedtoolError
+from reedtool.io.fileio import MAX_TEXT_BYTES, note_input
 from reedtool.io.legacy_xacro import LegacyScan, LegacyTag, scan_tree
 from reedtool.io.packages import PackageResolver, is_bundled
 from reedtool.model import SourceLoc
@@ -340,6 +341,69 @@ def _guarded_safe_eval(original):
     return safe_eval
 
 
+def _guarded_substitution_eval(original):
+    """xacro's `$(eval ...)` with the guards of `${...}`.
+
+    xacro evaluates $(eval) in substitution_args._eval with its own eval() call, not
+    through safe_eval, so `$(eval 'x'*10**9)` escaped the guard above and allocated
+    gigabytes. The same compiled, guarded code runs here, in the same namespaces xacro
+    gives it (its functions and args as locals, Python's builtins).
+    """
+    def _eval(s, context):
+        if "__" in s:
+            return original(s, context)     # xacro's own refusal and message
+        code = _compiled_expression(s.strip())
+        if code is None:
+            return original(s, context)
+        if "arg" not in context:
+            context["arg"] = {}
+        functions = {
+            "arg": lambda name: substitution_args.convert_value(
+                substitution_args._eval_arg(name, args=context["arg"]), "auto"),
+            "dirname": lambda: substitution_args._eval_dirname(context["filename"]),
+        }
+        functions.update(substitution_args._eval_dict)
+        namespace = {**_GUARDS, **_GUARDED_SYMBOLS}
+        return str(eval(code, namespace,
+                        substitution_args._DictWrapper(context["arg"], functions)))
+    return _eval
+
+
+# ----------------------------------------------------------------- XML depth
+
+# Hand-written robot files nest a dozen elements deep; xacro and minidom recurse once per
+# level, so a 100k-deep file would take minutes and then be blamed on macros.
+MAX_XML_DEPTH = 500
+
+
+def check_xml_depth(data: bytes, path: Path | str) -> None:
+    """Refuse XML nested deeper than MAX_XML_DEPTH, in one linear pass before xacro sees it."""
+    parser = xml.parsers.expat.ParserCreate()
+    depth = [0, 0, 0]          # current, deepest, line where the limit was first crossed
+
+    def start(_name, _attrs):
+        depth[0] += 1
+        if depth[0] > depth[1]:
+            depth[1] = depth[0]
+            if depth[0] == MAX_XML_DEPTH + 1:
+                depth[2] = parser.CurrentLineNumber
+
+    def end(_name):
+        depth[0] -= 1
+
+    parser.StartElementHandler = start
+    parser.EndElementHandler = end
+    try:
+        parser.Parse(data, True)
+    except xml.parsers.expat.ExpatError:
+        pass                # malformed XML: the real parse reports it with its position
+    if depth[1] > MAX_XML_DEPTH:
+        raise ReedtoolError(f"XML nested {depth[1]} deep (limit {MAX_XML_DEPTH})",
+                            file=display_path(path), line=depth[2],
+                            hint="robot files nest a few levels; is this file generated "
+                                 "wrongly?")
+
+
 # ----------------------------------------------------------------- xacro patches
 
 def _macro_names(macros) -> list[str]:
@@ -421,12 +485,17 @@ def _patched(st: _Tracker):
             if path.exists() and not path.is_file() and not path.is_dir():
                 # /dev/zero or a pipe would be read forever.
                 raise OSError(errno.EINVAL, "not a regular file (a device or pipe?)", filename)
+            if path.is_file() and path.stat().st_size > MAX_TEXT_BYTES:
+                raise OSError(errno.EFBIG, f"larger than the {MAX_TEXT_BYTES >> 20} MB "
+                                           "reedtool reads", filename)
             data = path.read_bytes()
+            note_input(path)
         except OSError as exc:
             xacro.filestack.pop()   # as xacro does: the missing file is not "being processed"
             raise xacro.XacroException(f"{exc.strerror}: {filename}", exc=exc) from None
         if path in st.legacy_text:
             data = st.legacy_text[path].encode("utf-8")
+        check_xml_depth(data, path)
         st.files.append(path)
         try:
             return _LineBuilder(str(path)).parseString(data)
@@ -510,6 +579,8 @@ def _patched(st: _Tracker):
     for table, name, _ in replaced:
         dict.__setitem__(table, name, _GUARDED_SYMBOLS[name])
     xml.dom.minidom._clone_node = clone_node
+    orig_eval = substitution_args._eval
+    substitution_args._eval = _guarded_substitution_eval(orig_eval)
     substitution_args._eval_find = find
     substitution_args._eval_dict["find"] = find
     try:
@@ -522,6 +593,7 @@ def _patched(st: _Tracker):
         for table, name, original in replaced:
             dict.__setitem__(table, name, original)
         xml.dom.minidom._clone_node = _orig_clone_node
+        substitution_args._eval = orig_eval
         substitution_args._eval_find = orig_find
         if orig_find_dict is not None:
             substitution_args._eval_dict["find"] = orig_find_dict
@@ -640,6 +712,9 @@ def expand_xacro(path: Path, mappings: dict[str, str] | None = None,
         raise ReedtoolError("file not found" if not path.exists() else "not a file",
                             file=display_path(path), hint="check the path")
     path = path.resolve()
+    from reedtool.io.fileio import read_bytes
+
+    check_xml_depth(read_bytes(path, what="xacro file"), path)   # before any recursive walk
     mappings = {str(k): str(v) for k, v in (mappings or {}).items()}
     resolver = PackageResolver(package_paths, model_path=path)
     legacy = scan_tree(path, _static_include_resolver(resolver, mappings), display=display_path)
@@ -680,6 +755,7 @@ def expand_xacro(path: Path, mappings: dict[str, str] | None = None,
             sys.setrecursionlimit(old_limit)
 
     st.warnings.extend(line for line in captured.getvalue().splitlines() if line.strip())
+    st.warnings.extend(resolver.notes)
     element_locs = _with_urdf_lines(urdf_xml, sites, path)
     return Expansion(urdf_xml, element_locs, legacy.tags, resolver, st.warnings, st.files)
 

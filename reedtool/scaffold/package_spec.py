@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Mapping
 
-from reedtool.errors import ReedtoolError
+from reedtool.errors import PLAUSIBLE, ReedtoolError, check_plausible
 from reedtool.scaffold.airframes import Airframe, GroundLayout, get_frame
 
 # Unit factors to SI, per dimension. A dimension with no units takes plain numbers only.
@@ -175,6 +175,8 @@ def parse_quantity(value, param: Param, source: str) -> float:
     if si < 0.0 or (si == 0.0 and not param.allow_zero):
         need = "zero or positive" if param.allow_zero else "positive"
         raise ReedtoolError(f"{param.key}: must be {need}, got {value!r}", file=source)
+    if param.dimension in PLAUSIBLE and not (si == 0.0 and param.allow_zero):
+        check_plausible(param.dimension, si, param.key, file=source)
     return si
 
 
@@ -208,6 +210,17 @@ def check_package_name(name: str) -> None:
             suggestion = "pkg_" + suggestion
         hint = f"try '{suggestion}'; see ROS REP 144" if suggestion else "see ROS REP 144"
         raise ReedtoolError(f"invalid ROS package name '{name}': it {problem}", hint=hint)
+
+
+def _check_not_bundled(name: str) -> None:
+    """A package named like one reedtool bundles would shadow it: its own model, which
+    includes the bundled macros of that name, could then not be expanded."""
+    from reedtool.io.packages import bundled_package_names
+
+    if name in bundled_package_names():
+        raise ReedtoolError(f"package name '{name}' is the name of a package reedtool "
+                            "bundles (and the generated model uses)",
+                            hint=f"choose another name, e.g. '{name}_custom'")
 
 
 # ------------------------------------------------------------------ loading
@@ -248,6 +261,7 @@ def build_spec(name: str, *, frame: str | None = None, ros: int | None = None,
                             f"'{name}'", file=spec_file, hint="drop `name` from the spec or "
                             "use the same name")
     check_package_name(name)
+    _check_not_bundled(name)
     _check_text_keys(data, spec_file)
 
     try:

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 from typing import Mapping
 
-from reedtool.errors import ReedtoolError
+from reedtool.errors import ReedtoolError, os_error
 
 TEMPLATE_SUFFIX = ".j2"
 
@@ -134,7 +134,7 @@ def write_tree(target: Path, files: list[RenderedFile], *, force: bool = False) 
         staging = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".reedtool-tmp",
                                         dir=parent))
     except OSError as exc:
-        raise ReedtoolError(f"cannot create directory: {exc.strerror}", file=parent) from exc
+        raise os_error(exc, parent, action="create a directory in") from exc
     replacing = target.is_dir() and any(target.iterdir())
     try:
         if replacing:
@@ -162,8 +162,9 @@ def write_tree(target: Path, files: list[RenderedFile], *, force: bool = False) 
             os.rename(staging, target)     # POSIX rename also replaces an empty directory
         return backup
     except OSError as exc:
-        raise ReedtoolError(f"cannot write package: {exc.strerror or exc}", file=target,
-                            hint="nothing was changed") from exc
+        error = os_error(exc, target, action="write package")
+        error.hint = f"{error.hint}; nothing was changed" if error.hint else "nothing was changed"
+        raise error from exc
     finally:
         if staging.exists():
             shutil.rmtree(staging, ignore_errors=True)
