@@ -51,6 +51,28 @@ def batch_memory_bytes(samples: int, n_rotors: int) -> int:
     return samples * (BATCH_BYTES_PER_VEHICLE + n_rotors * BATCH_BYTES_PER_VEHICLE_ROTOR)
 
 
+def check_batch_resources(every_rotor, samples: int | None, max_memory_bytes: int) -> None:
+    """Refuse, before anything is allocated, a model or batch this machine cannot fly."""
+    from reedtool.physics.rotors import lift_rotors
+
+    if len(every_rotor) > MAX_ROTORS:
+        source = every_rotor[0].loc.file if every_rotor else None
+        raise ReedtoolError(f"{len(every_rotor)} rotors: more than the {MAX_ROTORS} a multirotor "
+                            "hover test handles", file=source,
+                            hint="is the model generated wrongly? real multirotors have 3 to "
+                                 "16 rotors")
+    n_lift = len(lift_rotors(every_rotor))
+    if samples:
+        need = batch_memory_bytes(samples, n_lift)
+        if need > max_memory_bytes:
+            fit = max_memory_bytes // batch_memory_bytes(1, n_lift)
+            raise ReedtoolError(f"--samples {samples} needs about {need / 2**20:,.0f} MB for "
+                                f"{n_lift} rotors, more than --max-memory "
+                                f"{max_memory_bytes // 2**20} MB",
+                                hint=f"use --samples {fit} or fewer (a few hundred give the "
+                                     "pass rate to a few percent), or raise --max-memory")
+
+
 @click.command(name="hover-test")
 @click.argument("model", type=click.Path(path_type=Path, dir_okay=False))
 @click.argument("mappings", nargs=-1)
@@ -144,9 +166,6 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
         if not available():
             raise ReedtoolError(f"bad option: --engine numba: {unavailable_reason()}",
                                 hint="or use --engine numpy (the default)")
-    if plot_path is not None and plot_path.suffix.lower() not in (".png", ".svg"):
-        raise ReedtoolError(f"cannot tell the plot format from '{plot_path.suffix or plot_path.name}'",
-                            file=plot_path, hint="name the --plot file .png or .svg")
     from reedtool.io.fileio import check_writable, note_input
 
     note_input(model)           # the model is never an output of its own test
@@ -154,6 +173,10 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
         check_writable(plot_path, force)
     if csv_path is not None:
         check_writable(csv_path, force, stdout_ok=True)
+    # What the path is comes first (a FIFO is refused as such), then its format.
+    if plot_path is not None and plot_path.suffix.lower() not in (".png", ".svg"):
+        raise ReedtoolError(f"cannot tell the plot format from '{plot_path.suffix or plot_path.name}'",
+                            file=plot_path, hint="name the --plot file .png or .svg")
     if not model.is_file():
         raise ReedtoolError("model file not found", file=model,
                             hint="pass the path of a .urdf or .xacro file")
@@ -169,11 +192,14 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     require_sound_model(robot)
     errors = validation_errors(model, robot)
     if errors and not ignore_validation:
-        # Unreadable rotor parameters are bad input (exit 2), whatever else is wrong.
+        # Bad input (exit 2) comes before what validate finds (exit 1): unreadable rotor
+        # parameters, a batch too large for the machine.
         from reedtool.physics.rotors import discover_rotors
         from reedtool.sim.params import check_rotor_dynamics
 
-        check_rotor_dynamics(discover_rotors(robot))
+        every_rotor = discover_rotors(robot)
+        check_batch_resources(every_rotor, samples, max_memory_mb * 1024 * 1024)
+        check_rotor_dynamics(every_rotor)
     if errors:
         from reedtool.report import ModelResult, render
 
@@ -257,20 +283,7 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
     # Hover is held by the lift rotors: a VTOL's pusher or a plane's puller stays off.
     every_rotor = discover_rotors(robot)
     rotors = lift_rotors(every_rotor)
-    if len(every_rotor) > MAX_ROTORS:
-        raise ReedtoolError(f"{len(every_rotor)} rotors: more than the {MAX_ROTORS} a multirotor "
-                            "hover test handles", file=robot.source_file,
-                            hint="is the model generated wrongly? real multirotors have 3 to "
-                                 "16 rotors")
-    if samples:
-        need = batch_memory_bytes(samples, len(rotors))
-        if need > max_memory_bytes:
-            fit = max_memory_bytes // batch_memory_bytes(1, len(rotors))
-            raise ReedtoolError(f"--samples {samples} needs about {need / 2**20:,.0f} MB for "
-                                f"{len(rotors)} rotors, more than --max-memory "
-                                f"{max_memory_bytes // 2**20} MB",
-                                hint=f"use --samples {fit} or fewer (a few hundred give the "
-                                     "pass rate to a few percent), or raise --max-memory")
+    check_batch_resources(every_rotor, samples, max_memory_bytes)
     props = whole_robot_pinocchio(robot)
     trim = solve_trim(props.mass_kg, props.com_m, rotors)
     report: dict = {
