@@ -190,15 +190,10 @@ def parse_parm(text: str, file: str) -> ArduPilotParams:
 
 
 def load_parm(path: Path) -> ArduPilotParams:
+    from reedtool.io.fileio import read_text_file
+
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ReedtoolError("file not found", file=str(path),
-                            hint="give an ArduPilot .parm file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ReedtoolError(f"cannot read the ArduPilot parameters: {exc}", file=str(path)) from None
-    return parse_parm(text, str(path))
+    return parse_parm(read_text_file(path, what="ArduPilot parameter file"), str(path))
 
 
 # ------------------------------------------------------------------ choosing a frame

@@ -178,15 +178,10 @@ def parse_px4_params(text: str, file: str) -> Px4Params:
 
 
 def load_px4_params(path: Path) -> Px4Params:
+    from reedtool.io.fileio import read_text_file
+
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ReedtoolError("file not found", file=str(path),
-                            hint="give a PX4 airframe script or parameter file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ReedtoolError(f"cannot read the PX4 parameters: {exc}", file=str(path)) from None
-    params = parse_px4_params(text, str(path))
+    params = parse_px4_params(read_text_file(path, what="PX4 parameter file"), str(path))
     if not params.values:
         raise ReedtoolError("no PX4 parameter found (expected `param set-default NAME VALUE` "
                             "lines or a QGroundControl tab-separated export)", file=str(path),

@@ -270,11 +270,7 @@ def parse_dae(data: bytes, source: str | Path = "<dae>") -> DaeFile:
 
 
 def read_dae(path: str | Path) -> DaeFile:
+    from reedtool.io.fileio import MAX_MESH_BYTES, read_bytes
+
     path = Path(path)
-    try:
-        data = path.read_bytes()
-    except FileNotFoundError as exc:
-        raise ReedtoolError("mesh file not found", file=path) from exc
-    except OSError as exc:
-        raise ReedtoolError(f"cannot read mesh: {exc.strerror}", file=path) from exc
-    return parse_dae(data, path)
+    return parse_dae(read_bytes(path, what="mesh file", max_bytes=MAX_MESH_BYTES), path)

@@ -52,11 +52,7 @@ def parse_obj(data: bytes, source: str | Path = "<obj>") -> np.ndarray:
 
 
 def read_obj(path: str | Path) -> np.ndarray:
+    from reedtool.io.fileio import MAX_MESH_BYTES, read_bytes
+
     path = Path(path)
-    try:
-        data = path.read_bytes()
-    except FileNotFoundError as exc:
-        raise ReedtoolError("mesh file not found", file=path) from exc
-    except OSError as exc:
-        raise ReedtoolError(f"cannot read mesh: {exc.strerror}", file=path) from exc
-    return parse_obj(data, path)
+    return parse_obj(read_bytes(path, what="mesh file", max_bytes=MAX_MESH_BYTES), path)
