@@ -45,10 +45,7 @@ CASES = [
     ("R342_bad_long_arm.urdf", ["R342"]),
     ("I220_bad_tiny_frame.urdf", ["I220", "I220"]),
     ("clean_quad_x.urdf", []),
-    # An alternating hexacopter: R350 (information) names a fault-tolerant spin order.
-    ("clean_hex.urdf", ["R350"]),
-    ("R350_bad_alternating_hex.urdf", ["R350"]),
-    ("R350_good_ppnnpn_hex.urdf", []),
+    ("clean_hex.urdf", []),
     ("clean_octo.urdf", []),
 ]
 
