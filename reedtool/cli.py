@@ -24,6 +24,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "inertia": ("reedtool.commands.inertia", "Compare declared link inertia with the geometry's; whole-robot mass properties."),
     "new-package": ("reedtool.commands.new_package", "Scaffold a ROS 1/2 package (multirotor or ground robot) that validates and hovers."),
     "hover-test": ("reedtool.commands.hover_test", "Trim a multirotor for hover and fly it headless: does it settle and stay?"),
+    "authority": ("reedtool.commands.authority", "Control authority (ACAI) about hover, intact and after each single rotor failure."),
 }
 
 

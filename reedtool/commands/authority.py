@@ -1,0 +1,184 @@
+"""`reedtool authority`: can this multirotor lose a rotor and still be flown down?
+
+A static analysis (no simulation): the available control authority index (ACAI) of the
+intact vehicle and of every single-rotor failure, with and without yaw control, and the
+thrust-to-weight at which each failure becomes survivable. See docs/fault-tolerance.md.
+
+Exit 0 when the model meets --require, 1 when it does not, 2 on unreadable input.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import click
+
+from reedtool.errors import ReedtoolError
+
+# --require policies: what must hold for exit 0.
+POLICIES = {
+    "none": "report only",
+    "hover": "the intact vehicle is controllable about hover",
+    "any-single": "every single rotor failure leaves full control (thrust, roll, pitch, yaw)",
+    "any-single-without-yaw": "every single rotor failure leaves thrust, roll and pitch "
+                              "(the vehicle may spin down)",
+}
+
+
+def _efficiency(items: tuple[str, ...], names: list[str]) -> list[float]:
+    eta = [1.0] * len(names)
+    for item in items:
+        name, sep, value = item.partition("=")
+        if not sep or name not in names:
+            raise ReedtoolError(f"bad --efficiency '{item}': expected ROTOR=ETA with ROTOR one "
+                                f"of {', '.join(names)}", hint="e.g. --efficiency rotor_0=0.5")
+        try:
+            eta_i = float(value)
+        except ValueError:
+            eta_i = math.nan
+        if not 0.0 <= eta_i <= 1.0:
+            raise ReedtoolError(f"bad --efficiency '{item}': ETA must be a number in [0, 1]",
+                                hint="1 is a healthy rotor, 0 a failed one")
+        eta[names.index(name)] = eta_i
+    return eta
+
+
+def _finite(value: float) -> float | None:
+    return float(value) if math.isfinite(value) else None
+
+
+def analyse(rotors, mass_kg: float, com_m, efficiency=None) -> dict:
+    """The JSON-ready report: the intact case and one entry per single-rotor failure."""
+    import numpy as np
+
+    from reedtool.physics.allocation import allocation_matrix
+    from reedtool.physics.authority import failure_cases
+    from reedtool.physics.trim import STANDARD_GRAVITY_M_S2
+
+    B = allocation_matrix(rotors, np.asarray(com_m, dtype=float))
+    K = np.array([r.max_thrust_N for r in rotors], dtype=float)
+    eta = np.ones(len(rotors)) if efficiency is None else np.asarray(efficiency, dtype=float)
+    weight_N = mass_kg * STANDARD_GRAVITY_M_S2
+    # The designer's thrust-to-weight: every rotor healthy, at full speed, along body z.
+    thrust_to_weight = float(B[0] @ K) / weight_N
+
+    def entry(a) -> dict:
+        return {"acai": float(a.acai), "rank": a.rank, "controllable": a.controllable,
+                "acai_without_yaw": float(a.acai_without_yaw),
+                "controllable_without_yaw": a.controllable_without_yaw,
+                "min_thrust_to_weight": _finite(a.min_thrust_scale * thrust_to_weight),
+                "min_thrust_to_weight_without_yaw":
+                    _finite(a.min_thrust_scale_without_yaw * thrust_to_weight)}
+
+    intact, failed = failure_cases(B, K, weight_N, eta)
+    failures = []
+    for i, (rotor, a) in enumerate(zip(rotors, failed)):
+        failures.append({"rotor": rotor.name, "index": i, "motor_number": rotor.motor_number,
+                         "direction": rotor.direction, **entry(a)})
+    return {"mass_kg": mass_kg, "weight_N": weight_N, "thrust_to_weight": thrust_to_weight,
+            "efficiency": {r.name: float(e) for r, e in zip(rotors, eta)},
+            "intact": entry(intact), "failures": failures}
+
+
+def meets(report: dict, policy: str) -> bool:
+    failures = report["failures"]
+    if policy == "none":
+        return True
+    if policy == "hover":
+        return report["intact"]["controllable"]
+    if policy == "any-single":
+        return report["intact"]["controllable"] and all(f["controllable"] for f in failures)
+    return report["intact"]["controllable"] and all(f["controllable_without_yaw"]
+                                                    for f in failures)
+
+
+def _ttw(value: float | None) -> str:
+    return "never" if value is None else f"{value:.3g}"
+
+
+def render_text(name: str, report: dict, policy: str) -> str:
+    intact = report["intact"]
+    lines = [f"authority {name}: {len(report['failures'])} rotors, mass "
+             f"{report['mass_kg']:.4g} kg, thrust-to-weight {report['thrust_to_weight']:.3g}",
+             f"intact: ACAI {intact['acai']:.4g} ({'controllable' if intact['controllable'] else 'NOT controllable'}), "
+             f"needs thrust-to-weight > {_ttw(intact['min_thrust_to_weight'])}"]
+    degraded = {k: v for k, v in report["efficiency"].items() if v != 1.0}
+    if degraded:
+        lines.append("efficiency: " + ", ".join(f"{k} {v:g}" for k, v in degraded.items()))
+    rows = [("#", "failed rotor", "dir", "ACAI", "full control", "ACAI no yaw",
+             "no yaw", "min T/W", "min T/W no yaw")]
+    for f in report["failures"]:
+        number = "-" if f["motor_number"] is None else str(f["motor_number"])
+        rows.append((number, f["rotor"], f["direction"], f"{f['acai']:.4g}",
+                     "yes" if f["controllable"] else "no", f"{f['acai_without_yaw']:.4g}",
+                     "yes" if f["controllable_without_yaw"] else "no",
+                     _ttw(f["min_thrust_to_weight"]), _ttw(f["min_thrust_to_weight_without_yaw"])))
+    widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]))]
+    for r in rows:
+        lines.append("  " + "  ".join(cell.ljust(w) if c < 3 else cell.rjust(w)
+                                      for c, (cell, w) in enumerate(zip(r, widths))).rstrip())
+    full = sum(f["controllable"] for f in report["failures"])
+    no_yaw = sum(f["controllable_without_yaw"] for f in report["failures"])
+    lines.append(f"single failures: {full}/{len(report['failures'])} keep full control, "
+                 f"{no_yaw}/{len(report['failures'])} keep thrust, roll and pitch "
+                 f"(ACAI in mixed units: N and N*m)")
+    ok = meets(report, policy)
+    lines.append(("PASSED" if ok else "FAILED") + f" --require {policy}: {POLICIES[policy]}")
+    return "\n".join(lines)
+
+
+@click.command(name="authority")
+@click.argument("model", type=click.Path(path_type=Path, dir_okay=False))
+@click.argument("mappings", nargs=-1)
+@click.option("--package-path", "package_paths", multiple=True, metavar="DIR",
+              type=click.Path(path_type=Path, file_okay=False),
+              help="Directory to search for ROS packages first (repeatable).")
+@click.option("--efficiency", "efficiency_items", multiple=True, metavar="ROTOR=ETA",
+              help="Degrade a rotor: its maximum thrust times ETA in [0, 1] (repeatable).")
+@click.option("--require", "policy", type=click.Choice(list(POLICIES)), default="hover",
+              show_default=True, help="What must hold for exit 0.")
+@click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
+              show_default=True, help="Output format.")
+def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
+            efficiency_items: tuple[str, ...], policy: str, fmt: str) -> int:
+    """Control authority of MODEL about hover, intact and after each single rotor failure.
+
+    MODEL is a .urdf or .xacro (with xacro NAME:=VALUE arguments) with motor plugins.
+    """
+    if not model.is_file():
+        raise ReedtoolError("model file not found", file=model,
+                            hint="pass the path of a .urdf or .xacro file")
+    from reedtool.checks.preflight import require_sound_model
+    from reedtool.io.loader import load_robot
+    from reedtool.io.mappings import parse_mappings
+    from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
+    from reedtool.physics.rotors import discover_rotors
+
+    robot = load_robot(model, parse_mappings(mappings), list(package_paths))
+    require_sound_model(robot)
+    rotors = discover_rotors(robot)
+    if len(rotors) < 1:
+        raise ReedtoolError("no motor plugins found: nothing to analyse", file=model,
+                            hint="authority needs RotorS, PX4 or gz-sim motor plugins")
+    bad = [r.name for r in rotors
+           if not (math.isfinite(r.max_thrust_N) and r.max_thrust_N > 0 and r.turning_sign != 0
+                   and all(math.isfinite(v) for v in r.position_m)
+                   and math.isfinite(r.moment_constant))]
+    if bad:
+        raise ReedtoolError(f"rotor(s) {', '.join(bad)} lack a position, a turning direction "
+                            f"or usable constants", file=model,
+                            hint="`reedtool validate MODEL` names the problem")
+    props = whole_robot_pinocchio(robot)
+    if not props.mass_kg > 0:
+        raise ReedtoolError("the robot has no mass", file=model,
+                            hint="run `reedtool inertia` on the model")
+    report = analyse(rotors, props.mass_kg, props.com_m,
+                     _efficiency(efficiency_items, [r.name for r in rotors]))
+    report = {"model": robot.name, "require": policy, "passed": meets(report, policy), **report}
+    if fmt == "json":
+        click.echo(json.dumps(report, indent=2, allow_nan=False))
+    else:
+        click.echo(render_text(robot.name, report, policy))
+    return 0 if report["passed"] else 1
