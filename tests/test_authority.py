@@ -176,3 +176,23 @@ def test_efficiency_option_and_bad_input(tmp_path):
     assert code == 2 and "bad --efficiency" in out
     code, out = run_cli("authority", *base, "--efficiency", "t/rotor_0=2")
     assert code == 2 and "[0, 1]" in out
+
+
+def test_r350_names_an_order_that_really_keeps_control():
+    # Second opinion on the rule's suggestion: rebuild the hexacopter with the order it
+    # names and count the survivable failures with the paper's matrix.
+    import re
+
+    from reedtool.checks.runner import Selection, run_checks
+    from reedtool.io.loader import load_robot
+    from tests.rule_helpers import FIXTURES
+
+    (finding,) = run_checks(load_robot(FIXTURES / "R350_bad_alternating_hex.urdf"),
+                            Selection(select=("R350",)))
+    spins = re.findall(r"rotor_\d+ (ccw|cw)", finding.message)
+    assert len(spins) == 6 and spins.count("ccw") == 3
+    count = int(re.search(r"after (\d) of 6", finding.message).group(1))
+    order = "".join("P" if s == "ccw" else "N" for s in spins)
+    _, failed = failure_cases(paper_hexacopter(order, arm_m=0.3, k_mu=0.016),
+                              [8.54858e-06 * 838.0 ** 2] * 6, 2.03 * 9.80665)
+    assert sum(f.controllable for f in failed) == count >= 1

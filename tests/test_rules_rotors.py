@@ -38,8 +38,12 @@ CASES = [
     ("R315_bad_link_mismatch.urdf", ["R315"]),
     ("R316_bad_motor_constant.urdf", ["R316"]),
     ("R316_bad_missing_max_speed.urdf", ["R316"]),
+    # R350 (info): the alternating hexacopter loses full control with any rotor; the
+    # paper's PPNNPN order of the same rotors keeps it after four failures.
+    ("R350_bad_alternating_hex.urdf", ["R350"]),
+    ("R350_good_ppnnpn_hex.urdf", []),
     ("clean_quad_x.urdf", []),
-    ("clean_hex.urdf", []),
+    ("clean_hex.urdf", ["R350"]),
     ("clean_octo.urdf", []),
 ]
 

@@ -28,6 +28,11 @@ FAMILIES: dict[str, tuple[str, str]] = {
     "C": ("reedtool.checks.controller_rules", "Controller cross-check"),
 }
 
+# Further rule modules of a family, kept apart by topic (same code letter).
+EXTRA_MODULES: dict[str, tuple[str, ...]] = {
+    "R": ("reedtool.checks.fault_rules",),
+}
+
 _CODE = re.compile(r"^[A-Z]\d{3}$")
 _SLUG = re.compile(r"^[a-z0-9]+(-[a-z0-9]+)*$")
 
@@ -76,8 +81,10 @@ def rule(code: str, slug: str, severity: str, summary: str) -> Callable[[CheckFn
 
 
 def _load_families() -> None:
-    for module_name, _title in FAMILIES.values():
+    for letter, (module_name, _title) in FAMILIES.items():
         importlib.import_module(module_name)
+        for extra in EXTRA_MODULES.get(letter, ()):
+            importlib.import_module(extra)
 
 
 def all_rules() -> list[Rule]:
