@@ -12,8 +12,12 @@ import numpy as np
 
 
 def render_png(series: dict[str, np.ndarray], omega_max_rad_s: np.ndarray,
-               trim_omega_rad_s: np.ndarray, title: str) -> bytes:
-    """The three-panel figure as PNG bytes (the caller writes them atomically)."""
+               trim_omega_rad_s: np.ndarray, title: str,
+               events: tuple[tuple[float, str], ...] = ()) -> bytes:
+    """The three-panel figure as PNG bytes (the caller writes them atomically).
+
+    `events` (time [s], label), e.g. a rotor failure, are marked on every panel.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -47,6 +51,11 @@ def render_png(series: dict[str, np.ndarray], omega_max_rad_s: np.ndarray,
         ax_rot.legend(loc="lower right", fontsize="small")
     ax_rot.grid(True, alpha=0.3)
 
+    for time_s, label in events:
+        for ax in (ax_pos, ax_att, ax_rot):
+            ax.axvline(time_s, color="black", linestyle="-.", linewidth=1)
+        ax_pos.annotate(label, (time_s, 1.0), xycoords=("data", "axes fraction"),
+                        xytext=(3, -12), textcoords="offset points", fontsize="small")
     fig.suptitle(title)
     fig.tight_layout()
     buffer = io.BytesIO()
