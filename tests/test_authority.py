@@ -196,3 +196,20 @@ def test_r350_names_an_order_that_really_keeps_control():
     _, failed = failure_cases(paper_hexacopter(order, arm_m=0.3, k_mu=0.016),
                               [8.54858e-06 * 838.0 ** 2] * 6, 2.03 * 9.80665)
     assert sum(f.controllable for f in failed) == count >= 1
+
+
+def test_fly_reports_a_flight_per_failure_and_plots_the_failure(tmp_path):
+    code, out = run_cli("new-package", "t_quad", "--frame", "quad-x", "-o", tmp_path)
+    assert code == 0, out
+    model = tmp_path / "t_quad" / "urdf" / "t_quad.xacro"
+    png = tmp_path / "fail.png"
+    code, out = run_cli("authority", model, "namespace:=t", "--package-path", tmp_path,
+                        "--format", "json", "--fly", "--plot", png)
+    report = json.loads(out)
+    assert code == 0                        # --require hover: the intact quad is fine
+    # The analysis says no quad failure is survivable; no flight may claim otherwise.
+    assert [f["flight"]["passed"] for f in report["failures"]] == [False] * 4
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    code, out = run_cli("authority", model, "namespace:=t", "--package-path", tmp_path,
+                        "--fly", "--plot", png)
+    assert code == 2 and "refusing to overwrite" in out

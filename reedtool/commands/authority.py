@@ -82,6 +82,38 @@ def analyse(rotors, mass_kg: float, com_m, efficiency=None) -> dict:
             "intact": entry(intact), "failures": failures}
 
 
+def _fly(robot, rotors, props, report: dict, plot_path: Path | None, force: bool) -> None:
+    """Fly every single failure; the controller keeps yaw only where the analysis says it can."""
+    from reedtool.sim import HoverConfig
+    from reedtool.sim.failure import FailureSchedule, simulate_rotor_failure
+    from reedtool.sim.params import VehicleParams, check_rotor_dynamics
+
+    check_rotor_dynamics(rotors)
+    params = VehicleParams.from_rotors(props.mass_kg, props.com_m, props.inertia_kg_m2, rotors)
+    config = HoverConfig(duration_s=6.0)
+    chosen = None
+    for f in report["failures"]:
+        yaw = f["controllable"] or not f["controllable_without_yaw"]
+        run = simulate_rotor_failure(params, FailureSchedule(f["index"], 1.0), config,
+                                     yaw_controlled=yaw, record=plot_path is not None)
+        f["flight"] = {"status": run.status.value, "passed": run.passed,
+                       "yaw_controlled": yaw, "message": run.message}
+        if chosen is None or (chosen.passed and not run.passed):
+            chosen = run
+    if plot_path is not None and chosen is not None:
+        import numpy as np
+
+        from reedtool.io.fileio import atomic_write_bytes
+        from reedtool.sim.plot import render_png
+
+        keep = [i for i in range(params.n_rotors) if i != chosen.schedule.rotor_index]
+        png = render_png(chosen.series(), np.asarray(params.omega_max_rad_s)[keep],
+                         chosen.after.initial_omega_rad_s,
+                         f"{robot.name}: {chosen.status.value}",
+                         events=((chosen.schedule.time_s, f"{chosen.rotor_name} fails"),))
+        atomic_write_bytes(plot_path, png, force=force)
+
+
 def meets(report: dict, policy: str) -> bool:
     failures = report["failures"]
     if policy == "none":
@@ -119,6 +151,10 @@ def render_text(name: str, report: dict, policy: str) -> str:
     for r in rows:
         lines.append("  " + "  ".join(cell.ljust(w) if c < 3 else cell.rjust(w)
                                       for c, (cell, w) in enumerate(zip(r, widths))).rstrip())
+    for f in report["failures"]:
+        if "flight" in f:
+            mode = "" if f["flight"]["yaw_controlled"] else " (yaw dropped)"
+            lines.append(f"  flight{mode}: {f['flight']['status'].upper()}: {f['flight']['message']}")
     full = sum(f["controllable"] for f in report["failures"])
     no_yaw = sum(f["controllable_without_yaw"] for f in report["failures"])
     lines.append(f"single failures: {full}/{len(report['failures'])} keep full control, "
@@ -139,10 +175,17 @@ def render_text(name: str, report: dict, policy: str) -> str:
               help="Degrade a rotor: its maximum thrust times ETA in [0, 1] (repeatable).")
 @click.option("--require", "policy", type=click.Choice(list(POLICIES)), default="hover",
               show_default=True, help="What must hold for exit 0.")
+@click.option("--fly", is_flag=True,
+              help="Also fly each failure closed-loop (hover, lose the rotor at 1 s, 6 s in all).")
+@click.option("--plot", "plot_path", type=click.Path(path_type=Path, dir_okay=False),
+              help="With --fly: PNG of the first failure flight that does not hold "
+                   "(else of the first), the failure time marked.")
+@click.option("--force", is_flag=True, help="Overwrite an existing --plot file.")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
               show_default=True, help="Output format.")
 def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
-            efficiency_items: tuple[str, ...], policy: str, fmt: str) -> int:
+            efficiency_items: tuple[str, ...], policy: str, fly: bool, plot_path: Path | None,
+            force: bool, fmt: str) -> int:
     """Control authority of MODEL about hover, intact and after each single rotor failure.
 
     MODEL is a .urdf or .xacro (with xacro NAME:=VALUE arguments) with motor plugins.
@@ -150,6 +193,11 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     if not model.is_file():
         raise ReedtoolError("model file not found", file=model,
                             hint="pass the path of a .urdf or .xacro file")
+    if plot_path is not None and not fly:
+        raise ReedtoolError("--plot needs --fly", hint="add --fly to fly the failures")
+    if plot_path is not None and plot_path.exists() and not force:
+        raise ReedtoolError("refusing to overwrite an existing file", file=plot_path,
+                            hint="pass --force to replace it")
     from reedtool.checks.preflight import require_sound_model
     from reedtool.io.loader import load_robot
     from reedtool.io.mappings import parse_mappings
@@ -176,6 +224,8 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
                             hint="run `reedtool inertia` on the model")
     report = analyse(rotors, props.mass_kg, props.com_m,
                      _efficiency(efficiency_items, [r.name for r in rotors]))
+    if fly:
+        _fly(robot, rotors, props, report, plot_path, force)
     report = {"model": robot.name, "require": policy, "passed": meets(report, policy), **report}
     if fmt == "json":
         click.echo(json.dumps(report, indent=2, allow_nan=False))
