@@ -68,3 +68,18 @@ def test_bad_schedule_is_refused():
         simulate_rotor_failure(symmetric_multirotor(4), FailureSchedule(4, 1.0), CONFIG)
     with pytest.raises(ValueError):
         simulate_rotor_failure(symmetric_multirotor(4), FailureSchedule(0, 4.5), CONFIG)
+
+
+@pytest.mark.parametrize("n,index,yaw", [(8, 0, True), (4, 2, True), (6, 0, False)])
+def test_batch_engine_gives_the_same_verdict_after_a_failure(n, index, yaw):
+    from reedtool.sim.batch import simulate_batch
+    from reedtool.sim.controller import ControllerDesign
+    from reedtool.sim.failure import after_failure
+
+    params = symmetric_multirotor(n, mass_kg=1.5)
+    schedule = FailureSchedule(index, 1.0)
+    scalar = simulate_rotor_failure(params, schedule, CONFIG, yaw_controlled=yaw, record=False)
+    reduced, gains, config, omega0 = after_failure(params, schedule, CONFIG, ControllerDesign(),
+                                                   yaw)
+    batch = simulate_batch(reduced, config, gains=gains, initial_omega_rad_s=omega0)
+    assert batch.status(0) is scalar.after.status

@@ -90,6 +90,25 @@ def reconfigured_gains(params: VehicleParams, design: ControllerDesign,
     return dataclasses.replace(gains, allocation_pinv=np.hstack([pinv3, np.zeros((len(pinv3), 1))]))
 
 
+def after_failure(params: VehicleParams, schedule: FailureSchedule, config: HoverConfig,
+                  design: ControllerDesign, yaw_controlled: bool):
+    """(vehicle, gains, config, starting rotor speeds) of the flight from t_fail on.
+
+    Any engine can fly it: run.simulate_hover and batch.simulate_batch take the gains and
+    starting speeds as overrides (tests/test_failure_flight.py holds them to one verdict).
+    """
+    intact_gains = ControllerGains.from_params(params, design)
+    before_omega = hover_speeds(params, intact_gains)
+    keep = [i for i in range(params.n_rotors) if i != schedule.rotor_index]
+    after_params = without_rotor(params, schedule.rotor_index)
+    gains = reconfigured_gains(after_params, design, yaw_controlled)
+    after_config = dataclasses.replace(
+        config, duration_s=config.duration_s - schedule.time_s, offset_m=(0.0, 0.0, 0.0),
+        roll_rad=0.0, pitch_rad=0.0, yaw_rad=0.0,
+        yaw_spin_rad_s=config.yaw_spin_rad_s if yaw_controlled else math.inf)
+    return after_params, gains, after_config, before_omega[keep]
+
+
 def simulate_rotor_failure(params: VehicleParams, schedule: FailureSchedule,
                            config: HoverConfig = HoverConfig(),
                            design: ControllerDesign = ControllerDesign(),
@@ -100,18 +119,11 @@ def simulate_rotor_failure(params: VehicleParams, schedule: FailureSchedule,
     if not 0 <= schedule.time_s < config.duration_s - config.hold_s:
         raise ValueError(f"failure time {schedule.time_s} s must leave more than the hold "
                          f"time {config.hold_s} s before the end {config.duration_s} s")
-    intact_gains = ControllerGains.from_params(params, design)
-    before_omega = hover_speeds(params, intact_gains)
-    keep = [i for i in range(params.n_rotors) if i != schedule.rotor_index]
-    after_params = without_rotor(params, schedule.rotor_index)
-    gains = reconfigured_gains(after_params, design, yaw_controlled)
-    after_config = dataclasses.replace(
-        config, duration_s=config.duration_s - schedule.time_s, offset_m=(0.0, 0.0, 0.0),
-        roll_rad=0.0, pitch_rad=0.0, yaw_rad=0.0,
-        yaw_spin_rad_s=config.yaw_spin_rad_s if yaw_controlled else math.inf)
+    after_params, gains, after_config, omega0 = after_failure(params, schedule, config, design,
+                                                              yaw_controlled)
     after = simulate_hover(after_params, after_config, design,
                            record=record or not yaw_controlled, gains=gains,
-                           initial_omega_rad_s=before_omega[keep])
+                           initial_omega_rad_s=omega0)
     status, message = after.status, after.message
     if not yaw_controlled and status is ExitStatus.NOT_SETTLED:
         held = _spinning_hold(after.series, after_config)
