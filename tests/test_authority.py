@@ -213,3 +213,14 @@ def test_fly_reports_a_flight_per_failure_and_plots_the_failure(tmp_path):
     code, out = run_cli("authority", model, "namespace:=t", "--package-path", tmp_path,
                         "--fly", "--plot", png)
     assert code == 2 and "refusing to overwrite" in out
+
+
+@pytest.mark.parametrize("K_N", [5.5, HEX_K_N, 7.0])
+@pytest.mark.parametrize("arm_m,k_mu", [(0.2, 0.05), (0.275, 0.1), (0.35, 0.2)])
+def test_hexacopter_verdicts_do_not_hang_on_the_exact_parameters(K_N, arm_m, k_mu):
+    # The paper's qualitative result holds around its parameters, not just at them.
+    _, alternating = failure_cases(paper_hexacopter("PNPNPN", arm_m, k_mu), [K_N] * 6,
+                                   HEX_WEIGHT_N)
+    _, paired = failure_cases(paper_hexacopter("PPNNPN", arm_m, k_mu), [K_N] * 6, HEX_WEIGHT_N)
+    assert sum(f.controllable for f in alternating) == 0
+    assert sum(f.controllable for f in paired) == 4
