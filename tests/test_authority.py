@@ -224,3 +224,26 @@ def test_hexacopter_verdicts_do_not_hang_on_the_exact_parameters(K_N, arm_m, k_m
     _, paired = failure_cases(paper_hexacopter("PPNNPN", arm_m, k_mu), [K_N] * 6, HEX_WEIGHT_N)
     assert sum(f.controllable for f in alternating) == 0
     assert sum(f.controllable for f in paired) == 4
+
+
+def test_bad_input_is_one_line_and_exit_2(tmp_path):
+    from tests.rule_helpers import FIXTURES
+
+    code, out = run_cli("authority", tmp_path / "missing.urdf")
+    assert code == 2 and "model file not found" in out
+    code, out = run_cli("authority", FIXTURES / "clean_arm.urdf")
+    assert code == 2 and "no motor plugins" in out
+    code, out = run_cli("authority", FIXTURES / "clean_hex.urdf", "--plot", tmp_path / "x.png")
+    assert code == 2 and "--plot needs --fly" in out
+
+
+def test_require_policies_on_the_paper_hexacopter_fixtures():
+    from tests.rule_helpers import FIXTURES
+
+    alternating = FIXTURES / "R350_bad_alternating_hex.urdf"
+    paired = FIXTURES / "R350_good_ppnnpn_hex.urdf"
+    assert run_cli("authority", alternating, "--require", "any-single")[0] == 1
+    assert run_cli("authority", alternating, "--require", "any-single-without-yaw")[0] == 0
+    code, out = run_cli("authority", paired, "--format", "json", "--require", "none")
+    assert code == 0
+    assert sum(f["controllable"] for f in json.loads(out)["failures"]) == 4
