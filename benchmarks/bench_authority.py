@@ -48,12 +48,12 @@ def main() -> None:
             model = Path(tmp) / name / "urdf" / f"{name}.xacro"
             argv = ["authority", str(model), "namespace:=b", "--package-path", tmp]
 
-            def table():
+            def table(argv=argv):
                 result = runner.invoke(cli, argv, standalone_mode=False)
                 assert result.exception is None and "single failures:" in result.output, \
                     result.output
 
-            def load():
+            def load(model=model):
                 load_robot(model, parse_mappings(["namespace:=b"]), [Path(tmp)])
 
             table()                                  # warm imports

@@ -132,10 +132,11 @@ def _ttw(value: float | None) -> str:
 
 def render_text(name: str, report: dict, policy: str) -> str:
     intact = report["intact"]
-    lines = [f"authority {name}: {len(report['failures'])} rotors, mass "
-             f"{report['mass_kg']:.4g} kg, thrust-to-weight {report['thrust_to_weight']:.3g}",
-             f"intact: ACAI {intact['acai']:.4g} ({'controllable' if intact['controllable'] else 'NOT controllable'}), "
-             f"needs thrust-to-weight > {_ttw(intact['min_thrust_to_weight'])}"]
+    verdict = "controllable" if intact["controllable"] else "NOT controllable"
+    lines = [(f"authority {name}: {len(report['failures'])} rotors, mass "
+              f"{report['mass_kg']:.4g} kg, thrust-to-weight {report['thrust_to_weight']:.3g}"),
+             (f"intact: ACAI {intact['acai']:.4g} ({verdict}), "
+              f"needs thrust-to-weight > {_ttw(intact['min_thrust_to_weight'])}")]
     degraded = {k: v for k, v in report["efficiency"].items() if v != 1.0}
     if degraded:
         lines.append("efficiency: " + ", ".join(f"{k} {v:g}" for k, v in degraded.items()))
