@@ -25,6 +25,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "new-package": ("reedtool.commands.new_package", "Scaffold a ROS 1/2 package (multirotor or ground robot) that validates and hovers."),
     "rules": ("reedtool.commands.rules", "List validate's rules (codes, names, severities), filtered by family or prefix."),
     "hover-test": ("reedtool.commands.hover_test", "Trim a multirotor for hover and fly it headless: does it settle and stay?"),
+    "authority": ("reedtool.commands.authority", "Control authority (ACAI) about hover, intact and after each single rotor failure."),
     "layout": ("reedtool.commands.layout", "Draw the rotor layout seen from above (SVG/PNG): numbers, spin, COM, arms."),
 }
 

@@ -44,8 +44,12 @@ CASES = [
     ("R341_bad_joint_axis.urdf", ["R341"]),
     ("R342_bad_long_arm.urdf", ["R342"]),
     ("I220_bad_tiny_frame.urdf", ["I220", "I220"]),
+    # R350 (info): the alternating hexacopter loses full control with any rotor; the
+    # paper's PPNNPN order of the same rotors keeps it after four failures.
+    ("R350_bad_alternating_hex.urdf", ["R350"]),
+    ("R350_good_ppnnpn_hex.urdf", []),
     ("clean_quad_x.urdf", []),
-    ("clean_hex.urdf", []),
+    ("clean_hex.urdf", ["R350"]),
     ("clean_octo.urdf", []),
 ]
 

@@ -30,6 +30,7 @@ FAMILIES: dict[str, tuple[str, str]] = {
 # Further rule modules of the families above (a family may span modules).
 EXTRA_RULE_MODULES: tuple[str, ...] = (
     "reedtool.checks.argument_rules",
+    "reedtool.checks.fault_rules",
     "reedtool.checks.flightstack_rules",
     "reedtool.checks.plausibility_rules",
 )

@@ -22,6 +22,9 @@ class ExitStatus(enum.Enum):
     SATURATED = "saturated"            # not settled, the demand long beyond the rotors' range
     YAW_SPIN = "yaw-spin"              # spinning about the vertical
     TRIM_INFEASIBLE = "trim-infeasible"  # no hover trim exists, nothing was simulated
+    # After a rotor failure without yaw control (sim.failure): held position and stayed
+    # upright while spinning about the vertical. Last, so the batch codes above keep theirs.
+    SPINNING_HOLD = "spinning-hold"
 
     @property
     def passed(self) -> bool:

@@ -113,13 +113,14 @@ def describe(status: ExitStatus, reason: str, value: float, time_s: float, settl
 
 
 def initial_state(params: VehicleParams, gains: ControllerGains, config: HoverConfig,
-                  n_vehicles: int) -> tuple[State, np.ndarray]:
-    """Disturbed start with the rotors at the nominal trim speeds; also the setpoint (3,)."""
+                  n_vehicles: int, omega0: np.ndarray | None = None) -> tuple[State, np.ndarray]:
+    """Disturbed start with the rotors at the nominal trim speeds (or `omega0`); also the
+    setpoint (3,)."""
     N = n_vehicles
     setpoint = np.array([0.0, 0.0, config.hover_altitude_m])
     p0 = setpoint + np.asarray(config.offset_m, dtype=float)
     q0 = quat_from_rpy(config.roll_rad, config.pitch_rad, config.yaw_rad)
-    omega0 = hover_speeds(params, gains)
+    omega0 = hover_speeds(params, gains) if omega0 is None else np.asarray(omega0, dtype=float)
     state = State(p=np.repeat(p0[:, None], N, axis=1), v=np.zeros((3, N)),
                   q=np.repeat(q0[:, None], N, axis=1), w=np.zeros((3, N)),
                   omega=np.repeat(omega0[:, None], N, axis=1))
@@ -135,24 +136,32 @@ def hover_speeds(params: VehicleParams, gains: ControllerGains) -> np.ndarray:
 def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
                    plant: Plant | None = None, design: ControllerDesign = ControllerDesign(),
                    progress: Callable[[int], None] | None = None,
-                   engine: str = "numpy", record: bool = False) -> Outcome:
+                   engine: str = "numpy", record: bool = False,
+                   gains: ControllerGains | None = None,
+                   initial_omega_rad_s: np.ndarray | None = None) -> Outcome:
     """Fly every vehicle of `plant` (default: one nominal vehicle) on the nominal controller.
 
     `progress(steps)` is called now and then with the number of steps done since the last call.
     `engine`: "numpy" (this loop, the reference) or "numba" (`compiled`, across the cores).
+    `gains` and `initial_omega_rad_s` override the designed controller and the starting
+    rotor speeds, as in run.simulate_hover (sim.failure: the flight after a rotor fails);
+    the numpy engine flies those.
     """
     config.validate()
     plant = plant or Plant.from_params(params, 1)
     if engine == "numba":
+        if gains is not None or initial_omega_rad_s is not None:
+            raise ValueError("the compiled engine flies the designed controller from trim")
         outcome = _simulate_compiled(params, config, plant, design, record)
         if progress is not None:
             progress(config.n_steps)
         return outcome
-    gains = ControllerGains.from_params(params, design)
+    if gains is None:
+        gains = ControllerGains.from_params(params, design)
     kernel = PlantKernel(plant)
     N, n = plant.n_vehicles, params.n_rotors
     dt = config.dt_s
-    state, setpoint = initial_state(params, gains, config, N)
+    state, setpoint = initial_state(params, gains, config, N, initial_omega_rad_s)
     # Position error, velocity and integral of the position error share one (9, N) block,
     # so the PID is one matrix product; state.v and `integral` are views into it.
     evi = np.zeros((9, N))

@@ -77,14 +77,19 @@ class HoverRun:
 
 def simulate_hover(params: VehicleParams, config: HoverConfig = HoverConfig(),
                    design: ControllerDesign = ControllerDesign(),
-                   record: bool = True, engine: str = "numpy") -> HoverRun:
+                   record: bool = True, engine: str = "numpy",
+                   gains: ControllerGains | None = None,
+                   initial_omega_rad_s: np.ndarray | None = None) -> HoverRun:
     """Fly `params` from the disturbed start for config.duration_s and judge the hover.
 
     `engine`: "numpy" (the reference: the generated float step) or "numba" (the compiled
-    kernel of `compiled`, same equations and the same Flight).
+    kernel of `compiled`, same equations and the same Flight). `gains` and
+    `initial_omega_rad_s` override the designed controller and the trim speeds at the
+    start (sim.failure: the flight after a rotor fails).
     """
     config.validate()
-    gains = ControllerGains.from_params(params, design)
+    if gains is None:
+        gains = ControllerGains.from_params(params, design)
     sample_dt = config.sample_every * config.dt_s
     acos, degrees = math.acos, math.degrees
     setpoint = (0.0, 0.0, float(config.hover_altitude_m))
@@ -100,7 +105,8 @@ def simulate_hover(params: VehicleParams, config: HoverConfig = HoverConfig(),
     p0 = tuple(sp + off for sp, off in zip(setpoint, config.offset_m))
     q0 = tuple(float(x) for x in quat_from_rpy(config.roll_rad, config.pitch_rad,
                                                 config.yaw_rad))
-    omega0 = hover_speeds(params, gains)
+    omega0 = (hover_speeds(params, gains) if initial_omega_rad_s is None
+              else np.asarray(initial_omega_rad_s, dtype=float))
     rec: list[tuple] = []
     flight = fly((*p0, 0.0, 0.0, 0.0, *q0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
                   tuple(float(w) for w in omega0)), rec.append if record else None)

@@ -1,0 +1,250 @@
+"""`reedtool authority`: can this multirotor lose a rotor and still be flown down?
+
+A static analysis (no simulation): the available control authority index (ACAI) of the
+intact vehicle and of every single-rotor failure, with and without yaw control, and the
+thrust-to-weight at which each failure becomes survivable. See docs/fault-tolerance.md.
+
+Exit 0 when the model meets --require, 1 when it does not, 2 on unreadable input.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import click
+
+from reedtool.commands.params import model_option
+from reedtool.errors import ReedtoolError
+
+SCHEMA = "reedtool.authority/1"
+
+# --require policies: what must hold for exit 0.
+POLICIES = {
+    "none": "report only",
+    "hover": "the intact vehicle is controllable about hover",
+    "any-single": "every single rotor failure leaves full control (thrust, roll, pitch, yaw)",
+    "any-single-without-yaw": "every single rotor failure leaves thrust, roll and pitch "
+                              "(the vehicle may spin down)",
+}
+
+
+def _efficiency(items: tuple[str, ...], names: list[str]) -> list[float]:
+    eta = [1.0] * len(names)
+    for item in items:
+        name, sep, value = item.partition("=")
+        if not sep or name not in names:
+            raise ReedtoolError(f"bad --efficiency '{item}': expected ROTOR=ETA with ROTOR one "
+                                f"of {', '.join(names)}", hint="e.g. --efficiency rotor_0=0.5")
+        try:
+            eta_i = float(value)
+        except ValueError:
+            eta_i = math.nan
+        if not 0.0 <= eta_i <= 1.0:
+            raise ReedtoolError(f"bad --efficiency '{item}': ETA must be a number in [0, 1]",
+                                hint="1 is a healthy rotor, 0 a failed one")
+        eta[names.index(name)] = eta_i
+    return eta
+
+
+def _finite(value: float) -> float | None:
+    return float(value) if math.isfinite(value) else None
+
+
+def analyse(rotors, mass_kg: float, com_m, efficiency=None) -> dict:
+    """The JSON-ready report: the intact case and one entry per single-rotor failure."""
+    import numpy as np
+
+    from reedtool.physics.allocation import allocation_matrix
+    from reedtool.physics.authority import failure_cases
+    from reedtool.physics.trim import STANDARD_GRAVITY_M_S2
+
+    B = allocation_matrix(rotors, np.asarray(com_m, dtype=float))
+    K = np.array([r.max_thrust_N for r in rotors], dtype=float)
+    eta = np.ones(len(rotors)) if efficiency is None else np.asarray(efficiency, dtype=float)
+    weight_N = mass_kg * STANDARD_GRAVITY_M_S2
+    # The designer's thrust-to-weight: every rotor healthy, at full speed, along body z.
+    thrust_to_weight = float(B[0] @ K) / weight_N
+
+    def entry(a) -> dict:
+        return {"acai": float(a.acai), "rank": a.rank, "controllable": a.controllable,
+                "acai_without_yaw": float(a.acai_without_yaw),
+                "controllable_without_yaw": a.controllable_without_yaw,
+                "min_thrust_to_weight": _finite(a.min_thrust_scale * thrust_to_weight),
+                "min_thrust_to_weight_without_yaw":
+                    _finite(a.min_thrust_scale_without_yaw * thrust_to_weight)}
+
+    intact, failed = failure_cases(B, K, weight_N, eta)
+    failures = []
+    for i, (rotor, a) in enumerate(zip(rotors, failed)):
+        failures.append({"rotor": rotor.name, "index": i, "motor_number": rotor.motor_number,
+                         "direction": rotor.direction, **entry(a)})
+    return {"mass_kg": mass_kg, "weight_N": weight_N, "thrust_to_weight": thrust_to_weight,
+            "efficiency": {r.name: float(e) for r, e in zip(rotors, eta)},
+            "intact": entry(intact), "failures": failures}
+
+
+def _fly(robot, rotors, props, report: dict, plot_path: Path | None, force: bool) -> None:
+    """Fly every single failure; the controller keeps yaw only where the analysis says it can."""
+    from reedtool.sim import HoverConfig
+    from reedtool.sim.failure import FailureSchedule, simulate_rotor_failure
+    from reedtool.sim.params import VehicleParams, check_rotor_dynamics
+
+    check_rotor_dynamics(rotors)
+    params = VehicleParams.from_rotors(props.mass_kg, props.com_m, props.inertia_kg_m2, rotors)
+    config = HoverConfig(duration_s=6.0)
+    chosen = None
+    for f in report["failures"]:
+        yaw = f["controllable"] or not f["controllable_without_yaw"]
+        run = simulate_rotor_failure(params, FailureSchedule(f["index"], 1.0), config,
+                                     yaw_controlled=yaw, record=plot_path is not None)
+        f["flight"] = {"status": run.status.value, "passed": run.passed,
+                       "yaw_controlled": yaw, "message": run.message}
+        if chosen is None or (chosen.passed and not run.passed):
+            chosen = run
+    if plot_path is not None and chosen is not None:
+        import numpy as np
+
+        from reedtool.io.fileio import atomic_write_bytes
+        from reedtool.sim.plot import render
+
+        keep = [i for i in range(params.n_rotors) if i != chosen.schedule.rotor_index]
+        figure = render(chosen.series(), np.asarray(params.omega_max_rad_s)[keep],
+                        chosen.after.initial_omega_rad_s,
+                        f"{robot.name}: {chosen.status.value}",
+                        fmt=plot_path.suffix.lower().lstrip(".") or "png",
+                        position_tol_m=config.position_tol_m,
+                        attitude_tol_deg=config.attitude_tol_deg,
+                        failures=((chosen.schedule.time_s, f"{chosen.rotor_name} fails"),))
+        atomic_write_bytes(plot_path, figure, force=force)
+
+
+def meets(report: dict, policy: str) -> bool:
+    failures = report["failures"]
+    if policy == "none":
+        return True
+    if policy == "hover":
+        return report["intact"]["controllable"]
+    if policy == "any-single":
+        return report["intact"]["controllable"] and all(f["controllable"] for f in failures)
+    return report["intact"]["controllable"] and all(f["controllable_without_yaw"]
+                                                    for f in failures)
+
+
+def _ttw(value: float | None) -> str:
+    return "never" if value is None else f"{value:.3g}"
+
+
+def render_text(name: str, report: dict, policy: str) -> str:
+    intact = report["intact"]
+    verdict = "controllable" if intact["controllable"] else "NOT controllable"
+    lines = [(f"authority {name}: {len(report['failures'])} rotors, mass "
+              f"{report['mass_kg']:.4g} kg, thrust-to-weight {report['thrust_to_weight']:.3g}"),
+             (f"intact: ACAI {intact['acai']:.4g} ({verdict}), "
+              f"needs thrust-to-weight > {_ttw(intact['min_thrust_to_weight'])}")]
+    degraded = {k: v for k, v in report["efficiency"].items() if v != 1.0}
+    if degraded:
+        lines.append("efficiency: " + ", ".join(f"{k} {v:g}" for k, v in degraded.items()))
+    rows = [("#", "failed rotor", "dir", "ACAI", "full control", "ACAI no yaw",
+             "no yaw", "min T/W", "min T/W no yaw")]
+    for f in report["failures"]:
+        number = "-" if f["motor_number"] is None else str(f["motor_number"])
+        rows.append((number, f["rotor"], f["direction"], f"{f['acai']:.4g}",
+                     "yes" if f["controllable"] else "no", f"{f['acai_without_yaw']:.4g}",
+                     "yes" if f["controllable_without_yaw"] else "no",
+                     _ttw(f["min_thrust_to_weight"]), _ttw(f["min_thrust_to_weight_without_yaw"])))
+    widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]))]
+    for r in rows:
+        lines.append("  " + "  ".join(cell.ljust(w) if c < 3 else cell.rjust(w)
+                                      for c, (cell, w) in enumerate(zip(r, widths))).rstrip())
+    for f in report["failures"]:
+        if "flight" in f:
+            mode = "" if f["flight"]["yaw_controlled"] else " (yaw dropped)"
+            lines.append(f"  flight{mode}: {f['flight']['status'].upper()}: {f['flight']['message']}")
+    full = sum(f["controllable"] for f in report["failures"])
+    no_yaw = sum(f["controllable_without_yaw"] for f in report["failures"])
+    lines.append(f"single failures: {full}/{len(report['failures'])} keep full control, "
+                 f"{no_yaw}/{len(report['failures'])} keep thrust, roll and pitch "
+                 f"(ACAI in mixed units: N and N*m)")
+    ok = meets(report, policy)
+    lines.append(("PASSED" if ok else "FAILED") + f" --require {policy}: {POLICIES[policy]}")
+    return "\n".join(lines)
+
+
+@click.command(name="authority")
+@click.argument("model", type=click.Path(path_type=Path, dir_okay=False))
+@click.argument("mappings", nargs=-1)
+@click.option("--package-path", "package_paths", multiple=True, metavar="DIR",
+              type=click.Path(path_type=Path, file_okay=False),
+              help="Directory to search for ROS packages first (repeatable).")
+@model_option
+@click.option("--efficiency", "efficiency_items", multiple=True, metavar="ROTOR=ETA",
+              help="Degrade a rotor: its maximum thrust times ETA in [0, 1] (repeatable).")
+@click.option("--require", "policy", type=click.Choice(list(POLICIES)), default="hover",
+              show_default=True, help="What must hold for exit 0.")
+@click.option("--fly", is_flag=True,
+              help="Also fly each failure closed-loop (hover, lose the rotor at 1 s, 6 s in all).")
+@click.option("--plot", "plot_path", type=click.Path(path_type=Path, dir_okay=False),
+              help="With --fly: the first failure flight that does not hold (else the first) "
+                   "as .png or .svg, the failure time marked.")
+@click.option("--force", is_flag=True, help="Overwrite an existing --plot file.")
+@click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
+              show_default=True, help="Output format.")
+def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
+            model_name: str | None, efficiency_items: tuple[str, ...], policy: str, fly: bool, plot_path: Path | None,
+            force: bool, fmt: str) -> int:
+    """Control authority of MODEL about hover, intact and after each single rotor failure.
+
+    MODEL is a .urdf or .xacro (with xacro NAME:=VALUE arguments) with motor plugins.
+    """
+    if not model.is_file():
+        raise ReedtoolError("model file not found", file=model,
+                            hint="pass the path of a .urdf or .xacro file")
+    if plot_path is not None and not fly:
+        raise ReedtoolError("--plot needs --fly", hint="add --fly to fly the failures")
+    if plot_path is not None:          # refused before anything is flown
+        from reedtool.io.fileio import check_writable
+
+        check_writable(plot_path, force)
+        if plot_path.suffix.lower() not in (".png", ".svg"):
+            raise ReedtoolError(f"cannot tell the plot format from '{plot_path.name}'",
+                                file=plot_path, hint="name the --plot file .png or .svg")
+    from reedtool.checks.preflight import require_sound_model
+    from reedtool.io.loader import load_robot
+    from reedtool.io.mappings import parse_mappings
+    from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
+    from reedtool.physics.rotors import discover_rotors, lift_rotors
+
+    robot = load_robot(model, parse_mappings(mappings), list(package_paths),
+                       model_name=model_name)
+    require_sound_model(robot)
+    # A VTOL's pusher or a plane's puller holds no hover: the lift rotors are analysed.
+    rotors = lift_rotors(discover_rotors(robot))
+    if len(rotors) < 1:
+        raise ReedtoolError("no motor plugins found: nothing to analyse", file=model,
+                            hint="authority needs RotorS, PX4 or gz-sim motor plugins")
+    bad = [r.name for r in rotors
+           if not (math.isfinite(r.max_thrust_N) and r.max_thrust_N > 0 and r.turning_sign != 0
+                   and all(math.isfinite(v) for v in r.position_m)
+                   and math.isfinite(r.moment_constant))]
+    if bad:
+        raise ReedtoolError(f"rotor(s) {', '.join(bad)} lack a position, a turning direction "
+                            f"or usable constants", file=model,
+                            hint="`reedtool validate MODEL` names the problem")
+    props = whole_robot_pinocchio(robot)
+    if not props.mass_kg > 0:
+        raise ReedtoolError("the robot has no mass", file=model,
+                            hint="run `reedtool inertia` on the model")
+    report = analyse(rotors, props.mass_kg, props.com_m,
+                     _efficiency(efficiency_items, [r.name for r in rotors]))
+    if fly:
+        _fly(robot, rotors, props, report, plot_path, force)
+    report = {"model": robot.name, "require": policy, "passed": meets(report, policy), **report}
+    if fmt == "json":
+        from reedtool.report.json_format import envelope
+
+        click.echo(json.dumps({**envelope(SCHEMA), **report}, indent=2, allow_nan=False))
+    else:
+        click.echo(render_text(robot.name, report, policy))
+    return 0 if report["passed"] else 1
