@@ -28,8 +28,11 @@ def test_generated_autopilot_file_is_clean(tmp_path, frame, autopilot):
     params = px4.load_px4_params(table) if autopilot == "px4" else ardupilot.load_parm(table)
     findings = run_checks(load_robot(model), Selection(), flight_params=[params])
     assert [f for f in findings if f.severity != "info"] == []
-    # PX4: only the hover-throttle comparison, no position offset, no KM mismatch.
-    assert sorted(f.code for f in findings) == (["C421"] if autopilot == "px4" else [])
+    # PX4: only the hover-throttle comparison, no position offset, no KM mismatch; a
+    # hexacopter's alternating spins also get the fault-tolerance information (R350).
+    expected = (["C421"] if autopilot == "px4" else []) + (["R350"] if frame.startswith("hex")
+                                                            else [])
+    assert sorted(f.code for f in findings) == expected
     if autopilot == "px4":
         assert px4.out_of_range(params) == []               # PX4's documented ranges
         assert params.rotor_count == len(params.rotors()) > 0
