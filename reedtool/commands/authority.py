@@ -15,7 +15,7 @@ from pathlib import Path
 
 import click
 
-from reedtool.commands.params import model_option
+from reedtool.commands.params import FiniteFloatRange, model_option
 from reedtool.errors import ReedtoolError
 
 SCHEMA = "reedtool.authority/1"
@@ -85,7 +85,8 @@ def analyse(rotors, mass_kg: float, com_m, efficiency=None) -> dict:
             "intact": entry(intact), "failures": failures}
 
 
-def _fly(robot, rotors, props, report: dict, plot_path: Path | None, force: bool) -> None:
+def _fly(robot, rotors, props, report: dict, plot_path: Path | None, force: bool,
+         fail_at_s: float = 1.0, duration_s: float = 6.0) -> None:
     """Fly every single failure; the controller keeps yaw only where the analysis says it can."""
     from reedtool.sim import HoverConfig
     from reedtool.sim.failure import FailureSchedule, simulate_rotor_failure
@@ -93,11 +94,11 @@ def _fly(robot, rotors, props, report: dict, plot_path: Path | None, force: bool
 
     check_rotor_dynamics(rotors)
     params = VehicleParams.from_rotors(props.mass_kg, props.com_m, props.inertia_kg_m2, rotors)
-    config = HoverConfig(duration_s=6.0)
+    config = HoverConfig(duration_s=duration_s)
     chosen = None
     for f in report["failures"]:
         yaw = f["controllable"] or not f["controllable_without_yaw"]
-        run = simulate_rotor_failure(params, FailureSchedule(f["index"], 1.0), config,
+        run = simulate_rotor_failure(params, FailureSchedule(f["index"], fail_at_s), config,
                                      yaw_controlled=yaw, record=plot_path is not None)
         f["flight"] = {"status": run.status.value, "passed": run.passed,
                        "yaw_controlled": yaw, "message": run.message}
@@ -184,7 +185,12 @@ def render_text(name: str, report: dict, policy: str) -> str:
 @click.option("--require", "policy", type=click.Choice(list(POLICIES)), default="hover",
               show_default=True, help="What must hold for exit 0.")
 @click.option("--fly", is_flag=True,
-              help="Also fly each failure closed-loop (hover, lose the rotor at 1 s, 6 s in all).")
+              help="Also fly each failure closed-loop: hover, lose the rotor at --fail-at, "
+                   "fly on until --duration.")
+@click.option("--fail-at", "fail_at_s", type=FiniteFloatRange(0.0, 600.0), default=1.0,
+              show_default=True, metavar="S", help="With --fly: when the rotor stops [s].")
+@click.option("--duration", "duration_s", type=FiniteFloatRange(0.5, 600.0), default=6.0,
+              show_default=True, metavar="S", help="With --fly: length of each flight [s].")
 @click.option("--plot", "plot_path", type=click.Path(path_type=Path, dir_okay=False),
               help="With --fly: the first failure flight that does not hold (else the first) "
                    "as .png or .svg, the failure time marked.")
@@ -192,8 +198,9 @@ def render_text(name: str, report: dict, policy: str) -> str:
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
               show_default=True, help="Output format.")
 def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
-            model_name: str | None, efficiency_items: tuple[str, ...], policy: str, fly: bool, plot_path: Path | None,
-            force: bool, fmt: str) -> int:
+            model_name: str | None, efficiency_items: tuple[str, ...], policy: str, fly: bool,
+            fail_at_s: float, duration_s: float, plot_path: Path | None, force: bool,
+            fmt: str) -> int:
     """Control authority of MODEL about hover, intact and after each single rotor failure.
 
     MODEL is a .urdf or .xacro (with xacro NAME:=VALUE arguments) with motor plugins.
@@ -201,6 +208,14 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     if not model.is_file():
         raise ReedtoolError("model file not found", file=model,
                             hint="pass the path of a .urdf or .xacro file")
+    from reedtool.sim import HoverConfig
+
+    hold_s = HoverConfig().hold_s
+    if fly and fail_at_s >= duration_s - hold_s:
+        raise ReedtoolError(f"--fail-at {fail_at_s:g} s leaves less than the {hold_s:g} s hold "
+                            f"time before --duration {duration_s:g} s",
+                            hint=f"fail earlier or fly longer (--duration above "
+                                 f"{fail_at_s + hold_s:g})")
     if plot_path is not None and not fly:
         raise ReedtoolError("--plot needs --fly", hint="add --fly to fly the failures")
     if plot_path is not None:          # refused before anything is flown
@@ -239,7 +254,7 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     report = analyse(rotors, props.mass_kg, props.com_m,
                      _efficiency(efficiency_items, [r.name for r in rotors]))
     if fly:
-        _fly(robot, rotors, props, report, plot_path, force)
+        _fly(robot, rotors, props, report, plot_path, force, fail_at_s, duration_s)
     report = {"model": robot.name, "require": policy, "passed": meets(report, policy), **report}
     if fmt == "json":
         from reedtool.report.json_format import envelope
