@@ -146,9 +146,11 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
 def include_tree_of(mappings_for: Callable[[Path], Mapping[str, str]],
                     package_paths: Sequence[Path]) -> Callable[[Path], Sequence[Path]]:
     """An `include_tree` for expand_targets, following includes statically."""
-    from reedtool.io.xacro_expand import scan_legacy
 
     def tree(path: Path) -> Sequence[Path]:
+        # Only directories need it; a single model does not pay for importing xacro.
+        from reedtool.io.xacro_expand import scan_legacy
+
         try:
             return scan_legacy(path, dict(mappings_for(path)), package_paths).files
         except Exception:  # noqa: BLE001 - a broken file is reported when it is loaded
