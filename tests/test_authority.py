@@ -12,8 +12,9 @@ import numpy as np
 import pytest
 
 from reedtool.physics.allocation import allocation_matrix
-from reedtool.physics.authority import acai_support, authority, failure_cases
-from tests.cli_helpers import run_cli
+from reedtool.physics.authority import (acai_support, authority, failure_cases,
+                                        full_control_after_failures)
+from cli_helpers import run_cli
 
 # The paper's hexacopter (Sec. V, Table): mass 1.535 kg, g 9.80, arm 0.275 m,
 # K 6.125 N per rotor, k_mu 0.1; rotor i at 60*i degrees, rotor 1 at the nose.
@@ -185,7 +186,7 @@ def test_r350_names_an_order_that_really_keeps_control():
 
     from reedtool.checks.runner import Selection, run_checks
     from reedtool.io.loader import load_robot
-    from tests.rule_helpers import FIXTURES
+    from rule_helpers import FIXTURES
 
     (finding,) = run_checks(load_robot(FIXTURES / "R350_bad_alternating_hex.urdf"),
                             Selection(select=("R350",)))
@@ -227,7 +228,7 @@ def test_hexacopter_verdicts_do_not_hang_on_the_exact_parameters(K_N, arm_m, k_m
 
 
 def test_bad_input_is_one_line_and_exit_2(tmp_path):
-    from tests.rule_helpers import FIXTURES
+    from rule_helpers import FIXTURES
 
     code, out = run_cli("authority", tmp_path / "missing.urdf")
     assert code == 2 and "model file not found" in out
@@ -238,7 +239,7 @@ def test_bad_input_is_one_line_and_exit_2(tmp_path):
 
 
 def test_require_policies_on_the_paper_hexacopter_fixtures():
-    from tests.rule_helpers import FIXTURES
+    from rule_helpers import FIXTURES
 
     alternating = FIXTURES / "R350_bad_alternating_hex.urdf"
     paired = FIXTURES / "R350_good_ppnnpn_hex.urdf"
@@ -247,3 +248,23 @@ def test_require_policies_on_the_paper_hexacopter_fixtures():
     code, out = run_cli("authority", paired, "--format", "json", "--require", "none")
     assert code == 0
     assert sum(f["controllable"] for f in json.loads(out)["failures"]) == 4
+
+
+def test_the_search_verdict_is_the_tables_verdict():
+    """R350's fast per-failure verdict (column removed) equals failure_cases' (thrust zeroed)."""
+    rng = np.random.default_rng(7)
+    for _ in range(25):
+        n = int(rng.integers(6, 9))
+        angles = np.sort(rng.uniform(0, 2 * np.pi, n))
+        arm = rng.uniform(0.2, 0.4)
+        k_mu = rng.uniform(0.01, 0.1)
+        signs = rng.choice([-1.0, 1.0], n)
+        B = np.vstack([np.ones(n), -arm * np.sin(angles), arm * np.cos(angles), k_mu * signs])
+        K = rng.uniform(4.0, 8.0, n)
+        weight = rng.uniform(0.3, 0.6) * K.sum()
+        _, failed = failure_cases(B, K, weight)
+        fast = full_control_after_failures(B, K, weight)
+        assert [a is not None for a in fast] == [f.controllable for f in failed]
+        for a, f in zip(fast, failed):
+            if a is not None:
+                assert a == pytest.approx(f.acai, rel=1e-9, abs=1e-12)

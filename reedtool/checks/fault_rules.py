@@ -17,7 +17,7 @@ from reedtool.checks.finding import Issue
 from reedtool.checks.registry import rule
 from reedtool.checks.rotor_rules import _physics_ready, _rotors
 from reedtool.physics.allocation import allocation_matrix
-from reedtool.physics.authority import failure_cases
+from reedtool.physics.authority import full_control_after_failures
 from reedtool.physics.trim import STANDARD_GRAVITY_M_S2
 
 # Fewer rotors cannot survive a failure with full control whatever the spin order
@@ -30,8 +30,7 @@ def _survivors(rotors, com_m, signs, weight_N) -> tuple[int, float]:
     """(number of single failures that keep full control, their worst ACAI)."""
     B = _allocation_with_signs(rotors, com_m, signs)
     K = np.array([r.max_thrust_N for r in rotors])
-    _, failed = failure_cases(B, K, weight_N)
-    ok = [f.acai for f in failed if f.controllable]
+    ok = [acai for acai in full_control_after_failures(B, K, weight_N) if acai is not None]
     return len(ok), (min(ok) if ok else -math.inf)
 
 

@@ -161,6 +161,32 @@ def acai_support(B: np.ndarray, thrust_max_N: Sequence[float], G: Sequence[float
     return float(min(np.min(best), value(normal[None, :])[0]))
 
 
+def full_control_after_failures(B: np.ndarray, thrust_max_N: Sequence[float],
+                                weight_N: float) -> list[float | None]:
+    """Per single rotor failure, its ACAI when it keeps full control, else None.
+
+    The verdict of `failure_cases` alone (no yaw-less set, no thrust scale), with the
+    failed rotor's column removed rather than zeroed: fewer facets, the same zonotope.
+    For searches over many layouts (R350 tries every spin order).
+    """
+    B = np.asarray(B, dtype=float)
+    K = np.asarray(thrust_max_N, dtype=float)
+    G = np.array([weight_N, 0.0, 0.0, 0.0])
+    tol = ACAI_REL_TOL * (float(np.linalg.norm(B, axis=0) @ K) or 1.0)
+    out: list[float | None] = []
+    for i in range(B.shape[1]):
+        keep = np.arange(B.shape[1]) != i
+        B_i, K_i = B[:, keep], K[keep]
+        if np.linalg.matrix_rank(B_i[:, K_i > 0]) < 4:
+            out.append(None)
+            continue
+        normals = _facet_normals(B_i)
+        centre = B_i @ K_i / 2.0
+        acai = float(np.min(np.abs(normals @ B_i) @ (K_i / 2.0) - np.abs(normals @ (G - centre))))
+        out.append(acai if acai > tol else None)
+    return out
+
+
 def failure_cases(B: np.ndarray, thrust_max_N: Sequence[float], weight_N: float,
                   efficiency: Sequence[float] | None = None) -> tuple[Authority, list[Authority]]:
     """The intact vehicle and one Authority per single rotor failure (eta_i = 0)."""
