@@ -286,6 +286,14 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
     check_batch_resources(every_rotor, samples, max_memory_bytes)
     props = whole_robot_pinocchio(robot)
     trim = solve_trim(props.mass_kg, props.com_m, rotors)
+    if every_rotor and not rotors:
+        # A fixed-wing's puller (or a glider with a pusher): motors exist, none lifts.
+        import dataclasses
+
+        roles = ", ".join(f"{r.name} is {r.role}" for r in every_rotor)
+        trim = dataclasses.replace(trim, message=(
+            f"the model has no lift rotors ({roles}: its thrust axis is horizontal); "
+            "a fixed-wing cannot hover"))
     report: dict = {
         "model": {"name": robot.name, "file": str(robot.source_file or ""),
                   "mass_kg": props.mass_kg, "com_m": [float(v) for v in props.com_m],

@@ -45,6 +45,10 @@ ARDUPILOT_PLUGINS = {"ArduPilotPlugin"}        # libArduPilotPlugin.so (classic)
 LIFT_DRAG_PLUGINS = {"LiftDragPlugin", "gz-sim-lift-drag-system",
                      "ignition-gazebo-lift-drag-system"}
 LIFT_DRAG_NAMES = {"gz::sim::systems::LiftDrag", "ignition::gazebo::systems::LiftDrag"}
+# gz-sim's AdvancedLiftDrag models a whole airframe (PX4's advanced_plane): a wing, never
+# a propeller blade, so it only tells the roles a wing is there.
+ADVANCED_LIFT_DRAG_PLUGINS = {"gz-sim-advanced-lift-drag-system"}
+ADVANCED_LIFT_DRAG_NAMES = {"gz::sim::systems::AdvancedLiftDrag"}
 
 MAVLINK_PLUGINS = {"rotors_gazebo_mavlink_interface", "gazebo_mavlink_interface"}
 
@@ -383,8 +387,9 @@ def assign_roles(rotors: list[Rotor], has_wing: bool = False) -> None:
     Propulsion: a thrust axis between 60° and 120° from body z (horizontal or nearly; a
     rotor pointing down stays 'lift' so the tilt rule can say it points down) on a
     vehicle that lifts otherwise, and either along body ±x (within 30°: a pusher or a
-    puller) or on a vehicle with a wing (a LiftDrag surface not on a rotor; frames such
-    as ardupilot_gazebo's zephyr fly along their y axis). A sideways rotor on a wingless
+    puller) or on a vehicle with a wing (a LiftDrag surface not on a rotor, or an
+    AdvancedLiftDrag airframe; frames such as ardupilot_gazebo's zephyr fly along their
+    y axis). A sideways rotor on a wingless
     multirotor is a mistake, not propulsion: it stays 'lift' and R311 reports it. An
     omnidirectional frame (reversible motors, or axes spanning every direction) keeps
     every rotor as lift: it hovers with all of them through the 6-DoF allocation. A
@@ -421,7 +426,11 @@ def lift_rotors(rotors: list[Rotor]) -> list[Rotor]:
 
 def _has_wing(robot: Robot, rotors: list[Rotor], blades: dict[str, list[Blade]]) -> bool:
     rotor_links = {r.link for r in rotors}
-    return any(link not in rotor_links for link in blades)
+    if any(link not in rotor_links for link in blades):
+        return True
+    return any(plugin.library in ADVANCED_LIFT_DRAG_PLUGINS
+               or (plugin.name or "") in ADVANCED_LIFT_DRAG_NAMES
+               for _, plugin in robot.plugins())
 
 
 def rotor_table(rotors: list[Rotor]) -> list[dict]:
