@@ -310,13 +310,8 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
         report["message"] = f"no hover trim: {trim.message}"
         return report
 
-    estimated = [r for r in rotors if r.kind == "ardupilot"]
-    if estimated:
-        loc = estimated[0].loc
-        raise ReedtoolError(
-            f"rotor {estimated[0].name}: ArduPilotPlugin rotors have no motor time constants, "
-            "and hover-test simulates the motor response", file=loc.file, line=loc.line,
-            hint="`reedtool validate` checks their hover trim from the LiftDrag estimate")
+    rotors, derived = _ardupilot_motor_response(robot, rotors)
+    report["model"]["derived"] = derived
     check_rotor_dynamics(rotors)
     if props.mass_kg <= 0 or not np.all(np.linalg.eigvalsh(props.inertia_kg_m2) > 0):
         raise ReedtoolError("the whole-robot inertia is not positive definite, nothing can "
@@ -355,6 +350,31 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
         report["batch"] = batch.to_dict()
         report["_envelope"] = batch.envelope
     return report
+
+
+def _ardupilot_motor_response(robot, rotors):
+    """ArduPilotPlugin rotors carry no time constants: derive them from the joint's
+    velocity PID and the rotor's inertia, or refuse with the reason (one line)."""
+    import dataclasses
+
+    from reedtool.physics.rotors import ardupilot_time_constant
+
+    out, derived = [], []
+    for rotor in rotors:
+        if rotor.kind != "ardupilot":
+            out.append(rotor)
+            continue
+        found = ardupilot_time_constant(robot, rotor)
+        if not found.time_constant_s > 0:
+            raise ReedtoolError(
+                f"rotor {rotor.name}: the ArduPilotPlugin gives no motor time constant "
+                f"({found.explanation}), and hover-test simulates the motor response",
+                file=rotor.loc.file, line=rotor.loc.line,
+                hint="`reedtool validate` checks their hover trim from the LiftDrag estimate")
+        out.append(dataclasses.replace(rotor, time_constant_up_s=found.time_constant_s,
+                                       time_constant_down_s=found.time_constant_s))
+        derived.append(f"{rotor.name}: {found.explanation}")
+    return out, derived
 
 
 @contextlib.contextmanager
@@ -401,6 +421,8 @@ def render_text(report: dict) -> str:
     if others:
         lines.append("not used for hover: " + ", ".join(f"{r['name']} ({r['role']})"
                                                          for r in others))
+    for line in model.get("derived", ()):
+        lines.append(f"derived: {line}")
     if trim["feasible"]:
         lines.append(f"trim: {trim['message']}")
     else:

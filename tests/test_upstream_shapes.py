@@ -1,0 +1,137 @@
+"""Models in the shape of what people fly today (acceptance sweep, issues 10 and 11).
+
+Fixtures: tests/fixtures/upstream_shapes/<name>/model.sdf, written for this project in
+the structure and with the numbers of the public models their comments name. Each good
+fixture stays quiet (no error, no warning); each `<CODE>_bad_*` plants one defect that is
+still found. Expected numbers are derived here by hand from the fixtures' written values.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from reedtool.checks.runner import run_checks
+from reedtool.cli import main
+from reedtool.io.loader import load_robot
+from reedtool.physics.rotors import ardupilot_time_constant, discover_rotors
+
+SHAPES = Path(__file__).parent / "fixtures" / "upstream_shapes"
+
+CASES = [
+    ("fixed_wing_puller", ["R319"]),
+    ("R316_bad_fixed_wing_negative_k", ["R316", "R319"]),
+    ("tiltrotor", []),
+    ("I209_bad_tiltrotor_motor_inertia", ["I209", "I209"]),
+]
+GOOD = [name for name, _ in CASES if "_bad_" not in name]
+
+
+def _model(name: str) -> Path:
+    return SHAPES / name / "model.sdf"
+
+
+def _findings(name: str):
+    return run_checks(load_robot(_model(name)))
+
+
+@pytest.mark.parametrize("name,expected", CASES, ids=[c[0] for c in CASES])
+def test_codes(name, expected):
+    assert sorted(f.code for f in _findings(name)) == expected
+
+
+@pytest.mark.parametrize("name", GOOD)
+def test_good_shapes_have_no_error_or_warning(name):
+    assert [f.code for f in _findings(name) if f.severity in ("error", "warning")] == []
+
+
+# ------------------------------------------------------------------ fixed-wing
+
+def test_fixed_wing_puller_is_propulsion_with_an_advanced_lift_drag_wing():
+    (rotor,) = discover_rotors(load_robot(_model("fixed_wing_puller")))
+    assert rotor.role == "propulsion"
+    # Link pitched 1.57 rad: its z axis is (sin 1.57, 0, cos 1.57) in the base frame.
+    np.testing.assert_allclose(rotor.axis, [math.sin(1.57), 0, math.cos(1.57)], atol=1e-12)
+
+
+def test_fixed_wing_puller_without_a_wing_stays_lift(tmp_path):
+    """The wing is what makes a lone horizontal rotor propulsion: without any lift-drag
+    surface the same model is a (broken) multirotor and the rotor rules speak."""
+    text = _model("fixed_wing_puller").read_text()
+    start = text.index("    <plugin filename='gz-sim-advanced-lift-drag-system'")
+    end = text.index("</plugin>", start) + len("</plugin>\n")
+    model = tmp_path / "wingless.sdf"
+    model.write_text(text[:start] + text[end:])
+    (rotor,) = discover_rotors(load_robot(model))
+    assert rotor.role == "lift"
+    codes = {f.code for f in run_checks(load_robot(model))}
+    assert {"R304", "R305"} <= codes
+
+
+def test_hover_test_says_a_fixed_wing_cannot_hover(capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["hover-test", str(_model("fixed_wing_puller"))])
+    captured = capsys.readouterr()
+    assert info.value.code == 1
+    assert "Traceback" not in captured.err
+    failed = [line for line in captured.out.splitlines() if line.startswith("FAILED")]
+    assert failed == ["FAILED: no hover trim: the model has no lift rotors (rotor_puller is "
+                      "propulsion: its thrust axis is horizontal); a fixed-wing cannot hover"]
+
+
+# ------------------------------------------------------------------- tiltrotor
+
+def test_tiltrotor_servos_are_not_rotors_and_trim_by_hand():
+    robot = load_robot(_model("tiltrotor"))
+    rotors = discover_rotors(robot)
+    assert [r.link for r in rotors] == ["rotor_0", "rotor_1", "rotor_2", "rotor_3"]
+    assert [r.direction for r in rotors] == ["ccw", "ccw", "cw", "cw"]
+    assert all(r.role == "lift" for r in rotors)
+    from reedtool.checks.context import CheckContext
+
+    trim = CheckContext(robot).trim
+    # 5 kg body, two 50 g tilt motors at x = +0.35, four 5 g rotors: COM x = 0.035/5.12.
+    mass, k = 5 + 2 * 0.05 + 4 * 0.005, 2e-05
+    com_x = (2 * 0.05 * 0.35) / mass
+    # Pitch balance: 2 T_front (0.35 - c) = 2 T_back (0.35 + c); 2 T_front + 2 T_back = m g.
+    weight = mass * 9.80665
+    t_front = weight / 2 * (0.35 + com_x) / 0.7
+    t_back = weight / 2 - t_front
+    expected = np.sqrt(np.array([t_front, t_back, t_front, t_back]) / k)
+    assert trim.feasible
+    np.testing.assert_allclose(trim.omega_rad_s, expected, rtol=1e-6)
+
+
+# ----------------------------------------------------------- ArduPilot motor lag
+
+def _iris_rotor(tmp_path, edit=lambda text: text):
+    text = (Path(__file__).parent / "fixtures" / "ardupilot" / "iris_lift_drag.sdf").read_text()
+    model = tmp_path / "iris.sdf"
+    model.write_text(edit(text))
+    robot = load_robot(model)
+    return robot, discover_rotors(robot)[0]
+
+
+def test_ardupilot_time_constant_pd_and_offset_inertial(tmp_path):
+    """(I + d) / p with I about the joint axis through the link origin: the COM 0.01 m off
+    that axis adds m * 0.01^2 (parallel axis)."""
+    def edit(text):
+        text = text.replace("<d_gain>0</d_gain>", "<d_gain>0.0001</d_gain>")
+        return text.replace("<inertial><mass>0.005</mass>",
+                            "<inertial><pose>0.01 0 0 0 0 0</pose><mass>0.005</mass>", 1)
+    robot, rotor = _iris_rotor(tmp_path, edit)
+    found = ardupilot_time_constant(robot, rotor)
+    inertia = 2.5e-05 + 0.005 * 0.01 ** 2
+    assert found.time_constant_s == pytest.approx((inertia + 0.0001) / 0.20, rel=1e-12)
+
+
+def test_ardupilot_time_constant_refused_without_force_control(tmp_path):
+    def edit(text):
+        return text.replace("<useForce>1</useForce>", "<useForce>0</useForce>")
+    robot, rotor = _iris_rotor(tmp_path, edit)
+    found = ardupilot_time_constant(robot, rotor)
+    assert math.isnan(found.time_constant_s)
+    assert "useForce" in found.explanation
