@@ -26,12 +26,15 @@ CASES = [
     ("R316_bad_fixed_wing_negative_k", ["R316", "R319"]),
     ("tiltrotor", []),
     ("I209_bad_tiltrotor_motor_inertia", ["I209", "I209"]),
+    ("rotors_plus_quad", []),
+    ("R304_bad_rotors_plus_quad_flipped", ["R304"]),
 ]
 GOOD = [name for name, _ in CASES if "_bad_" not in name]
 
 
 def _model(name: str) -> Path:
-    return SHAPES / name / "model.sdf"
+    (path,) = [p for p in (SHAPES / name).iterdir() if p.suffix in (".sdf", ".xacro")]
+    return path
 
 
 def _findings(name: str):
@@ -135,3 +138,19 @@ def test_ardupilot_time_constant_refused_without_force_control(tmp_path):
     found = ardupilot_time_constant(robot, rotor)
     assert math.isnan(found.time_constant_s)
     assert "useForce" in found.explanation
+
+
+# ------------------------------------------------------------ RotorS "+" quad
+
+def test_rotors_plus_quad_through_the_bundled_macros_by_hand():
+    robot = load_robot(_model("rotors_plus_quad"))
+    rotors = discover_rotors(robot)
+    assert [r.direction for r in rotors] == ["cw", "ccw", "cw", "ccw"]
+    expected_xy = [(0.17, 0), (0, 0.17), (-0.17, 0), (0, -0.17)]
+    for rotor, (x, y) in zip(rotors, expected_xy):
+        np.testing.assert_allclose(rotor.position_m, [x, y, 0.01], atol=1e-12)
+    from reedtool.checks.context import CheckContext
+
+    mass, k = 0.68 + 4 * 0.009, 8.54858e-06
+    np.testing.assert_allclose(CheckContext(robot).trim.omega_rad_s,
+                               math.sqrt(mass * 9.80665 / (4 * k)), rtol=1e-9)
