@@ -28,6 +28,8 @@ CASES = [
     ("I209_bad_tiltrotor_motor_inertia", ["I209", "I209"]),
     ("rotors_plus_quad", []),
     ("R304_bad_rotors_plus_quad_flipped", ["R304"]),
+    ("quad_tailsitter", ["R320"]),
+    ("R311_bad_tailsitter_one_rotor_untilted", ["R311"] * 3),
 ]
 GOOD = [name for name, _ in CASES if "_bad_" not in name]
 
@@ -154,3 +156,23 @@ def test_rotors_plus_quad_through_the_bundled_macros_by_hand():
     mass, k = 0.68 + 4 * 0.009, 8.54858e-06
     np.testing.assert_allclose(CheckContext(robot).trim.omega_rad_s,
                                math.sqrt(mass * 9.80665 / (4 * k)), rtol=1e-9)
+
+
+# ------------------------------------------------------------- quad tailsitter
+
+def test_quad_tailsitter_tilts_and_trim_by_hand():
+    """rpy (+-0.17, +-0.17, 0): the rotor z axis is (cos r sin p, -sin r, cos r cos p), so
+    each rotor lifts with cos(0.17)^2 of its thrust; the side components cancel."""
+    robot = load_robot(_model("quad_tailsitter"))
+    rotors = discover_rotors(robot)
+    cz = math.cos(0.17) ** 2
+    for rotor in rotors:
+        assert rotor.role == "lift"
+        assert rotor.axis[2] == pytest.approx(cz, rel=1e-12)
+        assert abs(rotor.axis[0]) == pytest.approx(math.cos(0.17) * math.sin(0.17), rel=1e-12)
+        assert abs(rotor.axis[1]) == pytest.approx(math.sin(0.17), rel=1e-12)
+    from reedtool.checks.context import CheckContext
+
+    trim = CheckContext(robot).trim
+    thrust = (1.6 + 4 * 0.005) * 9.80665 / (4 * cz)
+    np.testing.assert_allclose(trim.thrust_N, thrust, rtol=1e-9)
