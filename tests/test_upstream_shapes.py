@@ -176,3 +176,32 @@ def test_quad_tailsitter_tilts_and_trim_by_hand():
     trim = CheckContext(robot).trim
     thrust = (1.6 + 4 * 0.005) * 9.80665 / (4 * cz)
     np.testing.assert_allclose(trim.thrust_N, thrust, rtol=1e-9)
+
+
+# ------------------------------------------------------- omnidirectional frame
+
+def test_hover_test_judges_an_omni_frame_by_its_6dof_trim_then_refuses_to_fly(capsys):
+    """validate finds the reversible omni frame's 6-DoF trim; hover-test used to run the
+    4-DoF one-way trim on it and report FAILED (yaw cannot cancel): a false alarm."""
+    omni = Path(__file__).parent / "fixtures" / "omni" / "omni_reversible.sdf"
+    with pytest.raises(SystemExit) as info:
+        main(["hover-test", str(omni)])
+    captured = capsys.readouterr()
+    assert info.value.code == 2
+    assert "FAILED" not in captured.out and "Traceback" not in captured.err
+    (line,) = captured.err.strip().splitlines()
+    assert "(6-DoF allocation)" in line and "cannot fly an omnidirectional frame" in line
+
+
+def test_hover_test_still_fails_an_omni_frame_too_heavy_to_hover(tmp_path, capsys):
+    omni = Path(__file__).parent / "fixtures" / "omni" / "omni_reversible.sdf"
+    text = omni.read_text()
+    model = tmp_path / "omni_heavy.sdf"
+    start = text.index("<mass>") + len("<mass>")
+    end = text.index("</mass>", start)
+    model.write_text(text[:start] + "60" + text[end:])
+    with pytest.raises(SystemExit) as info:
+        main(["hover-test", str(model), "--ignore-validation"])
+    out = capsys.readouterr().out
+    assert info.value.code == 1
+    assert "INFEASIBLE (insufficient-thrust)" in out

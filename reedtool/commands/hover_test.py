@@ -275,8 +275,9 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
     import numpy as np
 
     from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
-    from reedtool.physics.rotors import discover_rotors, lift_rotors, rotor_table
-    from reedtool.physics.trim import solve_trim
+    from reedtool.physics.rotors import (discover_rotors, is_omnidirectional, lift_rotors,
+                                         rotor_table)
+    from reedtool.physics.trim import solve_trim, solve_trim_6dof
     from reedtool.sim import ExitStatus
     from reedtool.sim.params import VehicleParams, check_rotor_dynamics
 
@@ -285,7 +286,10 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
     rotors = lift_rotors(every_rotor)
     check_batch_resources(every_rotor, samples, max_memory_bytes)
     props = whole_robot_pinocchio(robot)
-    trim = solve_trim(props.mass_kg, props.com_m, rotors)
+    # The trim validate judges by (checks.context): the 6-DoF allocation for an
+    # omnidirectional frame, whose reversible rotors may push down.
+    omni = is_omnidirectional(rotors)
+    trim = (solve_trim_6dof if omni else solve_trim)(props.mass_kg, props.com_m, rotors)
     if every_rotor and not rotors:
         # A fixed-wing's puller (or a glider with a pusher): motors exist, none lifts.
         import dataclasses
@@ -310,6 +314,13 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
         report["message"] = f"no hover trim: {trim.message}"
         return report
 
+    if omni:
+        raise ReedtoolError(
+            f"{robot.name}: {trim.message}; hover-test's flight controller cannot fly an "
+            "omnidirectional frame (reversible or many-direction rotors): it commands thrust "
+            "and three torques from rotors that push one way",
+            file=robot.source_file,
+            hint="`reedtool validate` checks this frame's 6-DoF hover trim and allocation")
     rotors, derived = _ardupilot_motor_response(robot, rotors)
     report["model"]["derived"] = derived
     check_rotor_dynamics(rotors)
