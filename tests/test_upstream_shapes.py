@@ -30,6 +30,8 @@ CASES = [
     ("R304_bad_rotors_plus_quad_flipped", ["R304"]),
     ("quad_tailsitter", ["R320"]),
     ("R311_bad_tailsitter_one_rotor_untilted", ["R311"] * 3),
+    ("px4vision_quad", []),
+    ("R301_bad_px4vision_duplicate_number", ["R301"]),
 ]
 GOOD = [name for name, _ in CASES if "_bad_" not in name]
 
@@ -205,3 +207,17 @@ def test_hover_test_still_fails_an_omni_frame_too_heavy_to_hover(tmp_path, capsy
     out = capsys.readouterr().out
     assert info.value.code == 1
     assert "INFEASIBLE (insufficient-thrust)" in out
+
+
+# ------------------------------------------------------------------- px4vision
+
+def test_px4vision_rotors_and_hover_by_hand():
+    robot = load_robot(_model("px4vision_quad"))
+    rotors = discover_rotors(robot)
+    assert [r.motor_number for r in rotors] == [0, 1, 2, 3]
+    assert [r.direction for r in rotors] == ["ccw", "ccw", "cw", "cw"]
+    from reedtool.checks.context import CheckContext
+
+    mass, k = 1.5 + 4 * 0.005, 8.54858e-06
+    np.testing.assert_allclose(CheckContext(robot).trim.omega_rad_s,
+                               math.sqrt(mass * 9.80665 / (4 * k)), rtol=1e-9)
