@@ -221,3 +221,15 @@ def test_px4vision_rotors_and_hover_by_hand():
     mass, k = 1.5 + 4 * 0.005, 8.54858e-06
     np.testing.assert_allclose(CheckContext(robot).trim.omega_rad_s,
                                math.sqrt(mass * 9.80665 / (4 * k)), rtol=1e-9)
+
+
+def test_hover_test_on_a_broken_ardupilot_model_reports_validation_not_time_constants(capsys):
+    """The bad-input pre-check before the validation verdict used to demand
+    <timeConstantUp> from ArduPilotPlugin rotors (exit 2, a false 'bad input')."""
+    bad = Path(__file__).parent / "fixtures" / "ardupilot" / "R318_bad_multiplier_sign.sdf"
+    with pytest.raises(SystemExit) as info:
+        main(["hover-test", str(bad)])
+    captured = capsys.readouterr()
+    assert info.value.code == 1
+    assert "timeConstantUp" not in captured.err
+    assert captured.out.splitlines()[-1].startswith("FAILED: validate reports")
