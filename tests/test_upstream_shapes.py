@@ -233,3 +233,17 @@ def test_hover_test_on_a_broken_ardupilot_model_reports_validation_not_time_cons
     assert info.value.code == 1
     assert "timeConstantUp" not in captured.err
     assert captured.out.splitlines()[-1].startswith("FAILED: validate reports")
+
+
+def test_fixed_wing_with_classic_lift_drag_wing_is_also_propulsion(tmp_path):
+    """rc_cessna's shape: the wing is a LiftDrag plugin on the body instead."""
+    text = _model("fixed_wing_puller").read_text()
+    start = text.index("    <plugin filename='gz-sim-advanced-lift-drag-system'")
+    end = text.index("</plugin>", start) + len("</plugin>\n")
+    wing = ("    <plugin filename='gz-sim-lift-drag-system' name='gz::sim::systems::LiftDrag'>"
+            "<a0>0.05984281113</a0><cla>4.752798721</cla><cda>0.6417112299</cda>"
+            "<cp>-0.12 0 0</cp><area>0.34</area><forward>1 0 0</forward><upward>0 0 1</upward>"
+            "<link_name>base_link</link_name></plugin>\n")
+    model = tmp_path / "cessna_like.sdf"
+    model.write_text(text[:start] + wing + text[end:])
+    assert sorted(f.code for f in run_checks(load_robot(model))) == ["R319"]
