@@ -495,7 +495,9 @@ def ardupilot_time_constant(robot: Robot, rotor: Rotor) -> DerivedTimeConstant:
     (I + d) * de/dt = -p * e, a first-order lag with tau = (I + d) / p, I the rotor
     link's moment of inertia about the joint axis. That holds while p*|e| <= cmd_max;
     beyond it the torque saturates and the speed ramps at cmd_max / I (a larger step
-    takes longer than tau says). Aerodynamic drag torque from the blades is left out.
+    takes longer than tau says). Aerodynamic drag torque from the blades is left out, and
+    so is joint damping b (it would give I / (p + b); ardupilot_gazebo's iris has
+    b = 1e-4 against p = 0.2, a 0.05 % change).
     An integral term makes the response second order, and `useForce` false sets the
     joint speed directly: neither has one time constant, so none is derived.
     """
