@@ -85,8 +85,8 @@ def test_hover_test_says_a_fixed_wing_cannot_hover(capsys):
     assert info.value.code == 1
     assert "Traceback" not in captured.err
     failed = [line for line in captured.out.splitlines() if line.startswith("FAILED")]
-    assert failed == ["FAILED: no hover trim: the model has no lift rotors (rotor_puller is "
-                      "propulsion: its thrust axis is horizontal); a fixed-wing cannot hover"]
+    assert failed == [("FAILED: no hover trim: the model has no lift rotors (rotor_puller is "
+                       "propulsion: its thrust axis is horizontal); a fixed-wing cannot hover")]
 
 
 # ------------------------------------------------------------------- tiltrotor

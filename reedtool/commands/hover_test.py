@@ -182,10 +182,9 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
                             hint="pass the path of a .urdf or .xacro file")
 
     from reedtool.checks.preflight import require_sound_model
+    from reedtool.commands.validate import validation_errors
     from reedtool.io.loader import load_robot
     from reedtool.io.mappings import parse_mappings
-
-    from reedtool.commands.validate import validation_errors
 
     robot = load_robot(model, parse_mappings(mappings), list(package_paths),
                        model_name=model_name)
@@ -277,8 +276,12 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
     import numpy as np
 
     from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
-    from reedtool.physics.rotors import (discover_rotors, is_omnidirectional, lift_rotors,
-                                         rotor_table)
+    from reedtool.physics.rotors import (
+        discover_rotors,
+        is_omnidirectional,
+        lift_rotors,
+        rotor_table,
+    )
     from reedtool.physics.trim import solve_trim, solve_trim_6dof
     from reedtool.sim import ExitStatus
     from reedtool.sim.params import VehicleParams, check_rotor_dynamics
