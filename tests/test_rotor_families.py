@@ -351,12 +351,32 @@ def test_odd_gz_input_never_raises(tmp_path, old, new):
         run_checks(robot)
 
 
-def test_hover_test_refuses_ardupilot_rotors_in_one_line(capsys):
+def test_hover_test_derives_ardupilot_time_constant_from_the_pid(capsys):
+    """iris: rotor izz 2.5e-05 kg m^2 about its +z joint, p_gain 0.20, d_gain 0: a P
+    controller on joint speed gives tau = I / p = 1.25e-4 s (hand-derived)."""
     from reedtool.cli import main
 
     with pytest.raises(SystemExit) as info:
         main(["hover-test", str(FIXTURES / "ardupilot/iris_lift_drag.sdf")])
+    out = capsys.readouterr().out
+    assert info.value.code == 0
+    derived = [line for line in out.splitlines() if line.startswith("derived: ")]
+    assert len(derived) == 4
+    assert all("0.000125 s derived from the ArduPilotPlugin velocity PID" in line
+               for line in derived)
+    assert "cmd_max/p_gain = 12.5 rad/s" in derived[0]   # 2.5 N*m / 0.2
+
+
+def test_hover_test_refuses_ardupilot_pid_with_integral_term(tmp_path, capsys):
+    from reedtool.cli import main
+
+    text = (FIXTURES / "ardupilot/iris_lift_drag.sdf").read_text()
+    assert "<i_gain>0</i_gain>" in text
+    model = tmp_path / "iris_pi.sdf"
+    model.write_text(text.replace("<i_gain>0</i_gain>", "<i_gain>0.5</i_gain>"))
+    with pytest.raises(SystemExit) as info:
+        main(["hover-test", str(model)])
     err = capsys.readouterr().err
     assert info.value.code == 2
-    assert "ArduPilotPlugin rotors have no motor time constants" in err
-    assert "Traceback" not in err
+    assert "integral term (i_gain 0.5)" in err and "second order" in err
+    assert "Traceback" not in err and len(err.strip().splitlines()) <= 2

@@ -199,7 +199,9 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
 
         every_rotor = discover_rotors(robot)
         check_batch_resources(every_rotor, samples, max_memory_mb * 1024 * 1024)
-        check_rotor_dynamics(every_rotor)
+        # ArduPilotPlugin rotors carry no time constants: hover_test derives them from
+        # the joint's velocity PID (or refuses with the reason) only when it flies.
+        check_rotor_dynamics([r for r in every_rotor if r.kind != "ardupilot"])
     if errors:
         from reedtool.report import ModelResult, render
 
@@ -275,8 +277,13 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
     import numpy as np
 
     from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
-    from reedtool.physics.rotors import discover_rotors, lift_rotors, rotor_table
-    from reedtool.physics.trim import solve_trim
+    from reedtool.physics.rotors import (
+        discover_rotors,
+        is_omnidirectional,
+        lift_rotors,
+        rotor_table,
+    )
+    from reedtool.physics.trim import solve_trim, solve_trim_6dof
     from reedtool.sim import ExitStatus
     from reedtool.sim.params import VehicleParams, check_rotor_dynamics
 
@@ -285,7 +292,18 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
     rotors = lift_rotors(every_rotor)
     check_batch_resources(every_rotor, samples, max_memory_bytes)
     props = whole_robot_pinocchio(robot)
-    trim = solve_trim(props.mass_kg, props.com_m, rotors)
+    # The trim validate judges by (checks.context): the 6-DoF allocation for an
+    # omnidirectional frame, whose reversible rotors may push down.
+    omni = is_omnidirectional(rotors)
+    trim = (solve_trim_6dof if omni else solve_trim)(props.mass_kg, props.com_m, rotors)
+    if every_rotor and not rotors:
+        # A fixed-wing's puller (or a glider with a pusher): motors exist, none lifts.
+        import dataclasses
+
+        roles = ", ".join(f"{r.name} is {r.role}" for r in every_rotor)
+        trim = dataclasses.replace(trim, message=(
+            f"the model has no lift rotors ({roles}: its thrust axis is horizontal); "
+            "a fixed-wing cannot hover"))
     report: dict = {
         "model": {"name": robot.name, "file": str(robot.source_file or ""),
                   "mass_kg": props.mass_kg, "com_m": [float(v) for v in props.com_m],
@@ -302,13 +320,15 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
         report["message"] = f"no hover trim: {trim.message}"
         return report
 
-    estimated = [r for r in rotors if r.kind == "ardupilot"]
-    if estimated:
-        loc = estimated[0].loc
+    if omni:
         raise ReedtoolError(
-            f"rotor {estimated[0].name}: ArduPilotPlugin rotors have no motor time constants, "
-            "and hover-test simulates the motor response", file=loc.file, line=loc.line,
-            hint="`reedtool validate` checks their hover trim from the LiftDrag estimate")
+            f"{robot.name}: {trim.message}; hover-test's flight controller cannot fly an "
+            "omnidirectional frame (reversible or many-direction rotors): it commands thrust "
+            "and three torques from rotors that push one way",
+            file=robot.source_file,
+            hint="`reedtool validate` checks this frame's 6-DoF hover trim and allocation")
+    rotors, derived = _ardupilot_motor_response(robot, rotors)
+    report["model"]["derived"] = derived
     check_rotor_dynamics(rotors)
     if props.mass_kg <= 0 or not np.all(np.linalg.eigvalsh(props.inertia_kg_m2) > 0):
         raise ReedtoolError("the whole-robot inertia is not positive definite, nothing can "
@@ -347,6 +367,31 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
         report["batch"] = batch.to_dict()
         report["_envelope"] = batch.envelope
     return report
+
+
+def _ardupilot_motor_response(robot, rotors):
+    """ArduPilotPlugin rotors carry no time constants: derive them from the joint's
+    velocity PID and the rotor's inertia, or refuse with the reason (one line)."""
+    import dataclasses
+
+    from reedtool.physics.rotors import ardupilot_time_constant
+
+    out, derived = [], []
+    for rotor in rotors:
+        if rotor.kind != "ardupilot":
+            out.append(rotor)
+            continue
+        found = ardupilot_time_constant(robot, rotor)
+        if not found.time_constant_s > 0:
+            raise ReedtoolError(
+                f"rotor {rotor.name}: the ArduPilotPlugin gives no motor time constant "
+                f"({found.explanation}), and hover-test simulates the motor response",
+                file=rotor.loc.file, line=rotor.loc.line,
+                hint="`reedtool validate` checks their hover trim from the LiftDrag estimate")
+        out.append(dataclasses.replace(rotor, time_constant_up_s=found.time_constant_s,
+                                       time_constant_down_s=found.time_constant_s))
+        derived.append(f"{rotor.name}: {found.explanation}")
+    return out, derived
 
 
 @contextlib.contextmanager
@@ -393,6 +438,8 @@ def render_text(report: dict) -> str:
     if others:
         lines.append("not used for hover: " + ", ".join(f"{r['name']} ({r['role']})"
                                                          for r in others))
+    for line in model.get("derived", ()):
+        lines.append(f"derived: {line}")
     if trim["feasible"]:
         lines.append(f"trim: {trim['message']}")
     else:

@@ -45,6 +45,10 @@ ARDUPILOT_PLUGINS = {"ArduPilotPlugin"}        # libArduPilotPlugin.so (classic)
 LIFT_DRAG_PLUGINS = {"LiftDragPlugin", "gz-sim-lift-drag-system",
                      "ignition-gazebo-lift-drag-system"}
 LIFT_DRAG_NAMES = {"gz::sim::systems::LiftDrag", "ignition::gazebo::systems::LiftDrag"}
+# gz-sim's AdvancedLiftDrag models a whole airframe (PX4's advanced_plane): a wing, never
+# a propeller blade, so it only tells the roles a wing is there.
+ADVANCED_LIFT_DRAG_PLUGINS = {"gz-sim-advanced-lift-drag-system"}
+ADVANCED_LIFT_DRAG_NAMES = {"gz::sim::systems::AdvancedLiftDrag"}
 
 MAVLINK_PLUGINS = {"rotors_gazebo_mavlink_interface", "gazebo_mavlink_interface"}
 
@@ -383,8 +387,9 @@ def assign_roles(rotors: list[Rotor], has_wing: bool = False) -> None:
     Propulsion: a thrust axis between 60° and 120° from body z (horizontal or nearly; a
     rotor pointing down stays 'lift' so the tilt rule can say it points down) on a
     vehicle that lifts otherwise, and either along body ±x (within 30°: a pusher or a
-    puller) or on a vehicle with a wing (a LiftDrag surface not on a rotor; frames such
-    as ardupilot_gazebo's zephyr fly along their y axis). A sideways rotor on a wingless
+    puller) or on a vehicle with a wing (a LiftDrag surface not on a rotor, or an
+    AdvancedLiftDrag airframe; frames such as ardupilot_gazebo's zephyr fly along their
+    y axis). A sideways rotor on a wingless
     multirotor is a mistake, not propulsion: it stays 'lift' and R311 reports it. An
     omnidirectional frame (reversible motors, or axes spanning every direction) keeps
     every rotor as lift: it hovers with all of them through the 6-DoF allocation. A
@@ -421,7 +426,11 @@ def lift_rotors(rotors: list[Rotor]) -> list[Rotor]:
 
 def _has_wing(robot: Robot, rotors: list[Rotor], blades: dict[str, list[Blade]]) -> bool:
     rotor_links = {r.link for r in rotors}
-    return any(link not in rotor_links for link in blades)
+    if any(link not in rotor_links for link in blades):
+        return True
+    return any(plugin.library in ADVANCED_LIFT_DRAG_PLUGINS
+               or (plugin.name or "") in ADVANCED_LIFT_DRAG_NAMES
+               for _, plugin in robot.plugins())
 
 
 def rotor_table(rotors: list[Rotor]) -> list[dict]:
@@ -466,3 +475,67 @@ def declared_rotor_counts(robot: Robot) -> list[RotorCountDeclaration]:
                 if rotor_channels:
                     out.append(RotorCountDeclaration(len(rotor_channels), plugin, channels.loc))
     return out
+
+
+# ------------------------------------------------- ArduPilot motor response
+
+@dataclass
+class DerivedTimeConstant:
+    """A motor time constant derived from an ArduPilotPlugin velocity PID (or why not)."""
+    time_constant_s: float          # nan when it cannot be derived
+    explanation: str                # how it was derived, or why it was not
+
+
+def ardupilot_time_constant(robot: Robot, rotor: Rotor) -> DerivedTimeConstant:
+    """The rotor's speed response under the ArduPilotPlugin's joint velocity PID.
+
+    With `useForce` (the default) the plugin applies the joint torque
+    PID(joint speed - target) every step, gz::math::PID giving -(p*e + i*∫e + d*de/dt)
+    clamped to [cmd_min, cmd_max]. For a P or PD controller (i_gain 0) the joint obeys
+    (I + d) * de/dt = -p * e, a first-order lag with tau = (I + d) / p, I the rotor
+    link's moment of inertia about the joint axis. That holds while p*|e| <= cmd_max;
+    beyond it the torque saturates and the speed ramps at cmd_max / I (a larger step
+    takes longer than tau says). Aerodynamic drag torque from the blades is left out, and
+    so is joint damping b (it would give I / (p + b); ardupilot_gazebo's iris has
+    b = 1e-4 against p = 0.2, a 0.05 % change).
+    An integral term makes the response second order, and `useForce` false sets the
+    joint speed directly: neither has one time constant, so none is derived.
+    """
+    def gain(tag: str, default: float) -> float:
+        text = rotor.param(tag)
+        return _float(text) if text is not None else default
+
+    # Defaults as the plugin's Control constructor: PID(0.1, 0, 0, ..., 1.0, -1.0).
+    p, i, d = gain("p_gain", 0.1), gain("i_gain", 0.0), gain("d_gain", 0.0)
+    cmd_max = gain("cmd_max", 1.0)
+    use_force = (rotor.param("useForce") or "1").strip().lower() not in ("0", "false")
+    joint = robot.joint_map.get(rotor.joint or "")
+    link = robot.link_map.get(rotor.link or "")
+    if not use_force:
+        return DerivedTimeConstant(math.nan, "<useForce> is off: the plugin sets the joint "
+                                             "speed directly, with no motor lag to derive")
+    if not (math.isfinite(p) and p > 0 and math.isfinite(d) and d >= 0):
+        return DerivedTimeConstant(math.nan, f"the velocity PID's p_gain {p:g} (d_gain {d:g}) "
+                                             "gives no first-order response")
+    if not (math.isfinite(i) and i == 0):
+        return DerivedTimeConstant(math.nan, f"the velocity PID has an integral term "
+                                             f"(i_gain {i:g}): its response is second order")
+    if joint is None or link is None or link.inertial is None:
+        return DerivedTimeConstant(math.nan, "the rotor joint or its link's <inertial> is "
+                                             "missing")
+    axis = _unit(np.asarray(joint.axis, dtype=float))
+    inertial = link.inertial
+    r = np.asarray(inertial.com_m, dtype=float)
+    # About the joint axis through the link origin: the COM tensor plus the parallel axis.
+    I_link = inertial.inertia_in_link_axes() + inertial.mass_kg * (
+        float(r @ r) * np.eye(3) - np.outer(r, r))
+    I_axis = float(axis @ I_link @ axis) if np.all(np.isfinite(axis)) else math.nan
+    if not (math.isfinite(I_axis) and I_axis > 0):
+        return DerivedTimeConstant(math.nan, "the rotor link has no positive moment of "
+                                             "inertia about its joint axis")
+    tau = (I_axis + d) / p
+    limit = f"; linear while the speed error stays below cmd_max/p_gain = {cmd_max / p:.4g} " \
+            "rad/s" if math.isfinite(cmd_max) and cmd_max > 0 else ""
+    return DerivedTimeConstant(tau, (
+        f"motor time constant {tau:.4g} s derived from the ArduPilotPlugin velocity PID: "
+        f"(I_axis {I_axis:.4g} kg·m² + d_gain {d:g}) / p_gain {p:g}{limit}"))

@@ -104,7 +104,7 @@ def trim_from_allocation(A: np.ndarray, motor_constant: np.ndarray, omega_max_ra
     n = A.shape[1]
     names = tuple(names) or tuple(f"rotor_{i}" for i in range(n))
     if n == 0:
-        return _empty(TrimCause.NO_ROTORS, "the model has no rotors (no motor-model plugins)",
+        return _empty(TrimCause.NO_ROTORS, "the model has no rotors (no motor plugin drives a rotor joint)",
                       0, weight_N, names)
     k = np.asarray(motor_constant, dtype=float)
     omega_max = np.asarray(omega_max_rad_s, dtype=float)

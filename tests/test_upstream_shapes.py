@@ -1,0 +1,249 @@
+"""Models in the shape of what people fly today (acceptance sweep, issues 10 and 11).
+
+Fixtures: tests/fixtures/upstream_shapes/<name>/model.sdf, written for this project in
+the structure and with the numbers of the public models their comments name. Each good
+fixture stays quiet (no error, no warning); each `<CODE>_bad_*` plants one defect that is
+still found. Expected numbers are derived here by hand from the fixtures' written values.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from reedtool.checks.runner import run_checks
+from reedtool.cli import main
+from reedtool.io.loader import load_robot
+from reedtool.physics.rotors import ardupilot_time_constant, discover_rotors
+
+SHAPES = Path(__file__).parent / "fixtures" / "upstream_shapes"
+
+CASES = [
+    ("fixed_wing_puller", ["R319"]),
+    ("R316_bad_fixed_wing_negative_k", ["R316", "R319"]),
+    ("tiltrotor", []),
+    ("I209_bad_tiltrotor_motor_inertia", ["I209", "I209"]),
+    ("rotors_plus_quad", []),
+    ("R304_bad_rotors_plus_quad_flipped", ["R304"]),
+    ("quad_tailsitter", ["R320"]),
+    ("R311_bad_tailsitter_one_rotor_untilted", ["R311"] * 3),
+    ("px4vision_quad", []),
+    ("R301_bad_px4vision_duplicate_number", ["R301"]),
+]
+GOOD = [name for name, _ in CASES if "_bad_" not in name]
+
+
+def _model(name: str) -> Path:
+    (path,) = [p for p in (SHAPES / name).iterdir() if p.suffix in (".sdf", ".xacro")]
+    return path
+
+
+def _findings(name: str):
+    return run_checks(load_robot(_model(name)))
+
+
+@pytest.mark.parametrize("name,expected", CASES, ids=[c[0] for c in CASES])
+def test_codes(name, expected):
+    assert sorted(f.code for f in _findings(name)) == expected
+
+
+@pytest.mark.parametrize("name", GOOD)
+def test_good_shapes_have_no_error_or_warning(name):
+    assert [f.code for f in _findings(name) if f.severity in ("error", "warning")] == []
+
+
+# ------------------------------------------------------------------ fixed-wing
+
+def test_fixed_wing_puller_is_propulsion_with_an_advanced_lift_drag_wing():
+    (rotor,) = discover_rotors(load_robot(_model("fixed_wing_puller")))
+    assert rotor.role == "propulsion"
+    # Link pitched 1.57 rad: its z axis is (sin 1.57, 0, cos 1.57) in the base frame.
+    np.testing.assert_allclose(rotor.axis, [math.sin(1.57), 0, math.cos(1.57)], atol=1e-12)
+
+
+def test_fixed_wing_puller_without_a_wing_stays_lift(tmp_path):
+    """The wing is what makes a lone horizontal rotor propulsion: without any lift-drag
+    surface the same model is a (broken) multirotor and the rotor rules speak."""
+    text = _model("fixed_wing_puller").read_text()
+    start = text.index("    <plugin filename='gz-sim-advanced-lift-drag-system'")
+    end = text.index("</plugin>", start) + len("</plugin>\n")
+    model = tmp_path / "wingless.sdf"
+    model.write_text(text[:start] + text[end:])
+    (rotor,) = discover_rotors(load_robot(model))
+    assert rotor.role == "lift"
+    codes = {f.code for f in run_checks(load_robot(model))}
+    assert {"R304", "R305"} <= codes
+
+
+def test_hover_test_says_a_fixed_wing_cannot_hover(capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["hover-test", str(_model("fixed_wing_puller"))])
+    captured = capsys.readouterr()
+    assert info.value.code == 1
+    assert "Traceback" not in captured.err
+    failed = [line for line in captured.out.splitlines() if line.startswith("FAILED")]
+    assert failed == [("FAILED: no hover trim: the model has no lift rotors (rotor_puller is "
+                       "propulsion: its thrust axis is horizontal); a fixed-wing cannot hover")]
+
+
+# ------------------------------------------------------------------- tiltrotor
+
+def test_tiltrotor_servos_are_not_rotors_and_trim_by_hand():
+    robot = load_robot(_model("tiltrotor"))
+    rotors = discover_rotors(robot)
+    assert [r.link for r in rotors] == ["rotor_0", "rotor_1", "rotor_2", "rotor_3"]
+    assert [r.direction for r in rotors] == ["ccw", "ccw", "cw", "cw"]
+    assert all(r.role == "lift" for r in rotors)
+    from reedtool.checks.context import CheckContext
+
+    trim = CheckContext(robot).trim
+    # 5 kg body, two 50 g tilt motors at x = +0.35, four 5 g rotors: COM x = 0.035/5.12.
+    mass, k = 5 + 2 * 0.05 + 4 * 0.005, 2e-05
+    com_x = (2 * 0.05 * 0.35) / mass
+    # Pitch balance: 2 T_front (0.35 - c) = 2 T_back (0.35 + c); 2 T_front + 2 T_back = m g.
+    weight = mass * 9.80665
+    t_front = weight / 2 * (0.35 + com_x) / 0.7
+    t_back = weight / 2 - t_front
+    expected = np.sqrt(np.array([t_front, t_back, t_front, t_back]) / k)
+    assert trim.feasible
+    np.testing.assert_allclose(trim.omega_rad_s, expected, rtol=1e-6)
+
+
+# ----------------------------------------------------------- ArduPilot motor lag
+
+def _iris_rotor(tmp_path, edit=lambda text: text):
+    text = (Path(__file__).parent / "fixtures" / "ardupilot" / "iris_lift_drag.sdf").read_text()
+    model = tmp_path / "iris.sdf"
+    model.write_text(edit(text))
+    robot = load_robot(model)
+    return robot, discover_rotors(robot)[0]
+
+
+def test_ardupilot_time_constant_pd_and_offset_inertial(tmp_path):
+    """(I + d) / p with I about the joint axis through the link origin: the COM 0.01 m off
+    that axis adds m * 0.01^2 (parallel axis)."""
+    def edit(text):
+        text = text.replace("<d_gain>0</d_gain>", "<d_gain>0.0001</d_gain>")
+        return text.replace("<inertial><mass>0.005</mass>",
+                            "<inertial><pose>0.01 0 0 0 0 0</pose><mass>0.005</mass>", 1)
+    robot, rotor = _iris_rotor(tmp_path, edit)
+    found = ardupilot_time_constant(robot, rotor)
+    inertia = 2.5e-05 + 0.005 * 0.01 ** 2
+    assert found.time_constant_s == pytest.approx((inertia + 0.0001) / 0.20, rel=1e-12)
+
+
+def test_ardupilot_time_constant_refused_without_force_control(tmp_path):
+    def edit(text):
+        return text.replace("<useForce>1</useForce>", "<useForce>0</useForce>")
+    robot, rotor = _iris_rotor(tmp_path, edit)
+    found = ardupilot_time_constant(robot, rotor)
+    assert math.isnan(found.time_constant_s)
+    assert "useForce" in found.explanation
+
+
+# ------------------------------------------------------------ RotorS "+" quad
+
+def test_rotors_plus_quad_through_the_bundled_macros_by_hand():
+    robot = load_robot(_model("rotors_plus_quad"))
+    rotors = discover_rotors(robot)
+    assert [r.direction for r in rotors] == ["cw", "ccw", "cw", "ccw"]
+    expected_xy = [(0.17, 0), (0, 0.17), (-0.17, 0), (0, -0.17)]
+    for rotor, (x, y) in zip(rotors, expected_xy):
+        np.testing.assert_allclose(rotor.position_m, [x, y, 0.01], atol=1e-12)
+    from reedtool.checks.context import CheckContext
+
+    mass, k = 0.68 + 4 * 0.009, 8.54858e-06
+    np.testing.assert_allclose(CheckContext(robot).trim.omega_rad_s,
+                               math.sqrt(mass * 9.80665 / (4 * k)), rtol=1e-9)
+
+
+# ------------------------------------------------------------- quad tailsitter
+
+def test_quad_tailsitter_tilts_and_trim_by_hand():
+    """rpy (+-0.17, +-0.17, 0): the rotor z axis is (cos r sin p, -sin r, cos r cos p), so
+    each rotor lifts with cos(0.17)^2 of its thrust; the side components cancel."""
+    robot = load_robot(_model("quad_tailsitter"))
+    rotors = discover_rotors(robot)
+    cz = math.cos(0.17) ** 2
+    for rotor in rotors:
+        assert rotor.role == "lift"
+        assert rotor.axis[2] == pytest.approx(cz, rel=1e-12)
+        assert abs(rotor.axis[0]) == pytest.approx(math.cos(0.17) * math.sin(0.17), rel=1e-12)
+        assert abs(rotor.axis[1]) == pytest.approx(math.sin(0.17), rel=1e-12)
+    from reedtool.checks.context import CheckContext
+
+    trim = CheckContext(robot).trim
+    thrust = (1.6 + 4 * 0.005) * 9.80665 / (4 * cz)
+    np.testing.assert_allclose(trim.thrust_N, thrust, rtol=1e-9)
+
+
+# ------------------------------------------------------- omnidirectional frame
+
+def test_hover_test_judges_an_omni_frame_by_its_6dof_trim_then_refuses_to_fly(capsys):
+    """validate finds the reversible omni frame's 6-DoF trim; hover-test used to run the
+    4-DoF one-way trim on it and report FAILED (yaw cannot cancel): a false alarm."""
+    omni = Path(__file__).parent / "fixtures" / "omni" / "omni_reversible.sdf"
+    with pytest.raises(SystemExit) as info:
+        main(["hover-test", str(omni)])
+    captured = capsys.readouterr()
+    assert info.value.code == 2
+    assert "FAILED" not in captured.out and "Traceback" not in captured.err
+    (line,) = captured.err.strip().splitlines()
+    assert "(6-DoF allocation)" in line and "cannot fly an omnidirectional frame" in line
+
+
+def test_hover_test_still_fails_an_omni_frame_too_heavy_to_hover(tmp_path, capsys):
+    omni = Path(__file__).parent / "fixtures" / "omni" / "omni_reversible.sdf"
+    text = omni.read_text()
+    model = tmp_path / "omni_heavy.sdf"
+    start = text.index("<mass>") + len("<mass>")
+    end = text.index("</mass>", start)
+    model.write_text(text[:start] + "60" + text[end:])
+    with pytest.raises(SystemExit) as info:
+        main(["hover-test", str(model), "--ignore-validation"])
+    out = capsys.readouterr().out
+    assert info.value.code == 1
+    assert "INFEASIBLE (insufficient-thrust)" in out
+
+
+# ------------------------------------------------------------------- px4vision
+
+def test_px4vision_rotors_and_hover_by_hand():
+    robot = load_robot(_model("px4vision_quad"))
+    rotors = discover_rotors(robot)
+    assert [r.motor_number for r in rotors] == [0, 1, 2, 3]
+    assert [r.direction for r in rotors] == ["ccw", "ccw", "cw", "cw"]
+    from reedtool.checks.context import CheckContext
+
+    mass, k = 1.5 + 4 * 0.005, 8.54858e-06
+    np.testing.assert_allclose(CheckContext(robot).trim.omega_rad_s,
+                               math.sqrt(mass * 9.80665 / (4 * k)), rtol=1e-9)
+
+
+def test_hover_test_on_a_broken_ardupilot_model_reports_validation_not_time_constants(capsys):
+    """The bad-input pre-check before the validation verdict used to demand
+    <timeConstantUp> from ArduPilotPlugin rotors (exit 2, a false 'bad input')."""
+    bad = Path(__file__).parent / "fixtures" / "ardupilot" / "R318_bad_multiplier_sign.sdf"
+    with pytest.raises(SystemExit) as info:
+        main(["hover-test", str(bad)])
+    captured = capsys.readouterr()
+    assert info.value.code == 1
+    assert "timeConstantUp" not in captured.err
+    assert captured.out.splitlines()[-1].startswith("FAILED: validate reports")
+
+
+def test_fixed_wing_with_classic_lift_drag_wing_is_also_propulsion(tmp_path):
+    """rc_cessna's shape: the wing is a LiftDrag plugin on the body instead."""
+    text = _model("fixed_wing_puller").read_text()
+    start = text.index("    <plugin filename='gz-sim-advanced-lift-drag-system'")
+    end = text.index("</plugin>", start) + len("</plugin>\n")
+    wing = ("    <plugin filename='gz-sim-lift-drag-system' name='gz::sim::systems::LiftDrag'>"
+            "<a0>0.05984281113</a0><cla>4.752798721</cla><cda>0.6417112299</cda>"
+            "<cp>-0.12 0 0</cp><area>0.34</area><forward>1 0 0</forward><upward>0 0 1</upward>"
+            "<link_name>base_link</link_name></plugin>\n")
+    model = tmp_path / "cessna_like.sdf"
+    model.write_text(text[:start] + wing + text[end:])
+    assert sorted(f.code for f in run_checks(load_robot(model))) == ["R319"]
