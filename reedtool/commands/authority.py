@@ -15,7 +15,7 @@ from pathlib import Path
 
 import click
 
-from reedtool.commands.params import FiniteFloatRange, model_option
+from reedtool.commands.params import FiniteFloatRange, model_arguments
 from reedtool.errors import ReedtoolError
 
 SCHEMA = "reedtool.authority/1"
@@ -174,12 +174,7 @@ def render_text(name: str, report: dict, policy: str) -> str:
 
 
 @click.command(name="authority")
-@click.argument("model", type=click.Path(path_type=Path, dir_okay=False))
-@click.argument("mappings", nargs=-1)
-@click.option("--package-path", "package_paths", multiple=True, metavar="DIR",
-              type=click.Path(path_type=Path, file_okay=False),
-              help="Directory to search for ROS packages first (repeatable).")
-@model_option
+@model_arguments
 @click.option("--efficiency", "efficiency_items", multiple=True, metavar="ROTOR=ETA",
               help="Degrade a rotor: its maximum thrust times ETA in [0, 1] (repeatable).")
 @click.option("--require", "policy", type=click.Choice(list(POLICIES)), default="hover",

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import click
 
-from reedtool.commands.params import FiniteFloatRange, model_option
+from reedtool.commands.params import FiniteFloatRange, model_arguments
 from reedtool.errors import ReedtoolError
 
 SPREAD_HELP = "Half-width of the uniform perturbation"
@@ -74,12 +74,7 @@ def check_batch_resources(every_rotor, samples: int | None, max_memory_bytes: in
 
 
 @click.command(name="hover-test")
-@click.argument("model", type=click.Path(path_type=Path, dir_okay=False))
-@click.argument("mappings", nargs=-1)
-@click.option("--package-path", "package_paths", multiple=True, metavar="DIR",
-              type=click.Path(path_type=Path, file_okay=False),
-              help="Directory to search for ROS packages first (repeatable).")
-@model_option
+@model_arguments
 @click.option("--duration", "duration_s", type=float, default=10.0, show_default=True,
               help="Simulated time [s].")
 @click.option("--rate", "rate_hz", type=float, default=1000.0, show_default=True,

@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 import numpy as np
 
-from reedtool.commands.params import model_option
+from reedtool.commands.params import model_arguments
 from reedtool.errors import ReedtoolError
 
 
@@ -227,12 +227,7 @@ def print_fix_xacro(comparisons) -> list[str]:
 
 
 @click.command("inertia")
-@click.argument("model", type=click.Path(path_type=Path, dir_okay=False))
-@click.argument("mappings", nargs=-1)
-@click.option("--package-path", "package_paths", multiple=True, metavar="DIR",
-              type=click.Path(path_type=Path, file_okay=False),
-              help="Directory to search for ROS packages first (repeatable).")
-@model_option
+@model_arguments
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
               show_default=True, help="Output format.")
 @click.option("--fix", is_flag=True,

@@ -7,6 +7,7 @@ through an open upper bound; an option that feeds a computation wants neither.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import click
 
@@ -29,3 +30,17 @@ def model_option(command):
         "--model", "model_name", metavar="NAME", default=None,
         help="In an SDF world holding several models, the one to read (by its name).",
     )(command)
+
+
+def model_arguments(command):
+    """MODEL, its xacro NAME:=VALUE arguments, --package-path and --model: what every
+    command that loads one model takes, spelt the same everywhere."""
+    for decorate in reversed((
+            click.argument("model", type=click.Path(path_type=Path, dir_okay=False)),
+            click.argument("mappings", nargs=-1),
+            click.option("--package-path", "package_paths", multiple=True, metavar="DIR",
+                         type=click.Path(path_type=Path, file_okay=False),
+                         help="Directory to search for ROS packages first (repeatable)."),
+            model_option)):
+        command = decorate(command)
+    return command
