@@ -10,11 +10,15 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from cli_helpers import run_cli
 
 from reedtool.physics.allocation import allocation_matrix
-from reedtool.physics.authority import (acai_support, authority, failure_cases,
-                                        full_control_after_failures)
-from cli_helpers import run_cli
+from reedtool.physics.authority import (
+    acai_support,
+    authority,
+    failure_cases,
+    full_control_after_failures,
+)
 
 # The paper's hexacopter (Sec. V, Table): mass 1.535 kg, g 9.80, arm 0.275 m,
 # K 6.125 N per rotor, k_mu 0.1; rotor i at 60*i degrees, rotor 1 at the nose.
@@ -184,9 +188,10 @@ def test_r350_names_an_order_that_really_keeps_control():
     # names and count the survivable failures with the paper's matrix.
     import re
 
+    from rule_helpers import FIXTURES
+
     from reedtool.checks.runner import Selection, run_checks
     from reedtool.io.loader import load_robot
-    from rule_helpers import FIXTURES
 
     (finding,) = run_checks(load_robot(FIXTURES / "R350_bad_alternating_hex.urdf"),
                             Selection(select=("R350",)))

@@ -14,13 +14,13 @@ import json
 
 import numpy as np
 import pytest
+from test_sim import tilted_hex
 
 from reedtool.sim import STATUS_CODES, ExitStatus, HoverConfig, compiled
-from reedtool.sim.batch import perturbed_plant, sample_perturbations, simulate_batch, Spreads
+from reedtool.sim.batch import Spreads, perturbed_plant, sample_perturbations, simulate_batch
 from reedtool.sim.dynamics import Plant
 from reedtool.sim.params import symmetric_multirotor
 from reedtool.sim.run import simulate_hover
-from test_sim import tilted_hex
 
 pytestmark = pytest.mark.skipif(
     not compiled.available(),

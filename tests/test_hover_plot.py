@@ -9,13 +9,13 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 from lxml import etree
+from test_hover_test_cli import multirotor_urdf, run_cli
 
 from reedtool.sim import HoverConfig
 from reedtool.sim.batch import Spreads, robustness_batch
 from reedtool.sim.params import symmetric_multirotor
 from reedtool.sim.plot import failure_marks, render
 from reedtool.sim.run import simulate_hover
-from test_hover_test_cli import multirotor_urdf, run_cli
 
 SVG = "{http://www.w3.org/2000/svg}"
 

@@ -14,9 +14,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_helpers import run_cli
 from lxml import etree
 
-from cli_helpers import run_cli
 from reedtool.commands.layout import ANCHOR_M
 from reedtool.io.loader import load_robot
 from reedtool.physics.rotors import discover_rotors

@@ -12,7 +12,7 @@ import pytest
 from oracles import CHECK_URDF
 from rule_helpers import FIXTURES, codes
 
-from reedtool.checks.runner import Selection, run_checks
+from reedtool.checks.runner import run_checks
 from reedtool.io.loader import load_robot
 
 CASES = [

@@ -10,8 +10,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from cli_helpers import run_cli
+
 from reedtool.checks.runner import Selection, run_checks
 from reedtool.errors import ReedtoolError
 from reedtool.io.loader import load_robot, load_robots

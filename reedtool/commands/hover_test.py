@@ -177,10 +177,9 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
                             hint="pass the path of a .urdf or .xacro file")
 
     from reedtool.checks.preflight import require_sound_model
+    from reedtool.commands.validate import validation_errors
     from reedtool.io.loader import load_robot
     from reedtool.io.mappings import parse_mappings
-
-    from reedtool.commands.validate import validation_errors
 
     robot = load_robot(model, parse_mappings(mappings), list(package_paths),
                        model_name=model_name)

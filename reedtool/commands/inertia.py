@@ -80,7 +80,7 @@ def format_text(model: Path, robot, comparisons, whole, own, findings=()) -> str
     lines.append(f"  total mass  {whole.mass_kg:.6g} kg")
     lines.append(f"  COM         {_vec(whole.com_m)} m")
     I = whole.inertia_kg_m2
-    lines.append(f"  inertia about the COM, base axes [kg*m^2]:")
+    lines.append("  inertia about the COM, base axes [kg*m^2]:")
     for row in clean_tensor(I):
         lines.append("    [" + " ".join(f"{x:>13.6g}" for x in row) + " ]")
     mass_gap = abs(own.mass_kg - whole.mass_kg)

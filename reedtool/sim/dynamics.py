@@ -271,7 +271,7 @@ class PlantKernel:
     """
 
     def __init__(self, plant: Plant):
-        N, n = plant.n_vehicles, plant.motor_constant.shape[0]
+        n = plant.motor_constant.shape[0]
         K = plant.drag_map.reshape(9, 6, n)
         drag = K[0:6] + np.concatenate([np.zeros((3, 6, n)), K[6:9]])  # rolling: a torque
         used = np.flatnonzero(np.any(drag != 0.0, axis=(0, 2))) if plant.has_drag else []
