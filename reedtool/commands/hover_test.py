@@ -184,15 +184,17 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     robot = load_robot(model, parse_mappings(mappings), list(package_paths),
                        model_name=model_name)
     require_sound_model(robot)
+    from reedtool.physics.rotors import discover_rotors
+
+    # A model or batch too large for the machine is refused before any rule runs on it.
+    every_rotor = discover_rotors(robot)
+    check_batch_resources(every_rotor, samples, max_memory_mb * 1024 * 1024)
     errors = validation_errors(model, robot)
     if errors and not ignore_validation:
         # Bad input (exit 2) comes before what validate finds (exit 1): unreadable rotor
-        # parameters, a batch too large for the machine.
-        from reedtool.physics.rotors import discover_rotors
+        # parameters.
         from reedtool.sim.params import check_rotor_dynamics
 
-        every_rotor = discover_rotors(robot)
-        check_batch_resources(every_rotor, samples, max_memory_mb * 1024 * 1024)
         # ArduPilotPlugin rotors carry no time constants: hover_test derives them from
         # the joint's velocity PID (or refuses with the reason) only when it flies.
         check_rotor_dynamics([r for r in every_rotor if r.kind != "ardupilot"])
