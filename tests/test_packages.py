@@ -115,3 +115,37 @@ def test_bundled_package_ships_as_package_data():
     assert root == BUNDLED_PACKAGES_DIR / "rotors_description"
     for rel in ("package.xml", "urdf/component_snippets.xacro", "urdf/multirotor_base.xacro"):
         assert (root / rel).is_file()
+
+
+def _twin_workspace(root: Path, copies: int) -> Path:
+    """A workspace with `copies` packages named 'twin' and a model using one of its meshes."""
+    import numpy as np
+
+    from reedtool.io.stl import stl_bytes
+
+    for i in range(copies):
+        pkg = root / "src" / f"twin_{i}"
+        (pkg / "meshes").mkdir(parents=True)
+        (pkg / "package.xml").write_text("<package><name>twin</name></package>")
+        box = np.array([[[0, 0, 0], [0.1, 0, 0], [0, 0.1, 0]], [[0, 0, 0], [0, 0.1, 0], [0, 0, 0.1]],
+                        [[0, 0, 0], [0, 0, 0.1], [0.1, 0, 0]], [[0.1, 0, 0], [0, 0, 0.1], [0, 0.1, 0]]])
+        (pkg / "meshes" / "body.stl").write_bytes(stl_bytes(box.astype(float)))
+    model = root / "robot.urdf"
+    model.write_text('<robot name="r"><link name="base"><visual><geometry>'
+                     '<mesh filename="package://twin/meshes/body.stl"/></geometry></visual>'
+                     '</link></robot>')
+    return model
+
+
+@pytest.mark.parametrize("copies,expected", [(2, ["S150"]), (1, [])])
+def test_two_packages_with_one_name_are_reported(tmp_path, copies, expected):
+    """S150: the copy that is ignored is named beside the one used (bad: two, good: one)."""
+    from reedtool.checks.runner import Selection, run_checks
+    from reedtool.io.loader import load_robot
+
+    model = _twin_workspace(tmp_path, copies)
+    robot = load_robot(model, {}, [tmp_path / "src"])
+    findings = run_checks(robot, Selection(select=("S",)))
+    assert [f.code for f in findings] == expected
+    if expected:
+        assert "twin_0" in findings[0].message and "twin_1" in findings[0].message

@@ -24,6 +24,7 @@ SDF_MIN_MASS_KG = 1e-6
 _NON_FINITE_KINDS = {"non-finite"}
 _LEGACY_KINDS = {"legacy-xacro"}
 _TOLERATED_KINDS = {"xml-tolerated"}
+_PACKAGE_KINDS = {"package-duplicate"}
 _PER_AXIS_JOINTS = {"revolute", "continuous", "prismatic", "planar"}
 _LIMITED_JOINTS = {"revolute", "prismatic"}
 
@@ -43,7 +44,7 @@ def urdf_parse_error(ctx: CheckContext) -> Iterator[Issue]:
     Fix the element at the reported line.
     """
     for issue in ctx.robot.parse_issues:
-        if issue.kind not in _NON_FINITE_KINDS | _LEGACY_KINDS | _TOLERATED_KINDS:
+        if issue.kind not in _NON_FINITE_KINDS | _LEGACY_KINDS | _TOLERATED_KINDS | _PACKAGE_KINDS:
             yield Issue(issue.message, issue.loc, issue.subject)
 
 
@@ -459,3 +460,20 @@ def xml_tolerated(ctx: CheckContext) -> Iterator[Issue]:
         if issue.kind in _TOLERATED_KINDS:
             yield Issue(issue.message, issue.loc, issue.subject,
                         hint="single hyphens in comments; declare xmlns:PREFIX on the root")
+
+
+@rule("S150", "package-name-ambiguous", "warning",
+      "Two ROS packages with the same name are on the search path; one is ignored.")
+def package_name_ambiguous(ctx: CheckContext) -> Iterator[Issue]:
+    """`$(find pkg)` and `package://pkg/...` name a package, not a directory. When two
+    packages of that name sit under one search root (a copied package, a backup next to
+    the original), ROS and reedtool take one of them and the edits in the other never
+    reach the simulation. The finding names both and the one used.
+
+    Remove or rename the copy, or put the intended one first with `--package-path`.
+    """
+    for issue in ctx.robot.parse_issues:
+        if issue.kind in _PACKAGE_KINDS:
+            yield Issue(issue.message, issue.loc, issue.subject,
+                        hint="remove or rename the copy, or pass the intended package's "
+                             "parent first with --package-path")

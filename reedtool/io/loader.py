@@ -22,8 +22,21 @@ def load_robots(path: Path | str, mappings: Mapping[str, str] | None = None,
         from reedtool.io.sdf import load_sdf_models
 
         sdf = _sdf_path(path)
-        return load_sdf_models(sdf, resolver=PackageResolver(package_paths, model_path=sdf))
+        resolver = PackageResolver(package_paths, model_path=sdf)
+        return [_with_package_notes(robot, resolver)
+                for robot in load_sdf_models(sdf, resolver=resolver)]
     return [load_robot(path, mappings, package_paths, model_name=model_name)]
+
+
+def _with_package_notes(robot: Robot, resolver) -> Robot:
+    """The resolver's ambiguities (two packages with one name) as ParseIssues for S150."""
+    for name, used, ignored, where in resolver.duplicates:
+        robot.parse_issues.append(ParseIssue(
+            kind="package-duplicate",
+            message=f"two packages named '{name}' under {where}: using {used}, ignoring "
+                    f"{ignored}",
+            loc=SourceLoc(str(robot.source_file or "")), subject=name))
+    return robot
 
 
 def _model_dir_sdf(path: Path) -> Path:
@@ -64,13 +77,15 @@ def load_robot(path: Path | str, mappings: Mapping[str, str] | None = None,
     if path.suffix.lower() in SDF_SUFFIXES:
         from reedtool.io.sdf import load_sdf_file
 
-        return load_sdf_file(path, resolver=PackageResolver(package_paths, model_path=path),
-                             model_name=model_name)
+        resolver = PackageResolver(package_paths, model_path=path)
+        return _with_package_notes(load_sdf_file(path, resolver=resolver,
+                                                 model_name=model_name), resolver)
     if model_name is not None:
         raise ReedtoolError("--model picks a model of an SDF file; this file is not SDF",
                             file=path, hint="drop --model")
     if path.suffix.lower() in URDF_SUFFIXES:
-        return load_urdf_file(path, resolver=PackageResolver(package_paths, model_path=path))
+        resolver = PackageResolver(package_paths, model_path=path)
+        return _with_package_notes(load_urdf_file(path, resolver=resolver), resolver)
 
     from reedtool.io.xacro_expand import expand_xacro
 
@@ -82,4 +97,4 @@ def load_robot(path: Path | str, mappings: Mapping[str, str] | None = None,
         robot.parse_issues.append(ParseIssue(
             kind="legacy-xacro", message=f"{what} <{tag.tag}> (write <{tag.modern}>)",
             loc=SourceLoc(str(tag.file), tag.line), subject=tag.tag))
-    return robot
+    return _with_package_notes(robot, expansion.resolver)

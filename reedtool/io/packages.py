@@ -149,6 +149,8 @@ class PackageResolver:
                     "not found" if not directory.exists() else "is not a directory"),
                     file=directory, hint="check the path")
         self.notes: list[str] = []   # e.g. two packages with one name: which one is used
+        # (name, used directory, ignored directory, where both were found)
+        self.duplicates: list[tuple[str, Path, Path, str]] = []
         self.model_path = Path(model_path) if model_path is not None else None
         self._roots: list[SearchRoot] | None = None
         self._index: dict[SearchRoot, dict[str, Path]] = {}
@@ -187,6 +189,7 @@ class PackageResolver:
             duplicates: list[tuple[str, Path, Path]] = []
             self._index[root] = _crawl(root.path, duplicates, root.origin)
             for dup_name, used, ignored in duplicates:
+                self.duplicates.append((dup_name, used, ignored, root.describe()))
                 self.notes.append(f"two packages named '{dup_name}' under {root.describe()}: "
                                   f"using {used}, ignoring {ignored}")
         return self._index[root].get(name)
