@@ -273,3 +273,19 @@ def test_the_search_verdict_is_the_tables_verdict():
         for a, f in zip(fast, failed):
             if a is not None:
                 assert a == pytest.approx(f.acai, rel=1e-9, abs=1e-12)
+
+
+def test_degraded_rotor_needs_the_hand_derived_thrust():
+    """A quad-X holds hover with zero torque only with four equal thrusts m g / 4, so a rotor
+    left with half its thrust needs 0.5 K >= m g / 4: thrust-to-weight 4 K / (m g) >= 2."""
+    a = 0.2
+    B = allocation_matrix([rotor(a, -a, 1), rotor(-a, a, 1), rotor(a, a, -1), rotor(-a, -a, -1)],
+                          np.zeros(3))
+    K = np.full(4, 6.0)
+    weight = 15.0
+    _, degraded = failure_cases(B, K, weight, failed_efficiency=0.5)
+    _, stopped = failure_cases(B, K, weight)
+    for half, none in zip(degraded, stopped):
+        assert half.min_thrust_scale * K.sum() / weight == pytest.approx(2.0, rel=1e-9)
+        assert math.isinf(none.min_thrust_scale)       # stopped: no thrust is enough
+        assert not half.controllable                   # this quad has 4 x 6 / 15 = 1.6

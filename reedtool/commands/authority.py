@@ -52,8 +52,9 @@ def _finite(value: float) -> float | None:
     return float(value) if math.isfinite(value) else None
 
 
-def analyse(rotors, mass_kg: float, com_m, efficiency=None) -> dict:
-    """The JSON-ready report: the intact case and one entry per single-rotor failure."""
+def analyse(rotors, mass_kg: float, com_m, efficiency=None, degrade: float = 0.0) -> dict:
+    """The JSON-ready report: the intact case and one entry per single-rotor failure (or,
+    with `degrade` > 0, per rotor left with that fraction of its thrust)."""
     import numpy as np
 
     from reedtool.physics.allocation import allocation_matrix
@@ -75,13 +76,14 @@ def analyse(rotors, mass_kg: float, com_m, efficiency=None) -> dict:
                 "min_thrust_to_weight_without_yaw":
                     _finite(a.min_thrust_scale_without_yaw * thrust_to_weight)}
 
-    intact, failed = failure_cases(B, K, weight_N, eta)
+    intact, failed = failure_cases(B, K, weight_N, eta, failed_efficiency=degrade)
     failures = []
     for i, (rotor, a) in enumerate(zip(rotors, failed)):
         failures.append({"rotor": rotor.name, "index": i, "motor_number": rotor.motor_number,
                          "direction": rotor.direction, **entry(a)})
     return {"mass_kg": mass_kg, "weight_N": weight_N, "thrust_to_weight": thrust_to_weight,
             "efficiency": {r.name: float(e) for r, e in zip(rotors, eta)},
+            "failed_rotor_efficiency": degrade,
             "intact": entry(intact), "failures": failures}
 
 
@@ -147,6 +149,9 @@ def render_text(name: str, report: dict, policy: str) -> str:
     degraded = {k: v for k, v in report["efficiency"].items() if v != 1.0}
     if degraded:
         lines.append("efficiency: " + ", ".join(f"{k} {v:g}" for k, v in degraded.items()))
+    if report["failed_rotor_efficiency"] > 0:
+        lines.append(f"each case below: that rotor keeps {report['failed_rotor_efficiency']:g} "
+                     "of its thrust (--degrade) instead of stopping")
     rows = [("#", "failed rotor", "dir", "ACAI", "full control", "ACAI no yaw",
              "no yaw", "min T/W", "min T/W no yaw")]
     for f in report["failures"]:
@@ -177,6 +182,10 @@ def render_text(name: str, report: dict, policy: str) -> str:
 @model_arguments
 @click.option("--efficiency", "efficiency_items", multiple=True, metavar="ROTOR=ETA",
               help="Degrade a rotor: its maximum thrust times ETA in [0, 1] (repeatable).")
+@click.option("--degrade", "degrade", type=FiniteFloatRange(0.0, 1.0, max_open=True),
+              default=0.0, show_default=True, metavar="ETA",
+              help="Each case leaves its rotor ETA of its thrust instead of stopping it "
+                   "(0: a failure; 0.5: a damaged propeller).")
 @click.option("--require", "policy", type=click.Choice(list(POLICIES)), default="hover",
               show_default=True, help="What must hold for exit 0.")
 @click.option("--fly", is_flag=True,
@@ -193,7 +202,8 @@ def render_text(name: str, report: dict, policy: str) -> str:
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
               show_default=True, help="Output format.")
 def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
-            model_name: str | None, efficiency_items: tuple[str, ...], policy: str, fly: bool,
+            model_name: str | None, efficiency_items: tuple[str, ...], degrade: float,
+            policy: str, fly: bool,
             fail_at_s: float, duration_s: float, plot_path: Path | None, force: bool,
             fmt: str) -> int:
     """Control authority of MODEL about hover, intact and after each single rotor failure.
@@ -206,6 +216,9 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     from reedtool.sim import HoverConfig
 
     hold_s = HoverConfig().hold_s
+    if fly and degrade > 0:
+        raise ReedtoolError("--fly stops the rotor; --degrade applies to the table only",
+                            hint="run the table with --degrade and the flights without it")
     if fly and fail_at_s >= duration_s - hold_s:
         raise ReedtoolError(f"--fail-at {fail_at_s:g} s leaves less than the {hold_s:g} s hold "
                             f"time before --duration {duration_s:g} s",
@@ -247,7 +260,7 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
         raise ReedtoolError("the robot has no mass", file=model,
                             hint="run `reedtool inertia` on the model")
     report = analyse(rotors, props.mass_kg, props.com_m,
-                     _efficiency(efficiency_items, [r.name for r in rotors]))
+                     _efficiency(efficiency_items, [r.name for r in rotors]), degrade)
     if fly:
         _fly(robot, rotors, props, report, plot_path, force, fail_at_s, duration_s)
     report = {"model": robot.name, "require": policy, "passed": meets(report, policy), **report}

@@ -188,14 +188,19 @@ def full_control_after_failures(B: np.ndarray, thrust_max_N: Sequence[float],
 
 
 def failure_cases(B: np.ndarray, thrust_max_N: Sequence[float], weight_N: float,
-                  efficiency: Sequence[float] | None = None) -> tuple[Authority, list[Authority]]:
-    """The intact vehicle and one Authority per single rotor failure (eta_i = 0)."""
+                  efficiency: Sequence[float] | None = None,
+                  failed_efficiency: float = 0.0) -> tuple[Authority, list[Authority]]:
+    """The intact vehicle and one Authority per single rotor failure.
+
+    A failed rotor keeps `failed_efficiency` of its thrust: 0 is a stopped rotor, 0.5 one
+    that can give half (the paper's degradation eta_i).
+    """
     K = np.asarray(thrust_max_N, dtype=float)
     eta = np.ones_like(K) if efficiency is None else np.asarray(efficiency, dtype=float)
     intact = authority(B, K, weight_N, eta)
     failed = []
     for i in range(len(K)):
         eta_i = eta.copy()
-        eta_i[i] = 0.0
+        eta_i[i] = eta[i] * failed_efficiency
         failed.append(authority(B, K, weight_N, eta_i))
     return intact, failed
