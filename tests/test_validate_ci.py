@@ -121,6 +121,19 @@ def test_ros_package_means_its_top_level_models_with_config_args(capsys, tmp_pat
     assert code == 2
 
 
+def test_a_changed_xacro_part_is_checked_through_the_model_that_includes_it(capsys, tmp_path):
+    """pre-commit passes the changed part alone; alone it has no robot to build (its
+    arguments come from the top file), so it is checked as part of the model beside it."""
+    package = Path(shutil.copytree(SEED, tmp_path / "reed_gazebo"))
+    part = package / "urdf" / "reed_quad_x.xacro"
+    code, doc = run_json([part, "--package-path", tmp_path,
+                          *(f"{k}:={v}" for k, v in SEED_ARGS.items())], capsys)
+    by_name = {Path(m["model"]).name: m for m in doc["models"]}
+    assert "part of" in by_name["reed_quad_x.xacro"]["skipped"]
+    assert model_codes(doc)["mav_generic_odometry_sensor.gazebo"] == ["I203", "R312", "S115"]
+    assert code == 1
+
+
 # ------------------------------------------------------------------ formats and outputs
 
 def test_junit_counts_failures_per_model(capsys, tmp_path):

@@ -3,7 +3,8 @@
 pre-commit passes every changed file; CI passes a directory or a glob. Each target becomes
 a list of model files:
 
-- a file: itself;
+- a file: itself, unless it is a xacro part that a model beside it includes (pre-commit
+  passes the changed part alone): then that model, which is what the part is checked in;
 - a directory holding `model.sdf`: that SDF model;
 - a ROS package (a directory with `package.xml`): the top-level models of its `urdf/`
   (and `models/`, `sdf/` for SDF), skipping xacro macro libraries;
@@ -89,6 +90,17 @@ def _model_files(directory: Path, recursive: bool,
                   and not any(part.startswith(".") for part in p.relative_to(directory).parts))
 
 
+def _includer(path: Path, include_tree: Callable[[Path], Sequence[Path]]) -> Path | None:
+    """A top-level model in the same directory whose includes read `path`, if any."""
+    key = path.resolve()
+    siblings = [f for f in _model_files(path.parent, recursive=False,
+                                        suffixes=PACKAGE_SUFFIXES) if f.resolve() != key]
+    for sibling in _top_level(siblings, include_tree):
+        if key in {p.resolve() for p in include_tree(sibling)[1:]}:
+            return sibling
+    return None
+
+
 def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequence[Path]],
                    display: Callable[[Path], str] = str) -> list[Target]:
     """Every model the targets name, in order, each once.
@@ -113,6 +125,13 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
                 # own; the models that include it are where its mistakes show.
                 out.append(Target(display(path), None, skipped="a xacro macro library (no "
                                   "robot of its own); validate the models that include it"))
+                continue
+            includer = (_includer(path, include_tree)
+                        if path.is_file() and path.suffix.lower() == ".xacro" else None)
+            if includer is not None:
+                out.append(Target(display(path), None,
+                                  skipped=f"part of {display(includer)}, checked through it"))
+                add(includer)
                 continue
             add(path)     # a device or a pipe too: the loader says what is wrong with it
         elif path.is_dir():
