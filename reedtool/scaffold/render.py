@@ -27,6 +27,7 @@ from pathlib import Path, PurePosixPath
 from typing import Mapping
 
 from reedtool.errors import ReedtoolError, os_error
+from reedtool.io.fileio import free_backup_name
 
 TEMPLATE_SUFFIX = ".j2"
 
@@ -115,15 +116,6 @@ def check_target(target: Path, force: bool) -> None:
                                  "regenerate it; the old tree is kept as NAME.bak")
 
 
-def _free_backup_name(target: Path) -> Path:
-    candidate = target.with_name(target.name + ".bak")
-    n = 1
-    while candidate.exists() or candidate.is_symlink():
-        candidate = target.with_name(f"{target.name}.bak.{n}")
-        n += 1
-    return candidate
-
-
 def write_tree(target: Path, files: list[RenderedFile], *, force: bool = False) -> Path | None:
     """Write `files` as the directory `target`, atomically. Returns the backup dir, if any."""
     target = Path(target).absolute()
@@ -151,7 +143,7 @@ def write_tree(target: Path, files: list[RenderedFile], *, force: bool = False) 
         os.chmod(staging, 0o777 & ~_umask())
         backup = None
         if replacing:
-            backup = _free_backup_name(target)
+            backup = free_backup_name(target)
             os.rename(target, backup)
             try:
                 os.rename(staging, target)
