@@ -114,7 +114,8 @@ def scan_and_fix(text: str, file: str, macros: set[str]) -> tuple[list[LegacyTag
     found: list[LegacyTag] = []
     edits: list[int] = []                 # offsets where "xacro:" is inserted
     stack: list[tuple[str, bool]] = []    # (tag name, renamed)
-    root_seen = False
+    gazebo_open = 0                       # <gazebo> elements on the stack (kept, not searched:
+    root_seen = False                     # a deep file would make that quadratic)
     root_needs_ns: int | None = None
     for tag in _tags(text):
         if tag.closing:
@@ -123,6 +124,7 @@ def scan_and_fix(text: str, file: str, macros: set[str]) -> tuple[list[LegacyTag
                 if stack[depth][0] == tag.name:
                     if stack[depth][1]:
                         edits.append(tag.start)
+                    gazebo_open -= sum(1 for name, _ in stack[depth:] if name == "gazebo")
                     del stack[depth:]
                     break
             continue
@@ -130,12 +132,13 @@ def scan_and_fix(text: str, file: str, macros: set[str]) -> tuple[list[LegacyTag
             root_seen = True
             if "xmlns:xacro" not in tag.attrs:
                 root_needs_ns = tag.start + len(tag.name)
-        kind = _legacy_kind(tag, macros, in_gazebo=any(name == "gazebo" for name, _ in stack))
+        kind = _legacy_kind(tag, macros, in_gazebo=gazebo_open > 0)
         if kind:
             found.append(LegacyTag(file, tag.line, tag.name, f"xacro:{tag.name}", kind))
             edits.append(tag.start)
         if not tag.empty:
             stack.append((tag.name, bool(kind)))
+            gazebo_open += tag.name == "gazebo"
     if not found:
         return [], text
     pieces, prev = [], 0

@@ -90,11 +90,17 @@ def _model_files(directory: Path, recursive: bool,
                   and not any(part.startswith(".") for part in p.relative_to(directory).parts))
 
 
+# Neighbours larger than this are not followed: a model that includes a part is a small
+# hand-written file, and a huge neighbour must not slow the check of the named one.
+SIBLING_MAX_BYTES = 1024 * 1024
+
+
 def _includer(path: Path, include_tree: Callable[[Path], Sequence[Path]]) -> Path | None:
     """A top-level model in the same directory whose includes read `path`, if any."""
     key = path.resolve()
     siblings = [f for f in _model_files(path.parent, recursive=False,
-                                        suffixes=PACKAGE_SUFFIXES) if f.resolve() != key]
+                                        suffixes=PACKAGE_SUFFIXES)
+                if f.resolve() != key and f.stat().st_size <= SIBLING_MAX_BYTES]
     for sibling in _top_level(siblings, include_tree):
         if key in {p.resolve() for p in include_tree(sibling)[1:]}:
             return sibling
