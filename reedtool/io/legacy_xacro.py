@@ -162,16 +162,14 @@ class LegacyScan:
     fixed_text: dict[Path, str]            # only files that change
 
 
-def scan_tree(model: Path, resolve_include: Callable[[str, Path], Path | None],
-              display: Callable[[Path], str] = str) -> LegacyScan:
-    """Follow includes from `model`, collect macro names, then find legacy tags.
+def follow_includes(model: Path, resolve_include: Callable[[str, Path], Path | None]
+                    ) -> dict[Path, str]:
+    """The text of `model` and of every file it includes statically, in include order.
 
-    `resolve_include(spec, including_file)` turns a filename attribute into a path, or
-    None when it cannot be evaluated statically (e.g. it uses ${...}); such includes are
-    not followed here, and their legacy tags, if any, are not seen.
+    Includes `resolve_include` cannot evaluate (None) are not followed; missing and
+    unreadable files are left out (the expansion reports them with their include line).
     """
     texts: dict[Path, str] = {}
-    order: list[Path] = []
     pending = [Path(model).resolve()]
     while pending:
         path = pending.pop(0)
@@ -182,12 +180,24 @@ def scan_tree(model: Path, resolve_include: Callable[[str, Path], Path | None],
         try:
             texts[path] = path.read_text(encoding="utf-8")
         except (OSError, UnicodeDecodeError):
-            continue  # the expansion reports unreadable files with their include line
-        order.append(path)
+            continue
         for spec in include_specs(texts[path]):
             target = resolve_include(spec, path)
             if target is not None:
                 pending.append(target.resolve())
+    return texts
+
+
+def scan_tree(model: Path, resolve_include: Callable[[str, Path], Path | None],
+              display: Callable[[Path], str] = str) -> LegacyScan:
+    """Follow includes from `model`, collect macro names, then find legacy tags.
+
+    `resolve_include(spec, including_file)` turns a filename attribute into a path, or
+    None when it cannot be evaluated statically (e.g. it uses ${...}); such includes are
+    not followed here, and their legacy tags, if any, are not seen.
+    """
+    texts = follow_includes(model, resolve_include)
+    order = list(texts)
     macros: set[str] = set()
     for text in texts.values():
         macros |= macro_names(text)

@@ -173,11 +173,11 @@ def include_tree_of(mappings_for: Callable[[Path], Mapping[str, str]],
     """An `include_tree` for expand_targets, following includes statically."""
 
     def tree(path: Path) -> Sequence[Path]:
-        # Only directories need it; a single model does not pay for importing xacro.
-        from reedtool.io.xacro_expand import scan_legacy
+        # Only directories and parts need it; a single model does not import xacro for it.
+        from reedtool.io.xacro_expand import include_texts
 
         try:
-            return scan_legacy(path, dict(mappings_for(path)), package_paths).files
+            return list(include_texts(path, dict(mappings_for(path)), package_paths)) or [path]
         except Exception:  # noqa: BLE001 - a broken file is reported when it is loaded
             return [path]
 

@@ -35,20 +35,15 @@ def known_arguments(path: Path, mappings: Mapping[str, str] | None = None,
     include of the tree could be followed (when not, a name may be missing)."""
     from reedtool.io.legacy_xacro import include_specs
     from reedtool.io.packages import PackageResolver
-    from reedtool.io.xacro_expand import _static_include_resolver, scan_legacy
+    from reedtool.io.xacro_expand import _static_include_resolver, include_texts
 
     mappings = dict(mappings or {})
-    scan = scan_legacy(Path(path), mappings, package_paths)
+    texts = include_texts(Path(path), mappings, package_paths)
     resolve = _static_include_resolver(PackageResolver(package_paths, model_path=Path(path)),
                                        mappings)
     names: set[str] = set()
-    complete = True
-    for file in scan.files:
-        try:
-            text = file.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError):
-            complete = False
-            continue
+    complete = bool(texts)
+    for file, text in texts.items():
         names.update(_DECLARED.findall(text))
         names.update(_READ.findall(text))
         for spec in include_specs(text):

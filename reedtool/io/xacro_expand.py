@@ -41,7 +41,7 @@ from xacro import substitution_args
 
 from reedtool.errors import ReedtoolError
 from reedtool.io.fileio import MAX_TEXT_BYTES, note_input
-from reedtool.io.legacy_xacro import LegacyScan, LegacyTag, scan_tree
+from reedtool.io.legacy_xacro import LegacyScan, LegacyTag, follow_includes, scan_tree
 from reedtool.io.packages import PackageResolver, is_bundled
 from reedtool.model import SourceLoc
 
@@ -693,6 +693,13 @@ def _static_include_resolver(resolver: PackageResolver, mappings: dict[str, str]
         return path if path.is_absolute() else including.parent / path
 
     return resolve
+
+
+def include_texts(path: Path, mappings: dict[str, str] | None = None,
+                  package_paths: Sequence[Path] = ()) -> dict[Path, str]:
+    """`path` and the files it includes statically, with their text (no legacy scan)."""
+    resolver = PackageResolver(package_paths, model_path=path)
+    return follow_includes(Path(path), _static_include_resolver(resolver, dict(mappings or {})))
 
 
 def scan_legacy(path: Path, mappings: dict[str, str] | None = None,
