@@ -14,3 +14,15 @@ def run_cli(*args) -> tuple[int, str]:
             return 2, result.output + result.exception.one_line()
         raise result.exception
     return result.return_value, result.output
+
+
+def run_validate(argv, capsys) -> tuple[int, str, str]:
+    """`reedtool validate ARGV` through the console entry (exit code, stdout, stderr)."""
+    import pytest
+
+    from reedtool.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(["validate", *map(str, argv)])
+    out, err = capsys.readouterr()
+    return exc.value.code, out, err

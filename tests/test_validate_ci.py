@@ -9,6 +9,7 @@ from pathlib import Path
 from xml.etree import ElementTree as ET
 
 import pytest
+from cli_helpers import run_validate
 
 from reedtool.checks.registry import all_rules, get_rule
 from reedtool.cli import main
@@ -20,15 +21,8 @@ WARNING_ONLY = FIXTURES / "S114_bad_reference.urdf"       # S114 (warning)
 TRIANGLE = FIXTURES / "I203_bad_triangle.urdf"             # I203 (error)
 
 
-def run(argv, capsys):
-    with pytest.raises(SystemExit) as exc:
-        main(["validate", *map(str, argv)])
-    out, err = capsys.readouterr()
-    return exc.value.code, out, err
-
-
 def run_json(argv, capsys):
-    code, out, err = run([*argv, "--format", "json"], capsys)
+    code, out, err = run_validate([*argv, "--format", "json"], capsys)
     return code, json.loads(out)
 
 
@@ -49,8 +43,8 @@ def test_many_files_one_report_exit_over_all(capsys):
 
 
 def test_warnings_only_across_models_exit_0_unless_strict(capsys):
-    assert run([CLEAN, WARNING_ONLY], capsys)[0] == 0
-    assert run([CLEAN, WARNING_ONLY, "--strict"], capsys)[0] == 1
+    assert run_validate([CLEAN, WARNING_ONLY], capsys)[0] == 0
+    assert run_validate([CLEAN, WARNING_ONLY, "--strict"], capsys)[0] == 1
 
 
 def test_an_unreadable_model_is_reported_and_the_others_still_checked(capsys, tmp_path):
@@ -65,7 +59,7 @@ def test_an_unreadable_model_is_reported_and_the_others_still_checked(capsys, tm
     assert by_name["missing.urdf"]["error"]["message"] == "file not found"
     assert doc["summary"]["input_errors"] == 2
     # Text: one line per unreadable model, the run's tail counts them.
-    code, out, _ = run([TWO_ERRORS, tmp_path / "missing.urdf"], capsys)
+    code, out, _ = run_validate([TWO_ERRORS, tmp_path / "missing.urdf"], capsys)
     assert code == 2
     assert f"{tmp_path / 'missing.urdf'}: error: file not found" in out
     assert out.rstrip().splitlines()[-1] == ("2 models: 2 errors, 0 warnings, 0 info; "
@@ -73,8 +67,8 @@ def test_an_unreadable_model_is_reported_and_the_others_still_checked(capsys, tm
 
 
 def test_exit_zero_keeps_exit_2_for_input_errors(capsys, tmp_path):
-    assert run([TWO_ERRORS, "--exit-zero"], capsys)[0] == 0
-    assert run([TWO_ERRORS, tmp_path / "missing.urdf", "--exit-zero"], capsys)[0] == 2
+    assert run_validate([TWO_ERRORS, "--exit-zero"], capsys)[0] == 0
+    assert run_validate([TWO_ERRORS, tmp_path / "missing.urdf", "--exit-zero"], capsys)[0] == 2
 
 
 def test_directory_and_glob(capsys, tmp_path):
@@ -137,7 +131,7 @@ def test_a_changed_xacro_part_is_checked_through_the_model_that_includes_it(caps
 # ------------------------------------------------------------------ formats and outputs
 
 def test_junit_counts_failures_per_model(capsys, tmp_path):
-    code, out, _ = run([CLEAN, TWO_ERRORS, WARNING_ONLY, "--format", "junit"], capsys)
+    code, out, _ = run_validate([CLEAN, TWO_ERRORS, WARNING_ONLY, "--format", "junit"], capsys)
     assert code == 1
     root = ET.fromstring(out)
     suites = {Path(s.get("name")).name: s for s in root.iter("testsuite")}
@@ -146,12 +140,12 @@ def test_junit_counts_failures_per_model(capsys, tmp_path):
         "S114_bad_reference.urdf": ("1", "0")}
     assert sorted(f.get("type") for f in root.iter("failure")) == ["S104", "S105"]
     # --strict: the warning fails too.
-    root = ET.fromstring(run([WARNING_ONLY, "--format", "junit", "--strict"], capsys)[1])
+    root = ET.fromstring(run_validate([WARNING_ONLY, "--format", "junit", "--strict"], capsys)[1])
     assert [f.get("type") for f in root.iter("failure")] == ["S114"]
 
 
 def test_github_annotations_for_many_models_and_input_errors(capsys, tmp_path):
-    code, out, _ = run([TWO_ERRORS, tmp_path / "gone.urdf", "--format", "github"], capsys)
+    code, out, _ = run_validate([TWO_ERRORS, tmp_path / "gone.urdf", "--format", "github"], capsys)
     assert code == 2
     lines = out.splitlines()
     assert [ln.split(" ")[0] for ln in lines] == ["::error", "::error", "::error"]
@@ -159,7 +153,7 @@ def test_github_annotations_for_many_models_and_input_errors(capsys, tmp_path):
 
 
 def test_statistics_counts_per_rule(capsys):
-    code, out, _ = run([TWO_ERRORS, TRIANGLE, TRIANGLE.parent / "I203_bad_triangle.urdf",
+    code, out, _ = run_validate([TWO_ERRORS, TRIANGLE, TRIANGLE.parent / "I203_bad_triangle.urdf",
                         "--statistics"], capsys)
     rows = out.rstrip().splitlines()[-3:]
     # I203_bad_triangle.urdf given twice is checked once.
@@ -173,13 +167,13 @@ def test_statistics_counts_per_rule(capsys):
 
 def test_output_file_is_written_atomically_and_never_clobbered(capsys, tmp_path):
     report = tmp_path / "out" / "report.sarif"
-    code, out, _ = run([TWO_ERRORS, "--format", "sarif", "--output-file", report], capsys)
+    code, out, _ = run_validate([TWO_ERRORS, "--format", "sarif", "--output-file", report], capsys)
     assert code == 1 and out == ""
     assert json.loads(report.read_text())["version"] == "2.1.0"
     before = report.read_text()
-    code, _, err = run([CLEAN, "--format", "sarif", "--output-file", report], capsys)
+    code, _, err = run_validate([CLEAN, "--format", "sarif", "--output-file", report], capsys)
     assert code == 2 and "--force" in err and report.read_text() == before
-    code, _, _ = run([CLEAN, "--format", "sarif", "-o", report, "--force"], capsys)
+    code, _, _ = run_validate([CLEAN, "--format", "sarif", "-o", report, "--force"], capsys)
     assert code == 0 and json.loads(report.read_text())["runs"][0]["results"] == []
 
 
@@ -190,7 +184,7 @@ def test_rule_names_accepted_wherever_codes_are(capsys):
     assert [f["code"] for f in doc["findings"]] == ["S105"]
     _, doc = run_json([TWO_ERRORS, "--ignore", "single-root"], capsys)
     assert [f["code"] for f in doc["findings"]] == ["S105"]
-    code, out, _ = run(["--explain", "joint-link-missing"], capsys)
+    code, out, _ = run_validate(["--explain", "joint-link-missing"], capsys)
     assert code == 0 and out.startswith("S105 joint-link-missing")
 
 
@@ -289,7 +283,7 @@ def test_show_settings_names_the_config_that_won(capsys, tmp_path):
     (tmp_path / "pyproject.toml").write_text('[tool.reedtool]\nstrict = true\n')
     (tmp_path / "models" / "reedtool.toml").write_text(
         'ignore = ["I205"]\nargs = {mav_name = "quad"}\n')
-    code, out, _ = run([model, "--show-settings"], capsys)
+    code, out, _ = run_validate([model, "--show-settings"], capsys)
     assert code == 0
     lines = out.splitlines()
     assert any(ln.startswith("  config: ") and ln.endswith("models/reedtool.toml")
@@ -303,7 +297,7 @@ def test_show_settings_names_the_config_that_won(capsys, tmp_path):
 def test_unknown_setting_suggests_the_right_one(capsys, tmp_path):
     shutil.copy(CLEAN, tmp_path / "m.urdf")
     (tmp_path / "reedtool.toml").write_text('per-file-ignore = {"*.urdf" = ["S1"]}\n')
-    code, _, err = run([tmp_path / "m.urdf"], capsys)
+    code, _, err = run_validate([tmp_path / "m.urdf"], capsys)
     assert code == 2 and "did you mean 'per-file-ignores'" in err
 
 
@@ -332,6 +326,6 @@ def test_strict_is_per_model_configuration(capsys, tmp_path):
     shutil.copy(WARNING_ONLY, tmp_path / "strict" / "w.urdf")
     shutil.copy(WARNING_ONLY, tmp_path / "lax" / "w.urdf")
     (tmp_path / "strict" / "reedtool.toml").write_text("strict = true\n")
-    assert run([tmp_path / "lax" / "w.urdf", CLEAN], capsys)[0] == 0
-    assert run([tmp_path / "lax" / "w.urdf", tmp_path / "strict" / "w.urdf"], capsys)[0] == 1
-    assert run([tmp_path / "strict" / "w.urdf", "--no-strict"], capsys)[0] == 0
+    assert run_validate([tmp_path / "lax" / "w.urdf", CLEAN], capsys)[0] == 0
+    assert run_validate([tmp_path / "lax" / "w.urdf", tmp_path / "strict" / "w.urdf"], capsys)[0] == 1
+    assert run_validate([tmp_path / "strict" / "w.urdf", "--no-strict"], capsys)[0] == 0
