@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from reedtool.model import SourceLoc
 from reedtool.physics.allocation import allocation_matrix
 from reedtool.physics.rotors import Rotor
-from reedtool.physics.trim import TrimCause, solve_trim
+from reedtool.physics.trim import BOUND_MARGIN, TrimCause, solve_trim
 from reedtool.sim.params import VehicleParams
 
 G = 9.80665
@@ -99,7 +99,8 @@ def test_com_outside_the_rotor_polygon_cannot_be_balanced(com_m):
     trim = solve_trim(1.5, np.array(com_m), ring(4, arm_m=0.25))
     assert not trim.feasible
     assert trim.cause is TrimCause.COM_UNBALANCED
-    assert np.min(trim.thrust_N) < 0.0   # the least-squares demand pulls a rotor down
+    assert np.min(trim.demand_N) < 0.0   # the least-squares demand pulls a rotor down
+    assert "min" in trim.limits()        # ... and that rotor is shown at 0, not below
 
 
 def test_com_inside_the_polygon_is_balanced_by_uneven_thrust():
@@ -175,3 +176,36 @@ def test_a_feasible_trim_always_holds_the_weight_within_limits(n, com, k, mass, 
                               TrimCause.YAW_UNBALANCED)
         if trim.cause is TrimCause.INSUFFICIENT_THRUST:
             assert n * t_max < mass * G
+
+
+@pytest.mark.parametrize("case", ["heavy", "com", "yaw"])
+def test_an_infeasible_trim_shows_each_rotor_at_what_it_can_give(case):
+    # Issue 19: the table listed 12.57 N at 1000 rad/s for a rotor whose maximum is
+    # k*w_max^2 = 8.55 N, and -1.07 N at 0 rad/s. Each row must be a thrust the rotor can
+    # make, k*w^2 of the speed beside it; the demand beyond a limit is kept beside it.
+    rotors = ring(4)
+    if case == "yaw":
+        rotors[1] = rotor(1, rotors[1].position_m, "ccw")          # three ccw, one cw
+    mass, com = {"heavy": (3.2, np.zeros(3)), "com": (1.5, np.array([0.3, 0.0, 0.0])),
+                 "yaw": (1.5, np.zeros(3))}[case]
+    trim = solve_trim(mass, com, rotors)
+    assert not trim.feasible
+    t_max = K * OMEGA_MAX ** 2
+    assert np.all(trim.thrust_N >= 0.0) and np.all(trim.thrust_N <= t_max)
+    assert not np.any(np.signbit(trim.thrust_N))                     # no "-0.0000 N"
+    # One multiplication and a square root apart: a few ulps (rtol 1e-12 is ~4500).
+    np.testing.assert_allclose(K * trim.omega_rad_s ** 2, trim.thrust_N, rtol=1e-12, atol=0)
+    limits = trim.limits()
+    for want, got, limit in zip(trim.demand_N, trim.thrust_N, limits):
+        if limit == "max":
+            assert want > t_max and got == t_max                     # clipped: exact
+        elif limit == "min":
+            assert want < 0.0 and got == 0.0
+        else:   # within round-off of its range (BOUND_MARGIN) of where it is shown
+            assert abs(got - want) <= BOUND_MARGIN * t_max
+    assert any(limits)
+    rows = trim.to_dict()["rotors"]
+    assert [r["limit"] for r in rows] == limits
+    assert trim.cause is {"heavy": TrimCause.INSUFFICIENT_THRUST,
+                          "com": TrimCause.COM_UNBALANCED,
+                          "yaw": TrimCause.YAW_UNBALANCED}[case]
