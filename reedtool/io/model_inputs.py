@@ -127,6 +127,17 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
         path = Path(raw)
         if path.exists() and not path.is_dir():
             if path.is_file() and path.suffix.lower() == ".xacro" and is_macro_library(path):
+                # A library that includes itself breaks every model that includes it: an
+                # error with the chain, not a skip.
+                from reedtool.io.xacro_expand import include_cycle
+
+                cycle = include_cycle(path)
+                if cycle is not None:
+                    chain = " -> ".join(p.name for p in cycle)
+                    out.append(Target(display(path), None,
+                                      error=f"include cycle: {chain} (remove one of the "
+                                            "includes; a file cannot include itself)"))
+                    continue
                 # pre-commit passes every changed file: a macro library has no robot of its
                 # own; the models that include it are where its mistakes show.
                 out.append(Target(display(path), None, skipped="a xacro macro library (no "
