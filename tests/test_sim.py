@@ -144,17 +144,74 @@ def test_allocation_desaturates_keeping_the_torque_direction():
 
 # ------------------------------------------------------------------ the two engines
 
+# Engines (plain floats, numpy arrays, numba) and batch widths compute the same steps with
+# other kernels and summation orders: a few ulps apart per step. Their results are held to
+# ENGINE_RTOL, which test_engine_tolerance_stands_far_above_the_ulp_floor keeps at least
+# 20x above what these flights make of a 1- or 16-ulp change of their inputs (measured:
+# up to 1.3e-10 relative, in the saturating spread batch, where a few ulps decide the step
+# at which the allocation switches), and below what a wrong equation does (a 1e-6 change
+# of the mass moves the results by more than 10x ENGINE_RTOL).
+ENGINE_RTOL = 1e-8
+ENGINE_CONFIG = HoverConfig(duration_s=2.5, offset_m=(0.3, -0.2, 0.25), roll_rad=0.15,
+                            pitch_rad=-0.1, yaw_rad=0.3)
+
+
+def relative_change(a, b) -> float:
+    """Largest change of the compared outcome fields, relative to each field's scale."""
+    worst = 0.0
+    for name in ("final_omega_rad_s", "max_position_error_m", "max_attitude_error_deg",
+                 "longest_saturation_s"):
+        x, y = np.asarray(getattr(a, name), float), np.asarray(getattr(b, name), float)
+        scale = float(np.nanmax(np.abs(x))) if np.isfinite(x).any() else 0.0
+        if scale > 0:
+            worst = max(worst, float(np.nanmax(np.abs(x - y))) / scale)
+    return worst
+
+
+def batch_with_mass_scaled(params, config, plant_perturbation, scale):
+    changed = replace(plant_perturbation, mass_scale=plant_perturbation.mass_scale * scale)
+    return simulate_batch(params, config, perturbed_plant(params, changed))
+
+
+@pytest.mark.parametrize("case", ["quad", "tilted-hex", "spread-batch"])
+def test_engine_tolerance_stands_far_above_the_ulp_floor(case):
+    eps = np.finfo(float).eps
+    if case == "spread-batch":   # test_compiled's batch: crashes, saturation and recovery
+        params, config = symmetric_multirotor(4), HoverConfig(duration_s=3.0)
+        perturbation = sample_perturbations(150, 4, Spreads(mass_rel=0.3, com_m=0.03,
+                                                            inertia_rel=0.2,
+                                                            motor_constant_rel=0.15), 3)
+    else:
+        params = symmetric_multirotor(4) if case == "quad" else tilted_hex()
+        config = ENGINE_CONFIG
+        perturbation = sample_perturbations(1, params.n_rotors, Spreads(0, 0, 0, 0), seed=1)
+    ref = batch_with_mass_scaled(params, config, perturbation, 1.0)
+    floor = max(relative_change(ref, batch_with_mass_scaled(params, config, perturbation,
+                                                            1.0 + k * eps))
+                for k in (1, 16, -16))
+    assert floor * 20 <= ENGINE_RTOL
+    # ... and a real change (1e-6 of the mass) is far above the tolerance: it can fail.
+    assert relative_change(ref, batch_with_mass_scaled(params, config, perturbation,
+                                                       1.0 + 1e-6)) > 10 * ENGINE_RTOL
+
+
 @pytest.mark.parametrize("make", [lambda: symmetric_multirotor(4), tilted_hex])
 def test_plain_float_engine_matches_the_array_engine(make):
     params = make()
-    config = HoverConfig(duration_s=2.5, offset_m=(0.3, -0.2, 0.25), roll_rad=0.15,
-                         pitch_rad=-0.1, yaw_rad=0.3)
+    config = ENGINE_CONFIG
     run = simulate_hover(params, config, record=False)
     out = simulate_batch(params, config)
     assert out.status(0) is run.status
-    np.testing.assert_allclose(run.final_omega_rad_s, out.final_omega_rad_s[:, 0], rtol=1e-9)
-    assert run.max_position_error_m == pytest.approx(out.max_position_error_m[0], rel=1e-9)
-    assert run.max_attitude_error_deg == pytest.approx(out.max_attitude_error_deg[0], rel=1e-9)
+    # Two engines: ENGINE_RTOL (>= 20x this flight's measured ulp floor, see above).
+    np.testing.assert_allclose(run.final_omega_rad_s, out.final_omega_rad_s[:, 0],
+                               rtol=ENGINE_RTOL)
+    assert run.max_position_error_m == pytest.approx(out.max_position_error_m[0],
+                                                     rel=ENGINE_RTOL)
+    assert run.max_attitude_error_deg == pytest.approx(out.max_attitude_error_deg[0],
+                                                       rel=ENGINE_RTOL)
+    # A final error of ~1e-5 m is the difference of two ~2 m coordinates: one ulp of 2 m
+    # (4.4e-16 m) is 4e-11 of it before the flight amplifies it, so it keeps fewer digits
+    # than ENGINE_RTOL: rel 1e-6 (100x ENGINE_RTOL), abs 1e-12 m for a settled 0.
     assert run.final_position_error_m == pytest.approx(out.final_position_error_m[0],
                                                        rel=1e-6, abs=1e-12)
 
@@ -237,8 +294,9 @@ def test_batch_without_spread_reproduces_the_single_vehicle():
     run = simulate_hover(params, config, record=False)
     for i in range(5):
         assert out.status(i) is run.status
+        # Batch of 5 against the plain-float engine: ENGINE_RTOL (see above).
         np.testing.assert_allclose(out.final_omega_rad_s[:, i], run.final_omega_rad_s,
-                                   rtol=1e-9)
+                                   rtol=ENGINE_RTOL)
 
 
 def ulp_sensitivity_m(params: VehicleParams, config: HoverConfig, alone) -> float:
