@@ -60,6 +60,9 @@ class RunOptions:
     diagram: Path | None = None           # --diagram: the rotor layout picture
     diagram_per_model: bool = False       # several models: NAME.svg -> NAME-MODEL.svg
     force: bool = False
+    # Models loaded while deciding what a named file means (io.model_inputs), kept so
+    # check_model does not expand them twice: resolved path -> load_models pairs.
+    preloaded: dict = field(default_factory=dict)
 
 
 def selection_for(config, select: Sequence[str] = (), ignore: Sequence[str] = ()):
@@ -169,7 +172,8 @@ def check_model(name: str, model: Path, options: RunOptions) -> list:
     mappings, given, origins, checked = model_arguments(model, config, options)
     try:
         arguments = _argument_use(model, mappings, given, origins, checked, config, options)
-        pairs = load_models(model, mappings, options.package_paths, options.model_name)
+        pairs = (options.preloaded.pop(model.resolve(), None)
+                 or load_models(model, mappings, options.package_paths, options.model_name))
     except ReedtoolError as exc:
         return [ModelResult(name, error=exc.one_line(), error_file=exc.file,
                             error_line=exc.line)]
@@ -208,8 +212,8 @@ def validation_errors(model: Path, robot) -> list:
 
 
 def targets_of(paths: Sequence[str], options: RunOptions):
-    from reedtool.config import load_config
-    from reedtool.io.model_inputs import expand_targets, include_tree_of
+    from reedtool.config import find_config, load_config
+    from reedtool.io.model_inputs import expand_targets, include_globs_of, include_tree_of
     from reedtool.report import display_path
 
     def mappings_for(path: Path) -> dict[str, str]:
@@ -219,8 +223,42 @@ def targets_of(paths: Sequence[str], options: RunOptions):
             return dict(options.mappings)
         return model_arguments(path, config, options)[0]
 
+    def has_arguments(path: Path) -> bool:
+        """Arguments meant for this file: typed, from --launch, or a per-file table.
+        (The config's `args` reach every model of a repository, so they do not say the
+        file is a model: whether it expands alone with them does.)"""
+        if options.mappings or (options.launch is not None and options.launch.mappings):
+            return True
+        try:
+            config = load_config(path)
+        except ReedtoolError:
+            return False
+        return set(config.args_for(path)[0].items()) != set(config.args.items())
+
+    def stands_alone(path: Path) -> bool:
+        """Loads alone into a robot with links; the robots are kept for check_model."""
+        key = path.resolve()
+        if key in options.preloaded:
+            return True
+        try:
+            pairs = load_models(path, mappings_for(path), options.package_paths,
+                                options.model_name)
+        except ReedtoolError:
+            return False
+        if not any(robot.links for _, robot in pairs):
+            return False
+        options.preloaded[key] = pairs
+        return True
+
+    def configures_models(path: Path) -> bool:
+        found = find_config(path)
+        return found is not None and found[0] == path.resolve()
+
     return expand_targets(paths, include_tree_of(mappings_for, options.package_paths),
-                          display=lambda p: display_path(str(p)) or str(p))
+                          display=lambda p: display_path(str(p)) or str(p),
+                          include_globs=include_globs_of(mappings_for, options.package_paths),
+                          has_arguments=has_arguments, stands_alone=stands_alone,
+                          configures_models=configures_models)
 
 
 def print_settings(targets, options: RunOptions) -> int:
@@ -338,7 +376,11 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
         raise click.UsageError("missing argument 'MODEL' (or use --explain CODE)")
     if len(paths) == 1 and not Path(paths[0]).exists() and not re.search(r"[*?\[]", paths[0]):
         # One model that is not there: the one-line error of every command, exit 2.
-        raise ReedtoolError("file not found", file=paths[0], hint="check the model path")
+        from reedtool.io.model_inputs import not_found_message
+
+        message = not_found_message(paths[0])
+        raise ReedtoolError(message, file=paths[0],
+                            hint=None if message != "file not found" else "check the model path")
 
     targets = targets_of(paths, options)
     if show_settings:
@@ -369,6 +411,13 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
             results.append(ModelResult(target.name, error=target.error, error_file=target.name))
             continue
         model_results = check_model(target.name, target.path, options)
+        if target.checked_for is not None:
+            for result in model_results:
+                if result.error is not None:
+                    # The failure is this model's; name the file it was checked for.
+                    result.error += (f" [checked for {target.checked_for}, which it includes; "
+                                     f"give {target.checked_for} its arguments (name:=value) "
+                                     "to validate it as a model of its own]")
         results.extend(model_results)
         if len(targets) == 1 and results[-1].error is not None:
             # One model: its input error is the one-line error of every command.
