@@ -359,6 +359,13 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
 
     mappings = parse_mappings([w for w in inputs if MAPPING_SEPARATOR in w])
     paths = [w for w in inputs if MAPPING_SEPARATOR not in w]
+    from reedtool.io.mappings import suggest_mapping
+
+    for word in paths:
+        if not Path(word).exists() and suggest_mapping(word) is not None:
+            # `mav_name=foo` names no file: an argument missing its `:`, not a model.
+            raise ReedtoolError(f"'{word}' is not a file; xacro arguments are written "
+                                "name:=value", hint=f"did you mean '{suggest_mapping(word)}'?")
     options = RunOptions(mappings=mappings, package_paths=list(package_paths),
                          select=select, ignore=ignore, model_name=model_name,
                          launch_file=launch_file, diagram=diagram, force=force)

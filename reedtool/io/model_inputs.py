@@ -129,13 +129,16 @@ SIBLING_MAX_BYTES = 1024 * 1024
 
 def _includers(path: Path, include_tree: Callable[[Path], Sequence[Path]],
                include_globs: Callable[[Path], Sequence[str]] | None = None) -> list[Path]:
-    """The top-level models in the same directory whose includes read `path`."""
+    """The models in the same directory whose includes read `path`, top-level ones first
+    (a `<mav>_base.xacro` that a .gazebo file picks by argument still includes its parts)."""
     key = path.resolve()
     siblings = [f for f in _model_files(path.parent, recursive=False,
                                         suffixes=PACKAGE_SUFFIXES)
                 if f.resolve() != key and f.stat().st_size <= SIBLING_MAX_BYTES]
-    return [sibling for sibling in _top_level(siblings, include_tree, include_globs)
-            if key in {p.resolve() for p in include_tree(sibling)[1:]}]
+    top = set(_top_level(siblings, include_tree, include_globs))
+    includers = [sibling for sibling in siblings if not is_macro_library(sibling)
+                 and key in {p.resolve() for p in include_tree(sibling)[1:]}]
+    return sorted(includers, key=lambda sibling: sibling not in top)
 
 
 def _memo(function: Callable[[Path], Sequence]) -> Callable[[Path], Sequence]:

@@ -1,0 +1,199 @@
+"""What a path on the command line means (issue 18 item 4, issue 19 item 4).
+
+Arguments mean "this model"; a file that cannot stand alone is checked through a model
+that includes it, and a broken sibling never refuses the user's file. Directory discovery
+and the pre-commit hook know every model file a ROS/Gazebo package uses.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+from cli_helpers import run_validate
+
+FIXTURES = Path(__file__).parent / "fixtures"
+FLIE = FIXTURES / "discovery" / "flie_description"
+SEED = FIXTURES / "seed000" / "reed_gazebo"
+FLIE_ARGS = {"mav_name": "flie", "namespace": "flie", "enable_ground_truth": "true"}
+SEED_ARGS = {"mav_name": "reed_quad_x", "namespace": "reed_quad_x",
+             "enable_mavlink_interface": "true", "enable_ground_truth": "true",
+             "enable_logging": "false", "log_file": "reed_quad_x",
+             "wait_to_record_bag": "false"}
+
+
+def run_json(argv, capsys):
+    code, out, _ = run_validate([*argv, "--format", "json"], capsys)
+    return code, json.loads(out)
+
+
+def by_name(doc) -> dict[str, dict]:
+    return {Path(m["model"]).name: m for m in doc["models"]}
+
+
+def config_text(args: dict[str, str]) -> str:
+    table = ", ".join(f'{k} = "{v}"' for k, v in args.items())
+    return f"[tool.reedtool]\nargs = {{{table}}}\n"
+
+
+@pytest.fixture
+def flie(tmp_path) -> Path:
+    """The CrazyS-shaped package in a workspace of its own (tmp/ws/flie_description)."""
+    return Path(shutil.copytree(FLIE, tmp_path / "ws" / "flie_description"))
+
+
+# ------------------------------------------------------------------ arguments mean this model
+
+def test_a_model_given_arguments_is_validated_as_itself_beside_a_broken_sibling(flie, capsys):
+    """CrazyS: `crazyflie2_base.xacro mav_name:=crazyflie2 ...` was "skipped: part of
+    asymmetric_quadrotor_two_cameras.gazebo", which then failed to expand (exit 2)."""
+    base = flie / "urdf" / "flie_base.xacro"
+    code, doc = run_json([base, "--package-path", flie.parent,
+                          *(f"{k}:={v}" for k, v in FLIE_ARGS.items())], capsys)
+    assert list(by_name(doc)) == ["flie_base.xacro"]
+    model = doc["models"][0]
+    assert model["skipped"] is None and model["error"] is None
+    assert doc["summary"]["input_errors"] == 0
+    # It was really loaded and checked: its rotors are there for the rotor rules, and the
+    # one argument the vehicle never reads (mav_name picks it, upstream) is told about.
+    assert [f["code"] for f in doc["findings"] if f["severity"] == "error"] == []
+    assert [f["subject"] for f in doc["findings"] if f["code"] == "S140"] == ["mav_name"]
+    assert code == 0
+
+
+def test_config_arguments_let_a_changed_model_stand_alone(flie, capsys):
+    """pre-commit passes the changed file with no arguments of its own; the repository's
+    config carries them. The vehicle expands alone with them: it is validated as itself."""
+    (flie.parent / "pyproject.toml").write_text(config_text(FLIE_ARGS))
+    code, doc = run_json([flie / "urdf" / "flie_base.xacro", "--package-path", flie.parent],
+                         capsys)
+    assert list(by_name(doc)) == ["flie_base.xacro"]
+    assert doc["models"][0]["skipped"] is None and doc["summary"]["input_errors"] == 0
+    assert code == 0
+
+
+def test_a_part_that_cannot_stand_alone_names_itself_in_its_includers_failure(flie, capsys):
+    """flie.xacro without arguments cannot expand alone (it reads namespace); the model
+    beside it that includes it is checked instead, and that model's failure is reported
+    against that model, naming the part."""
+    code, doc = run_json([flie / "urdf" / "flie.xacro", "--package-path", flie.parent],
+                         capsys)
+    models = by_name(doc)
+    assert models["flie.xacro"]["skipped"].startswith("part of ")
+    assert "flie_base.xacro" in models["flie.xacro"]["skipped"]
+    error = models["flie_base.xacro"]["error"]["message"]
+    assert "argument 'namespace' is not set" in error
+    assert re.search(r"checked for \S*flie\.xacro, which it includes", error)
+    assert code == 2
+
+
+def test_a_part_is_checked_through_an_includer_that_loads_not_a_broken_one(tmp_path, capsys):
+    """Two models include one part (a fragment that uses its includer's property); the one
+    sorted first is broken. The part is checked through the one that loads."""
+    def robot(body: str) -> str:
+        return ('<?xml version="1.0"?>\n<robot name="r" xmlns:xacro="http://ros.org/wiki/'
+                f'xacro">\n{body}\n</robot>\n')
+
+    link = ('<link name="{n}"><inertial><mass value="{m}"/><inertia ixx="0.01" ixy="0" '
+            'ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>')
+    (tmp_path / "arm.xacro").write_text(robot(
+        link.format(n="arm", m="${arm_mass}") + '\n<joint name="arm_joint" type="fixed">'
+        '<parent link="base"/><child link="arm"/></joint>'))
+    (tmp_path / "a_broken.xacro").write_text(robot(
+        link.format(n="base", m="${base_mass}") + '\n<xacro:property name="arm_mass" '
+        'value="0.1"/>\n<xacro:include filename="arm.xacro"/>'))
+    (tmp_path / "b_good.xacro").write_text(robot(
+        link.format(n="base", m="1.0") + '\n<xacro:property name="arm_mass" value="-1"/>\n'
+        '<xacro:include filename="arm.xacro"/>'))
+    code, doc = run_json([tmp_path / "arm.xacro"], capsys)
+    models = by_name(doc)
+    assert list(models) == ["arm.xacro", "b_good.xacro"]
+    assert models["arm.xacro"]["skipped"] == f"part of {tmp_path / 'b_good.xacro'}, " \
+                                             "checked through it"
+    # The part's own mistake (mass -1, from the includer's property) is found on its line.
+    i201 = [(Path(f["file"]).name, f["line"]) for f in doc["findings"] if f["code"] == "I201"]
+    assert i201 == [("arm.xacro", 3)]
+    assert doc["summary"]["input_errors"] == 0
+    assert code == 1
+
+
+# ------------------------------------------------------------------ discovery
+
+def test_a_directory_finds_the_gazebo_top_file_not_the_base_xacro(tmp_path, capsys):
+    """A workspace directory (not a package) holding a RotorS vehicle: the top model is the
+    .gazebo file no other file includes; <mav>_base.xacro is the part it includes through
+    `$(arg mav_name)_base.xacro`, with or without the arguments."""
+    shutil.copytree(SEED, tmp_path / "reed_gazebo")
+    from reedtool.io.model_inputs import expand_targets, include_globs_of, include_tree_of
+
+    for mappings in ({}, SEED_ARGS):
+        targets = expand_targets([str(tmp_path)],
+                                 include_tree_of(lambda _p: mappings, [tmp_path]),
+                                 include_globs=include_globs_of(lambda _p: mappings,
+                                                                [tmp_path]))
+        assert [t.path.name for t in targets] == [
+            "mav_generic_odometry_sensor.gazebo",
+            "mav_generic_odometry_sensor.untouched.gazebo"], mappings
+
+
+def test_an_include_pattern_needs_an_argument_without_a_value(tmp_path):
+    from reedtool.io.model_inputs import include_globs_of
+
+    top = tmp_path / "top.gazebo"
+    top.write_text('<robot xmlns:xacro="http://ros.org/wiki/xacro">\n'
+                   '<xacro:include filename="$(arg mav_name)_base.xacro"/>\n'
+                   '<xacro:include filename="$(arg mav_name)"/>\n'
+                   '<xacro:include filename="fixed.xacro"/>\n</robot>\n')
+    assert include_globs_of(lambda _p: {}, [])(top) == [str(tmp_path / "*_base.xacro")]
+    # With the argument set, the include tree follows the file exactly: no pattern.
+    assert include_globs_of(lambda _p: {"mav_name": "m"}, [])(top) == []
+
+
+def test_a_changed_config_means_the_models_it_configures(tmp_path, capsys):
+    """The hook passes pyproject.toml when it changes; validate checks the models below
+    it and never reads the TOML as a model. Without [tool.reedtool] it is not ours."""
+    package = Path(shutil.copytree(SEED, tmp_path / "reed_gazebo"))
+    pyproject = tmp_path / "pyproject.toml"
+    pyproject.write_text("[project]\nname = 'x'\n")
+    code, doc = run_json([pyproject], capsys)
+    assert code == 0 and doc["models"][0]["skipped"].startswith("not a model")
+    pyproject.write_text(config_text(SEED_ARGS))
+    code, doc = run_json([pyproject, "--package-path", tmp_path], capsys)
+    assert [Path(m["model"]).name for m in doc["models"]] == [
+        "mav_generic_odometry_sensor.gazebo", "mav_generic_odometry_sensor.untouched.gazebo"]
+    assert sorted(f["code"] for f in doc["findings"] if f["severity"] == "error") == \
+        ["I203", "R312", "S115"]
+    assert code == 2   # the untouched copy keeps its misspelt macro parameter
+    assert package.is_dir()
+
+
+def test_the_hook_and_discovery_know_the_same_model_files():
+    """.pre-commit-hooks.yaml's `files` regex matches exactly the model suffixes directory
+    discovery uses, plus the configuration files that carry xacro arguments."""
+    import yaml
+
+    from reedtool.io.model_inputs import CONFIG_NAMES, MODEL_SUFFIXES
+
+    hooks = yaml.safe_load((Path(__file__).parents[1] / ".pre-commit-hooks.yaml").read_text())
+    pattern = re.compile(hooks[0]["files"])
+    for suffix in MODEL_SUFFIXES:
+        assert pattern.search(f"pkg/urdf/robot{suffix}"), suffix
+    assert pattern.search("pkg/urdf/robot.urdf.xacro")
+    assert pattern.search("pkg/urdf/mav_generic_odometry_sensor.gazebo")
+    for name in CONFIG_NAMES:
+        assert pattern.search(name) and pattern.search(f"sub/{name}"), name
+    for other in ("README.md", "meshes/body.stl", "notpyproject.toml", "setup.cfg",
+                  "launch/a.launch"):
+        assert not pattern.search(other), other
+
+
+# ------------------------------------------------------------------ messages that lead
+
+def test_an_argument_without_colon_suggests_the_mapping(capsys):
+    code, out, err = run_validate([FLIE / "urdf" / "flie_base.xacro", "mav_name=foo"], capsys)
+    assert code == 2
+    line, = [l for l in err.splitlines() if "error" in l]
+    assert "mav_name=foo" in line and "did you mean 'mav_name:=foo'?" in line
