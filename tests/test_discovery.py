@@ -197,3 +197,87 @@ def test_an_argument_without_colon_suggests_the_mapping(capsys):
     assert code == 2
     line, = [l for l in err.splitlines() if "error" in l]
     assert "mav_name=foo" in line and "did you mean 'mav_name:=foo'?" in line
+
+
+@pytest.mark.parametrize("name", ["frame.stl", "FRAME.STL", "body.dae", "arm.obj"])
+def test_a_mesh_given_as_a_model_says_so_and_names_import_stl(tmp_path, capsys, name):
+    import numpy as np
+
+    from reedtool.io.stl import stl_bytes
+
+    mesh = tmp_path / name
+    # A real mesh (one triangle); the refusal must not depend on reading it as XML.
+    mesh.write_bytes(stl_bytes(np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], float), "t"))
+    code, out, err = run_validate([mesh], capsys)
+    assert code == 2 and out == ""
+    line, = err.strip().splitlines()
+    assert str(mesh) in line and "is a mesh" in line and "reedtool import-stl" in line
+    assert "malformed XML" not in line
+
+
+def test_a_mesh_given_to_another_command_says_so(tmp_path):
+    from cli_helpers import run_cli
+
+    mesh = tmp_path / "frame.stl"
+    mesh.write_text("solid x\nendsolid x\n")
+    code, out = run_cli("inertia", mesh)
+    assert code == 2 and "is a mesh" in out and "import-stl" in out
+
+
+def test_a_bare_px4_airframe_name_says_where_px4_keeps_airframes(capsys):
+    model = FIXTURES / "flightstack" / "x500_flat.sdf"
+    code, out, err = run_validate([model, "--airframe", "4001_gz_x500"], capsys)
+    assert code == 2
+    line, = err.strip().splitlines()
+    assert line.startswith("reedtool: error: 4001_gz_x500: no such file")
+    assert "PX4-Autopilot" in line and "ROMFS/px4fmu_common/init.d-posix/airframes/" in line
+    # A path that is missing is an ordinary missing file, not a lecture about PX4.
+    code, _, err = run_validate([model, "--airframe", "px4/4001_gz_x500"], capsys)
+    assert code == 2 and "ROMFS" not in err
+
+
+@pytest.mark.parametrize("option, word, meant", [
+    ("--select", "R3O4", "R304"), ("--ignore", "i2O3", "I203"),
+    ("--select", "inertia-triangle-inequalty", "inertia-triangle-inequality")])
+def test_a_rule_selector_gets_did_you_mean(capsys, option, word, meant):
+    model = FIXTURES / "validate" / "clean_quad_x.urdf"
+    code, _, err = run_validate([model, option, word], capsys)
+    assert code == 2 and f"did you mean '{meant}'?" in err
+
+
+def test_a_selector_like_no_rule_gets_no_guess():
+    from reedtool.checks.registry import suggest_selector
+
+    assert suggest_selector("X999") is None and suggest_selector("zzzz-yyyy") is None
+
+
+def test_a_clean_cross_check_says_what_it_compared(capsys):
+    """A cross-check that finds nothing above information prints one line naming what it
+    compared; machine formats keep it off stdout."""
+    flight = FIXTURES / "flightstack"
+    code, out, _ = run_validate([flight / "x500_flat.sdf", "--airframe",
+                                 flight / "x500_airframe"], capsys)
+    assert code == 0
+    line, = [l for l in out.splitlines() if l.startswith("flight stack:")]
+    assert line.endswith("x500_flat.sdf agree with x500_airframe (CA_ROTOR0..3, SIM_GZ_EC_*)")
+    assert line.startswith("flight stack: 4 rotors of ")
+    code, out, _ = run_validate([flight / "iris_ardupilot.sdf", "--autopilot-params",
+                                 flight / "iris_quad_x.parm"], capsys)
+    line, = [l for l in out.splitlines() if l.startswith("flight stack:")]
+    assert line.endswith("agree with iris_quad_x.parm (FRAME_CLASS/FRAME_TYPE, "
+                         "SERVOn_FUNCTION)")
+    code, out, err = run_validate([flight / "x500_flat.sdf", "--airframe",
+                                   flight / "x500_airframe", "--format", "json"], capsys)
+    json.loads(out)
+    assert "flight stack: 4 rotors" in err
+
+
+def test_a_cross_check_with_findings_claims_no_agreement(tmp_path, capsys):
+    flight = FIXTURES / "flightstack"
+    airframe = tmp_path / "x500_airframe"
+    # Motor 0 commanded the other way round: C416, so no "agree" line.
+    text = (flight / "x500_airframe").read_text()
+    assert "CA_ROTOR0_KM  0.05" in text
+    airframe.write_text(text.replace("CA_ROTOR0_KM  0.05", "CA_ROTOR0_KM -0.05"))
+    code, out, _ = run_validate([flight / "x500_flat.sdf", "--airframe", airframe], capsys)
+    assert code == 1 and "C416" in out and "flight stack:" not in out

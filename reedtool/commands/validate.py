@@ -63,6 +63,7 @@ class RunOptions:
     # Models loaded while deciding what a named file means (io.model_inputs), kept so
     # check_model does not expand them twice: resolved path -> load_models pairs.
     preloaded: dict = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)   # one line per clean cross-check
 
 
 def selection_for(config, select: Sequence[str] = (), ignore: Sequence[str] = ()):
@@ -183,9 +184,34 @@ def check_model(name: str, model: Path, options: RunOptions) -> list:
                               flight_params=options.flight_params, arguments=arguments)
         kept, dropped = apply_suppressions(findings, ignores_for)
         results.append(ModelResult(name + suffix, kept, suppressed=dropped))
+        options.notes += _agreement_lines(robot, findings, selection, options, name + suffix)
         if options.diagram is not None:
             _write_diagram(robot, kept, options, several=len(pairs) > 1)
     return results
+
+
+def _agreement_lines(robot, findings, selection, options: RunOptions, model: str) -> list[str]:
+    """One line per --airframe/--autopilot-params file the model agrees with: every rule
+    of that flight stack ran and none found anything above information."""
+    if not options.flight_params or any(f.code.startswith("S") and f.severity == "error"
+                                        for f in findings):
+        return []     # a broken tree: the flight-stack rules did not look
+    from reedtool.checks.registry import all_rules
+    from reedtool.flightstack.params_files import agreement_line
+    from reedtool.physics.rotors import discover_rotors
+
+    rotors = discover_rotors(robot)
+    lines = []
+    for params in options.flight_params:
+        rules = [r for r in all_rules() if r.check.__module__.endswith(".flightstack_rules")
+                 and r.slug.startswith(params.kind)]
+        ran = all(selection.enabled(r.code) for r in rules)
+        quiet = not any(f.code in {r.code for r in rules} and f.severity != "info"
+                        for f in findings)
+        counted = rotors if params.kind == "px4" else [r for r in rotors if r.role == "lift"]
+        if rules and ran and quiet and counted:
+            lines.append(agreement_line(params, len(counted), model))
+    return lines
 
 
 def _write_diagram(robot, findings, options: RunOptions, several: bool) -> None:
@@ -444,6 +470,9 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
         atomic_write_text(output_file, text, force=force)
     else:
         click.echo(text, nl=False, color=color)
+    for note in options.notes:
+        # Text on the terminal carries it; machine formats and files stay as they are.
+        click.echo(note, err=fmt != "text" or output_file is not None)
     if any(r.error is not None for r in results):
         return 2
     if exit_zero:
