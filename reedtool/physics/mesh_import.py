@@ -234,7 +234,7 @@ def _conventions_with(source_axis: int, letter: str, assumed: str) -> tuple[str,
     named = [name for name, (code, _) in ALIASES.items() if code[source_axis] == letter]
     codes = sorted((code for code in RIGHT_HANDED_CODES if code[source_axis] == letter),
                    key=lambda code: -sum(a == b for a, b in zip(code, assumed)))
-    return tuple(dict.fromkeys(named + codes[:2]))
+    return tuple(dict.fromkeys(named + codes[:1]))
 
 
 def read_axes(imported: ImportedMesh) -> AxisReading:
