@@ -281,3 +281,29 @@ def test_a_cross_check_with_findings_claims_no_agreement(tmp_path, capsys):
     airframe.write_text(text.replace("CA_ROTOR0_KM  0.05", "CA_ROTOR0_KM -0.05"))
     code, out, _ = run_validate([flight / "x500_flat.sdf", "--airframe", airframe], capsys)
     assert code == 1 and "C416" in out and "flight stack:" not in out
+
+
+def test_a_changed_macro_library_is_checked_through_a_model_beside_it(flie, capsys):
+    """A macro library cannot stand alone; with a model beside it that includes it, that
+    model is where its mistakes show."""
+    (flie / "urdf" / "flie_macros.xacro").write_text(
+        '<?xml version="1.0"?>\n<robot xmlns:xacro="http://ros.org/wiki/xacro">\n'
+        '  <xacro:macro name="payload" params="parent">\n'
+        '    <link name="payload"><inertial><mass value="-0.01"/><inertia ixx="1e-6" '
+        'ixy="0" ixz="0" iyy="1e-6" iyz="0" izz="1e-6"/></inertial></link>\n'
+        '    <joint name="payload_joint" type="fixed"><parent link="${parent}"/>'
+        '<child link="payload"/></joint>\n  </xacro:macro>\n</robot>\n')
+    base = flie / "urdf" / "flie_base.xacro"
+    base.write_text(base.read_text().replace(
+        "</robot>", '  <xacro:include filename="flie_macros.xacro" />\n'
+                    '  <xacro:payload parent="${namespace}/base_link" />\n</robot>'))
+    (flie.parent / "pyproject.toml").write_text(config_text(FLIE_ARGS))
+    code, doc = run_json([flie / "urdf" / "flie_macros.xacro", "--package-path", flie.parent],
+                         capsys)
+    models = by_name(doc)
+    assert models["flie_macros.xacro"]["skipped"].startswith("part of ")
+    i201 = [(Path(f["file"]).name, f["line"]) for f in doc["findings"] if f["code"] == "I201"]
+    call_line = next(n for n, line in enumerate(base.read_text().splitlines(), 1)
+                     if "<xacro:payload " in line)
+    assert i201 == [("flie_base.xacro", call_line)]     # the call site in the user's file
+    assert code == 1

@@ -4,8 +4,9 @@ pre-commit passes every changed file; CI passes a directory or a glob. Each targ
 a list of model files:
 
 - a file: itself when it is a model (issue 18: arguments mean "this model"). A xacro file
-  given arguments (`name:=value`, `--launch`, the config) is validated as itself; without
-  arguments, a file that expands alone into a robot with links is too. Only a file that
+  given arguments (`name:=value`, `--launch`, a per-file table of the config) is validated
+  as itself; without them, a file that expands alone (with the config's repository-wide
+  `args`) into a robot with links is too. Only a file that
   cannot stand alone (a macro library, or a part that needs the arguments of the model
   that includes it) is checked through a model beside it that includes it, preferring one
   that loads; that model's failure is reported against it, naming the part;
@@ -174,6 +175,7 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
     a reedtool configuration (its directory's models are checked when it changes).
     """
     include_tree = _memo(include_tree)
+    include_globs = _memo(include_globs) if include_globs is not None else None
     out: list[Target] = []
     seen: set[Path] = set()
 
@@ -199,14 +201,15 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
 
     def add_file(path: Path) -> None:
         xacro = path.is_file() and path.suffix.lower() in XACRO_SUFFIXES
-        if xacro and is_macro_library(path):
+        includers = _includers(path, include_tree, include_globs) if xacro else []
+        library = xacro and is_macro_library(path)
+        if library and not includers:
             # pre-commit passes every changed file: a macro library has no robot of its
             # own; the models that include it are where its mistakes show.
             out.append(Target(display(path), None, skipped="a xacro macro library (no "
                               "robot of its own); validate the models that include it"))
             return
-        includers = _includers(path, include_tree, include_globs) if xacro else []
-        if not includers or has_arguments(path) or stands_alone(path):
+        if not library and (not includers or has_arguments(path) or stands_alone(path)):
             add(path)     # a device or a pipe too: the loader says what is wrong with it
             return
         # A part that cannot stand alone: checked in a model that includes it, one that

@@ -232,8 +232,10 @@ def _conventions_with(source_axis: int, letter: str, assumed: str) -> tuple[str,
     from reedtool.frames import ALIASES, RIGHT_HANDED_CODES
 
     named = [name for name, (code, _) in ALIASES.items() if code[source_axis] == letter]
+    # Closest first; on a tie, x forward (FLU, FRD, NED all keep it) before the rest.
     codes = sorted((code for code in RIGHT_HANDED_CODES if code[source_axis] == letter),
-                   key=lambda code: -sum(a == b for a, b in zip(code, assumed)))
+                   key=lambda code: (-sum(a == b for a, b in zip(code, assumed)),
+                                     code[0] != "f"))
     return tuple(dict.fromkeys(named + codes[:1]))
 
 
