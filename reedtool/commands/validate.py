@@ -202,7 +202,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
             no_color: bool, controller_files: tuple[Path, ...] = (),
             airframe_files: tuple[Path, ...] = (), autopilot_files: tuple[Path, ...] = (),
             diagram: Path | None = None) -> int:
-    """Check models (.urdf, .xacro or .sdf files, directories, globs, ROS packages) for
+    """Check models (.urdf, .xacro, .gazebo, .sdf or .world files, directories, globs, ROS
+    packages, or a changed pyproject.toml/reedtool.toml: the models it configures) for
     mistakes; NAME:=VALUE words are xacro arguments for every model.
 
     Exit 0 when there is no error, 1 when there are errors (or warnings with --strict),
