@@ -307,3 +307,11 @@ def test_a_changed_macro_library_is_checked_through_a_model_beside_it(flie, caps
                      if "<xacro:payload " in line)
     assert i201 == [("flie_base.xacro", call_line)]     # the call site in the user's file
     assert code == 1
+
+
+def test_every_command_suggests_the_mapping():
+    """Commands that take one model read the words after it as arguments (io.mappings)."""
+    from cli_helpers import run_cli
+
+    code, out = run_cli("inertia", FLIE / "urdf" / "flie_base.xacro", "namespace=flie")
+    assert code == 2 and "did you mean 'namespace:=flie'?" in out
