@@ -37,6 +37,7 @@ FIELDS = ("status_code", "reason", "reason_value", "end_time_s", "settle_time_s"
 def assert_close(got, ref, name):
     got, ref = np.asarray(got, dtype=float), np.asarray(ref, dtype=float)
     scale = float(np.nanmax(np.abs(ref))) if np.isfinite(ref).any() else 0.0
+    # RTOL: test_sim.ENGINE_RTOL, derived from the flights' measured ulp floor.
     np.testing.assert_allclose(got, ref, rtol=RTOL, atol=RTOL * scale, err_msg=name)
 
 
@@ -68,6 +69,7 @@ def test_single_vehicle_equals_the_reference(make):
                  "max_attitude_error_deg", "final_position_error_m",
                  "final_attitude_error_deg", "max_throttle", "longest_saturation_s"):
         assert_close(getattr(got, name), getattr(ref, name), name)
+    # Engines: RTOL (test_sim.ENGINE_RTOL, derived from the flights' ulp floor).
     np.testing.assert_allclose(got.final_omega_rad_s, ref.final_omega_rad_s, rtol=RTOL)
     assert got.series.keys() == ref.series.keys()
     for key in ref.series:
@@ -127,6 +129,7 @@ def test_saturated_climb_is_the_same():
     ref = simulate_hover(params, config)
     got = simulate_hover(params, config, engine="numba")
     assert ref.status is got.status is ExitStatus.SATURATED
+    # Engines: RTOL (test_sim.ENGINE_RTOL, derived from the flights' ulp floor).
     assert got.longest_saturation_s == pytest.approx(ref.longest_saturation_s, rel=RTOL)
     np.testing.assert_allclose(got.series["z_m"], ref.series["z_m"], rtol=RTOL)
 

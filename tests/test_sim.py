@@ -84,6 +84,9 @@ def test_torque_free_tumbling_keeps_angular_momentum_and_energy():
         R = rot_matrices(state.q)
         step_rigid_body(plant, state, R, np.zeros((3, 1)), np.zeros((3, 1)), 5e-4)
     L1, E1 = momentum_world_and_energy()
+    # First-order integrator: step halving gives |dL|/|L| = 1.0e-3, 5.0e-4, 2.5e-4 and
+    # |dE|/E = 1.1e-3, 5.6e-4, 2.8e-4 at dt 1, 0.5, 0.25 ms (error ~ dt, as the order says);
+    # at 0.5 ms that is 5e-4, and 5e-3 is 10x it: a wrong gyroscopic term drifts by O(1).
     np.testing.assert_allclose(L1, L0, rtol=0, atol=5e-3 * np.linalg.norm(L0))
     assert E1 == pytest.approx(E0, rel=5e-3)
 
@@ -98,6 +101,8 @@ def test_thrust_and_yaw_reaction_follow_rotors_conventions():
     force, torque = body_wrench(Plant.from_params(params), one_vehicle_state(params, omega),
                                 rot_matrices(np.array([[1.0], [0], [0], [0]])))
     T = params.motor_constant[0] * 600.0 ** 2
+    # T ~ 3 N from a few products: rounding ~1e-15 N; 1e-12 leaves margin, a wrong
+    # sign or lever arm (0.2 m) is O(1) N.
     np.testing.assert_allclose(force[:, 0], [0, 0, T], atol=1e-12)
     np.testing.assert_allclose(torque[:, 0], [0, -0.2 * T, -params.moment_constant[0] * T],
                                atol=1e-12)
@@ -116,14 +121,20 @@ def test_rotor_drag_matrices_match_the_per_rotor_formula():
         force = -params.rotor_drag_coefficient[i] * u_perp
         expected = np.concatenate([force, np.cross(r, force),
                                    -params.rolling_moment_coefficient[i] * u_perp])
+        # Entries ~1e-4 (drag coefficients) times O(1) speeds: rounding ~1e-20; 1e-15 is
+        # far above it and far below the entries themselves.
         np.testing.assert_allclose(K[:, :, i] @ np.concatenate([v, w]), expected, atol=1e-15)
 
 
 def test_motor_response_and_command_limits():
     up, down = speed_filter_factors(1e-3, np.array([0.0125]), np.array([0.025]))
+    # Same formula in numpy and math: pytest.approx's default rel 1e-6 is only a ceiling
+    # (the values agree to an ulp); a wrong time constant moves them by ~1e-2.
     assert up[0] == pytest.approx(math.exp(-1e-3 / 0.0125))
     assert down[0] == pytest.approx(math.exp(-1e-3 / 0.025))
     cmd = speed_command(np.array([-1.0, 2.0, 1e9]), np.array([1e-5] * 3), np.array([800.0] * 3))
+    # Exact limits (0 and 800 are clamps) and one sqrt (correctly rounded): the default
+    # rtol 1e-7 is only a ceiling.
     np.testing.assert_allclose(cmd, [0.0, math.sqrt(2.0 / 1e-5), 800.0])
 
 
@@ -224,6 +235,8 @@ def test_steady_hover_speed_equals_the_trim(n):
     run = simulate_hover(params, HoverConfig(duration_s=12.0), record=False)
     assert run.status is ExitStatus.PASSED
     expected = math.sqrt(params.mass_kg * G / (n * params.motor_constant[0]))
+    # Settled for ~9 s, the remaining error decays with the closed loop: measured 1.3e-9
+    # of the hover speed for n = 4, 6, 8; 1e-6 is a margin over that, far below a wrong k.
     np.testing.assert_allclose(run.final_omega_rad_s, expected, rtol=1e-6)
 
 
@@ -231,7 +244,11 @@ def test_undisturbed_hover_stays_exactly_at_trim():
     params = symmetric_multirotor(6).with_changes(inertia_kg_m2=tilted_hex().inertia_kg_m2)
     config = HoverConfig(duration_s=2.0, offset_m=(0.0, 0.0, 0.0), roll_rad=0.0)
     run = simulate_hover(params, config)
+    # Settled at the first sample (0.01 s at 100 Hz): exact up to approx's default
+    # rel 1e-6 for the float product of steps and dt.
     assert run.status is ExitStatus.PASSED and run.settle_time_s == pytest.approx(0.01)
+    # Undisturbed: the state moves only by rounding of the trim (measured 1.3e-15, a few
+    # ulps) through a stable loop; 1e-9 is a wide margin, a drifting trim is 1e-3.
     np.testing.assert_allclose(run.final_omega_rad_s, run.initial_omega_rad_s, rtol=1e-9)
     assert run.max_position_error_m < 1e-3
 
@@ -240,6 +257,8 @@ def test_disturbed_awkward_vehicle_settles():
     run = simulate_hover(tilted_hex(), HoverConfig(duration_s=6.0))
     assert run.status is ExitStatus.PASSED
     assert 0.5 < run.settle_time_s < 5.0
+    # The start offset is 0.5 m and the controller only shrinks it; 0.05 m allows the
+    # overshoot of the tilted start (a controller design figure, not rounding).
     assert run.max_position_error_m == pytest.approx(0.5, abs=0.05)
 
 
@@ -386,4 +405,5 @@ def test_initial_attitude_is_the_urdf_rpy_convention():
 
     q = quat_from_rpy(0.3, -0.2, 1.1)
     R = rot_matrices(q.reshape(4, 1))[:, :, 0]
+    # Quaternion products vs Euler products of unit entries: a few ulps (~1e-15).
     np.testing.assert_allclose(R, rpy_to_matrix((0.3, -0.2, 1.1)), atol=1e-12)
