@@ -300,7 +300,7 @@ def physics_of(robot) -> None:
     from reedtool.physics.inertia import whole_robot
     from reedtool.physics.kinematics import link_poses
     from reedtool.physics.rotors import discover_rotors, lift_rotors
-    from reedtool.physics.trim import solve_trim
+    from reedtool.physics.trim import solve_trim, solve_trim_6dof
 
     for compute in (lambda: link_poses(robot), lambda: whole_robot(robot),
                     lambda: discover_rotors(robot)):
@@ -308,11 +308,12 @@ def physics_of(robot) -> None:
             compute()
         except ReedtoolError:
             pass
-    try:
-        whole = whole_robot(robot)
-        solve_trim(whole.mass_kg, whole.com_m, lift_rotors(discover_rotors(robot)))
-    except ReedtoolError:
-        pass
+    for solve in (solve_trim, solve_trim_6dof):
+        try:
+            whole = whole_robot(robot)
+            solve(whole.mass_kg, whole.com_m, lift_rotors(discover_rotors(robot)))
+        except ReedtoolError:
+            pass
 
 
 # Valid robots of up to eight rotors (R350 searches six to eight) with one to three of
