@@ -289,6 +289,7 @@ def whole_robot(robot: Robot) -> MassProperties:
         declared = declared_mass_properties(robot.link_map[name])
         if declared is not None:
             parts.append(declared.transformed(T_base_link))
+
     def finite(p: MassProperties) -> bool:
         return bool(np.isfinite(p.mass_kg) and np.all(np.isfinite(p.com_m))
                     and np.all(np.isfinite(p.inertia_kg_m2)))

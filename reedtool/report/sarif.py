@@ -53,6 +53,11 @@ def source_root(files: list[str], cwd: Path | None = None) -> Path:
         return Path(os.path.commonpath(list(map(str, resolved)))) if resolved else root
 
 
+def _directory_uri(root: Path) -> str:
+    uri = root.as_uri()        # SARIF: a base URI ends with a slash ("file:///" for /)
+    return uri if uri.endswith("/") else uri + "/"
+
+
 def _location(path: str, root: Path) -> dict:
     relative = Path(os.path.relpath(os.path.abspath(path), root)).as_posix()
     return {"uri": quote(relative, safe="/-._~"), "uriBaseId": SRCROOT}
@@ -125,7 +130,7 @@ def format_sarif(results: list[ModelResult]) -> str:
                 "informationUri": "https://github.com/reedtool/reedtool",
                 "rules": [_rule_descriptor(code) for code in codes],
             }},
-            "originalUriBaseIds": {SRCROOT: {"uri": root.as_uri().rstrip("/") + "/"}},
+            "originalUriBaseIds": {SRCROOT: {"uri": _directory_uri(root)}},
             "invocations": [invocation],
             "results": sarif_results,
         }],
