@@ -143,8 +143,9 @@ def prove(original, model_sdf: Path, port: GzPort, request: MigrateRequest):
     compare_structure(original, ported, fold, proof)
     compare_vehicle(original, ported, proof, request.hover_config or HoverConfig(),
                     fly=request.fly)
-    dropped = [(row.source.file, row.source.line) for row in port.rows
-               if row.action in ("dropped", "unknown")]
+    # A macro call writes many elements at one line: the macro line tells them apart.
+    dropped = [(loc.file, loc.line, loc.macro) for row in port.rows
+               if row.action in ("dropped", "unknown") for loc in (row.source, *row.covers)]
     compare_findings(run_checks(original), run_checks(ported), proof, dropped)
     return proof
 

@@ -173,6 +173,7 @@ class PortRow:
     why: str
     carried: dict[str, str] = field(default_factory=dict)   # number name -> text as written
     target: Element | None = None  # the output element, for its line in model.sdf
+    covers: tuple[SourceLoc, ...] = ()  # every source location inside the element
 
     def to_dict(self) -> dict:
         return {"source": str(self.source), "element": self.element, "action": self.action,
@@ -254,7 +255,8 @@ def plan_port(robot: Robot, name: str, options: PortOptions = PortOptions()) -> 
             else:
                 rows.append(PortRow(plugin.loc, _plugin_label(plugin), "unknown", "",
                                     "no gz-sim counterpart reedtool knows: kept out of the "
-                                    "port; port it by hand if the model needs it"))
+                                    "port; port it by hand if the model needs it",
+                                    covers=_covers(plugin)))
             continue
         _HANDLERS[family.action.split(":")[0]](port, robot, plugin, family, fold, by_name)
     return port
@@ -597,14 +599,20 @@ def _sensor(port: GzPort, robot, plugin, family, fold, by_name) -> None:
                              target=sensor))
 
 
+def _covers(plugin: Plugin) -> tuple[SourceLoc, ...]:
+    return tuple(node.loc for node in plugin.node.iter())
+
+
 def _drop(port: GzPort, robot, plugin, family, fold, by_name) -> None:
-    port.rows.append(PortRow(plugin.loc, _plugin_label(plugin), "dropped", "", family.why))
+    port.rows.append(PortRow(plugin.loc, _plugin_label(plugin), "dropped", "", family.why,
+                             covers=_covers(plugin)))
 
 
 def _controller(port: GzPort, robot, plugin, family, fold, by_name) -> None:
     """Dropped; MulticopterVelocityControl is written by the writer with --velocity-control
     (its gains need the whole model's mass and inertia)."""
-    port.rows.append(PortRow(plugin.loc, _plugin_label(plugin), "dropped", "", family.why))
+    port.rows.append(PortRow(plugin.loc, _plugin_label(plugin), "dropped", "", family.why,
+                             covers=_covers(plugin)))
 
 
 def _lift_drag(port: GzPort, robot, plugin, family, fold, by_name) -> None:

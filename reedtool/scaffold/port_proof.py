@@ -301,7 +301,7 @@ def _fly(props, rotors, config):
 def compare_findings(original: list, port: list, proof: Proof, dropped=()) -> None:
     """Error and warning counts per code of validate on each side.
 
-    `dropped`: (file, line) of source elements the port leaves out. A finding on one of
+    `dropped`: (file, line, macro) of source elements the port leaves out. A finding on one of
     them (R312: the MAVLink interface's rotor count) goes with its element: it is listed
     in the notes, not counted as hidden.
     """
@@ -312,7 +312,7 @@ def compare_findings(original: list, port: list, proof: Proof, dropped=()) -> No
         for f in findings:
             if f.severity not in ("error", "warning"):
                 continue
-            if side == "original" and (f.file, f.line) in dropped:
+            if side == "original" and (f.file, f.line, f.macro) in dropped:
                 proof.notes.append(f"{f.code} ({f.severity}) on the original is about an "
                                    f"element the port leaves out ({f.file}:{f.line}): "
                                    f"{f.message}")
