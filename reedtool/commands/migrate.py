@@ -40,7 +40,7 @@ SCHEMA = "reedtool.migrate/1"
 @click.option("--autopilot", type=click.Choice(["px4"]), default=None,
               help="Also write the autopilot's rotor table: a PX4 gz airframe (px4/).")
 @click.option("--force", is_flag=True,
-              help="Write into an existing output directory (replaced files kept as .bak).")
+              help="Write into an existing output directory, replacing the files migrate writes.")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
               show_default=True, help="Output format.")
 def command(model: Path | None, mappings: tuple[str, ...], package_paths: tuple[Path, ...],

@@ -75,8 +75,7 @@ def check_target(target: Path, force: bool) -> None:
     if target.is_dir() and any(target.iterdir()) and not force:
         raise ReedtoolError("output directory exists and is not empty", file=target,
                             hint="choose another -o directory or --name, or pass --force to "
-                                 "replace the files migrate writes (each old file is kept as "
-                                 "NAME.bak)")
+                                 "replace the files migrate writes (other files are left)")
 
 
 def migrate(request: MigrateRequest) -> MigrateResult:
