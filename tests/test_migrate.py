@@ -310,7 +310,7 @@ def test_the_proof_fails_on_a_port_that_differs(tmp_path, monkeypatch):
 
 def test_the_proof_catches_an_edited_constant(tmp_path):
     """Read back a port whose motorConstant was changed in the last digit."""
-    from reedtool.scaffold.gz_migrate import MigrateRequest, prove
+    from reedtool.assembly.migration import MigrateRequest, prove
     from reedtool.scaffold.gz_port import plan_port
 
     model = FIXTURES / "migrate" / "pelican_quad.xacro"

@@ -52,27 +52,28 @@ def command(model: Path | None, mappings: tuple[str, ...], package_paths: tuple[
     original: links, joints, masses, inertias, poses, rotors, hover trim, hover-test
     verdict and validate's findings.
     """
+    from reedtool.assembly.migration import MigrateRequest, migrate
+    from reedtool.assembly.models import ModelRequest
     from reedtool.io.mappings import parse_mappings
-    from reedtool.scaffold.gz_migrate import MigrateRequest, migrate
 
-    given = parse_mappings(mappings)
+    request = ModelRequest(mappings=parse_mappings(mappings), package_paths=list(package_paths),
+                           model_name=model_name, launch_file=launch_file)
     if launch_file is not None:
         from reedtool.io.launch import read_launch
 
-        launch = read_launch(launch_file, package_paths=list(package_paths))
-        if launch.model is None:
-            raise ReedtoolError("the launch file's xacro call names no model reedtool can "
-                                "evaluate", file=launch_file, hint="pass MODEL instead")
+        request.launch = read_launch(launch_file, package_paths=list(package_paths))
         if model is None:
-            model = Path(launch.model)
-        given = {**launch.mappings, **given}
+            if request.launch.model is None:
+                raise ReedtoolError("the launch file's xacro call names no model reedtool "
+                                    "can evaluate", file=launch_file, hint="pass MODEL instead")
+            model = Path(request.launch.model)
     if model is None:
         raise ReedtoolError("no model given", hint="pass MODEL or --launch FILE")
     if not model.is_file():
         raise ReedtoolError("model file not found", file=model,
                             hint="pass the path of a .urdf, .xacro or .sdf file")
-    result = migrate(MigrateRequest(model, output_dir, given, tuple(package_paths), model_name,
-                                    name, velocity_control, autopilot, force))
+    result = migrate(MigrateRequest(model, output_dir, request, name, velocity_control,
+                                    autopilot, force))
     if fmt == "json":
         from reedtool.report.json_format import envelope
 

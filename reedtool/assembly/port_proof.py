@@ -207,14 +207,14 @@ ROTOR_NUMBERS = ("motor_constant", "moment_constant", "max_rot_velocity_rad_s",
 
 
 def compare_vehicle(original: Robot, port: Robot, proof: Proof, config, fly: bool = True) -> None:
-    """Whole-robot mass properties, rotors, trim and the hover verdict."""
-    from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
-    from reedtool.physics.rotors import discover_rotors, lift_rotors
+    """Whole-robot mass properties, rotors, trim and the hover verdict, each side assembled
+    as hover-test assembles it (assembly.vehicle, assembly.flight)."""
+    from reedtool.assembly.vehicle import Vehicle
 
     check = _Comparer(proof)
     size_m = _size_m(original)
-    props = {side: whole_robot_pinocchio(robot) for side, robot in
-             (("original", original), ("port", port))}
+    vehicles = {"original": Vehicle.of(original), "port": Vehicle.of(port)}
+    props = {side: v.props for side, v in vehicles.items()}
     a, b = props["original"], props["port"]
     check.numbers("mass", "robot", "mass_kg", a.mass_kg, b.mass_kg, a.mass_kg)
     check.numbers("mass", "robot", "com_m", a.com_m, b.com_m, size_m)
@@ -224,7 +224,7 @@ def compare_vehicle(original: Robot, port: Robot, proof: Proof, config, fly: boo
                                          "inertia_kg_m2": p.inertia_kg_m2}
                                   for side, p in props.items()}
 
-    rotors = {"original": discover_rotors(original), "port": discover_rotors(port)}
+    rotors = {side: v.every_rotor for side, v in vehicles.items()}
     by_joint = {r.joint: r for r in rotors["port"]}
     rows = []
     for rotor in rotors["original"]:
@@ -254,7 +254,7 @@ def compare_vehicle(original: Robot, port: Robot, proof: Proof, config, fly: boo
             check.differ("rotors", rotor.name, "present", False, True)
     proof.side_by_side["rotors"] = rows
 
-    trims = {side: _trim(props[side], lift_rotors(rotors[side])) for side in props}
+    trims = {side: v.trim for side, v in vehicles.items()}
     t0, t1 = trims["original"], trims["port"]
     check.same("trim", "robot", "feasible", t0.feasible, t1.feasible)
     if len(t0.thrust_N) == len(t1.thrust_N):
@@ -265,35 +265,28 @@ def compare_vehicle(original: Robot, port: Robot, proof: Proof, config, fly: boo
     proof.side_by_side["trim"] = {side: {"feasible": t.feasible, "message": t.message,
                                          "thrust_N": t.thrust_N, "omega_rad_s": t.omega_rad_s}
                                   for side, t in trims.items()}
-    if fly and t0.feasible and t1.feasible:
-        runs = {side: _fly(props[side], lift_rotors(rotors[side]), config) for side in props}
-        verdicts = {side: (run.status.value if run is not None else "not flown")
-                    for side, run in runs.items()}
-        check.same("hover", "robot", "verdict", verdicts["original"], verdicts["port"])
-        proof.side_by_side["hover"] = {
-            side: (run.to_dict() if run is not None else {"status": "not flown"})
-            for side, run in runs.items()}
+    if fly:
+        flights = {side: _fly(v, config) for side, v in vehicles.items()}
+        check.same("hover", "robot", "verdict", flights["original"]["status"],
+                   flights["port"]["status"])
+        proof.side_by_side["hover"] = flights
 
 
-def _trim(props, rotors):
-    from reedtool.physics.rotors import is_omnidirectional
-    from reedtool.physics.trim import solve_trim, solve_trim_6dof
+def _fly(vehicle, config) -> dict:
+    """hover-test's verdict on one vehicle (assembly.flight.hover_test), or why it cannot
+    fly (the same refusal hover-test makes, as a status)."""
+    from reedtool.assembly.flight import hover_test
+    from reedtool.errors import ReedtoolError
 
-    solve = solve_trim_6dof if is_omnidirectional(rotors) else solve_trim
-    return solve(props.mass_kg, props.com_m, rotors)
-
-
-def _fly(props, rotors, config):
-    """One hover flight, or None when the rotors carry no motor response to simulate
-    (ArduPilotPlugin rotors: hover-test derives it from the joint PID)."""
-    from reedtool.sim.params import VehicleParams
-    from reedtool.sim.run import simulate_hover
-
-    if not rotors or any(not (r.time_constant_up_s > 0 and r.time_constant_down_s > 0)
-                         for r in rotors):
-        return None
-    params = VehicleParams.from_rotors(props.mass_kg, props.com_m, props.inertia_kg_m2, rotors)
-    return simulate_hover(params, config)
+    try:
+        report = hover_test(vehicle.robot, config, vehicle=vehicle)
+    except ReedtoolError as exc:
+        return {"status": "not flown", "message": exc.message, "passed": False}
+    sim = report.get("sim") or {}
+    return {"status": report.get("status"), "message": report.get("message"),
+            "passed": report["passed"],
+            **{key: sim[key] for key in ("settle_time_s", "max_position_error_m",
+                                         "final_position_error_m", "max_throttle") if key in sim}}
 
 
 # ------------------------------------------------------------------ findings

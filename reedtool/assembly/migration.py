@@ -1,9 +1,11 @@
 """`migrate`: a Gazebo Classic multirotor -> a Gazebo Sim model directory, and its proof.
 
-One call, `migrate(request)`: load the original, plan the port (scaffold.gz_port), add
-what needs the whole vehicle (MulticopterVelocityControl gains, the PX4 airframe), write
-the directory all or nothing through io.fileio, read model.sdf back with reedtool's SDF
-reader and compare it with the original (scaffold.port_proof).
+One call, `migrate(request)`: load the original with its arguments as every command does
+(assembly.assemble.load_robot_for: configuration, --launch, name:=value), plan the port
+(scaffold.gz_port), add what needs the whole vehicle (MulticopterVelocityControl gains,
+the PX4 airframe), write the directory all or nothing through io.fileio
+(scaffold.sdf_writer), read model.sdf back with reedtool's SDF reader and compare it with
+the original, both assembled as hover-test assembles them (assembly.port_proof).
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ from pathlib import Path, PurePosixPath
 
 import numpy as np
 
+from reedtool.assembly.models import ModelRequest
 from reedtool.errors import ReedtoolError
 from reedtool.scaffold.gz_port import (
     VELOCITY_CONTROL_SYSTEM,
@@ -31,9 +34,7 @@ NAME_PATTERN = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
 class MigrateRequest:
     model: Path
     output_dir: Path
-    mappings: dict[str, str] = field(default_factory=dict)
-    package_paths: tuple[Path, ...] = ()
-    model_name: str | None = None
+    models: ModelRequest = field(default_factory=ModelRequest)   # arguments, --launch, ...
     name: str | None = None
     velocity_control: bool = False
     autopilot: str | None = None
@@ -47,7 +48,7 @@ class MigrateResult:
     target: Path
     files: list[PurePosixPath]
     rows: list[PortRow]
-    proof: object                            # scaffold.port_proof.Proof
+    proof: object                            # assembly.port_proof.Proof
     port: GzPort
     source: str
 
@@ -79,14 +80,11 @@ def check_target(target: Path, force: bool) -> None:
 
 
 def migrate(request: MigrateRequest) -> MigrateResult:
-    from reedtool.checks.preflight import require_sound_model
+    from reedtool.assembly.assemble import load_robot_for
     from reedtool.io.fileio import atomic_write_many, note_input
-    from reedtool.io.loader import load_robot
 
     note_input(request.model)
-    original = load_robot(request.model, request.mappings, list(request.package_paths),
-                          model_name=request.model_name)
-    require_sound_model(original)
+    original, _mappings = load_robot_for(request.model, request.models)
     name = port_name(original.name, request.name)
     target = Path(request.output_dir) / name
     check_target(target, request.force)
@@ -125,18 +123,27 @@ def migrate(request: MigrateRequest) -> MigrateResult:
 
 
 def prove(original, model_sdf: Path, port: GzPort, request: MigrateRequest):
-    """Read the written port back and compare it with the original."""
-    from reedtool.checks.runner import run_checks
-    from reedtool.io.loader import load_robot
-    from reedtool.scaffold.port_proof import (
+    """Read the written port back and compare it with the original.
+
+    validate's rules run on both with the original's selection and severities (its
+    configuration, --select/--ignore), before suppressions: an inline suppression comment
+    stays in the source, so comparing after them would count it as a finding introduced.
+    """
+    from reedtool.assembly.assemble import load_robot_for
+    from reedtool.assembly.port_proof import (
         Proof,
         compare_findings,
         compare_structure,
         compare_vehicle,
     )
+    from reedtool.assembly.validation import selection_for
+    from reedtool.checks.runner import run_checks
+    from reedtool.config import load_config
     from reedtool.sim import HoverConfig
 
-    ported = load_robot(model_sdf, {}, list(request.package_paths))
+    models = request.models
+    ported, _ = load_robot_for(model_sdf, ModelRequest(package_paths=list(models.package_paths)))
+    selection = selection_for(load_config(request.model), models.select, models.ignore)
     proof = Proof()
     fold = _fold_map(original, port)
     compare_structure(original, ported, fold, proof)
@@ -145,7 +152,8 @@ def prove(original, model_sdf: Path, port: GzPort, request: MigrateRequest):
     # A macro call writes many elements at one line: the macro line tells them apart.
     dropped = [(loc.file, loc.line, loc.macro) for row in port.rows
                if row.action in ("dropped", "unknown") for loc in (row.source, *row.covers)]
-    compare_findings(run_checks(original), run_checks(ported), proof, dropped)
+    compare_findings(run_checks(original, selection), run_checks(ported, selection), proof,
+                     dropped)
     return proof
 
 
