@@ -249,6 +249,12 @@ def test_px4_airframe_matches_the_port(tmp_path):
     outputs = sorted(int(line.split()[2][len("SIM_GZ_EC_FUNC"):]) for line in text.splitlines()
                      if line.startswith("param set-default SIM_GZ_EC_FUNC"))
     assert outputs == [n + 1 for n in sorted(motor_numbers(original_robot(model)).values())]
+    # The motors listen where PX4's gz bridge publishes (/<instance>/command/motor_speed).
+    sdf = etree.parse(str(target / "model.sdf"))
+    for motor in sdf.findall(f".//plugin[@filename='{MOTOR_SYSTEM}']"):
+        assert motor.findtext("commandSubTopic") == "command/motor_speed"
+        assert motor.find("robotNamespace") is None
+    reset_inputs()
     status, out = run("validate", target / "model.sdf", "--airframe", airframe, "--format",
                       "json")
     codes = {f["code"] for m in json.loads(out)["models"] for f in m["findings"]

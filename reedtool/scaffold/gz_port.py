@@ -61,6 +61,9 @@ SENSOR_SYSTEMS = {
 # Classic sensor types gz spells differently.
 SENSOR_TYPE_RENAMES = {"ray": "gpu_lidar", "gpu_ray": "gpu_lidar", "depth": "depth_camera",
                        "gps": "navsat"}
+# Where PX4's gz bridge sends motor speeds, below the model instance's name, as PX4's own
+# gz models subscribe.
+PX4_MOTOR_TOPIC = "command/motor_speed"
 # The IMU update rate the port writes: RotorS' noise densities become per-sample
 # standard deviations at this rate (sigma = density * sqrt(rate)).
 IMU_RATE_HZ = 250.0
@@ -221,6 +224,7 @@ class GzPort:
     rows: list[PortRow]
     meshes: dict[str, object] = field(default_factory=dict)   # uri -> model.Mesh
     namespace: str = ""
+    options: "PortOptions" = None
 
 
 @dataclass(frozen=True)
@@ -234,7 +238,7 @@ def plan_port(robot: Robot, name: str, options: PortOptions = PortOptions()) -> 
     links, joints, frames, rows, fold = _structure(robot)
     port = GzPort(name=name, links=links, joints=joints, frames=frames, plugins=[],
                   world_systems=[WORLD_PHYSICS, WORLD_USER_COMMANDS, WORLD_SCENE], rows=rows,
-                  namespace=_namespace(robot) or name)
+                  namespace=_namespace(robot) or name, options=options)
     by_name = {link.name: link for link in links}
     for link in links:
         for _T, shape in [*link.visuals, *link.collisions]:
@@ -481,9 +485,22 @@ def _motor(port: GzPort, robot, plugin: Plugin, family: Family, fold, by_name) -
         out.add("motorType", "velocity")
     if out.find("robotNamespace") is None:
         out.children.insert(0, Element("robotNamespace", {}, port.namespace))
+    why = family.why + (f"; not read by gz-sim, dropped: {', '.join(dropped)}" if dropped else "")
+    if port.options is not None and port.options.autopilot == "px4":
+        # PX4's gz bridge publishes on /<model instance>/command/motor_speed (x500_0, ...);
+        # without <robotNamespace> the motor model takes the instance name, as PX4's own
+        # gz models leave it.
+        topic = out.find("commandSubTopic") or out.add("commandSubTopic")
+        changed = [f"commandSubTopic '{topic.text or ''}' -> '{PX4_MOTOR_TOPIC}'"] \
+            if topic.text != PX4_MOTOR_TOPIC else []
+        topic.text = PX4_MOTOR_TOPIC
+        namespace = out.find("robotNamespace")
+        out.children.remove(namespace)
+        changed.append(f"robotNamespace '{namespace.text or ''}' left out (gz uses the "
+                       "model instance's name)")
+        why += f"; for PX4's gz bridge: {', '.join(changed)}"
     number = out.find("actuator_number")
     port.plugins.append(out)
-    why = family.why + (f"; not read by gz-sim, dropped: {', '.join(dropped)}" if dropped else "")
     port.rows.append(PortRow(plugin.loc, _plugin_label(plugin), "mapped",
                              f"plugin {MOTOR_SYSTEM[0]} (actuator_number "
                              f"{number.text if number is not None else '?'})", why, carried,
