@@ -99,9 +99,13 @@ def migrate(request: MigrateRequest) -> MigrateResult:
     if request.autopilot == "px4":
         extra_files.append(WrittenFile(PurePosixPath("px4", f"airframe_gz_{name}"),
                                        px4_airframe(original, name).encode("utf-8")))
-    elif request.autopilot is not None:
-        raise ReedtoolError(f"--autopilot {request.autopilot} is not supported by migrate yet",
-                            hint="use --autopilot px4, or none")
+    elif request.autopilot == "ardupilot":
+        from reedtool.scaffold.ardupilot_gz import ardupilot_port
+
+        plugins, parm = ardupilot_port(original, port)
+        extra_plugins += plugins
+        extra_files.append(WrittenFile(PurePosixPath("ardupilot", f"{name}.parm"),
+                                       parm.encode("utf-8")))
     written, mesh_rows = port_files(port, source, extra_plugins, extra_files)
     rows = [*port.rows, *mesh_rows]
     if request.velocity_control:

@@ -240,8 +240,14 @@ def compare_vehicle(original: Robot, port: Robot, proof: Proof, config, fly: boo
         check.same("rotors", rotor.name, "number", rotor.motor_number, other.motor_number)
         check.same("rotors", rotor.name, "role", rotor.role, other.role)
         check.same("rotors", rotor.name, "reversible", rotor.reversible, other.reversible)
+        values = {key: getattr(other, key) for key in ROTOR_NUMBERS}
+        if other.kind == "ardupilot" and rotor.kind != "ardupilot":
+            values.update(_ardupilot_values(port, other, rotor, proof))
         for key in ROTOR_NUMBERS:
-            x, y = getattr(rotor, key), getattr(other, key)
+            x, y = getattr(rotor, key), values[key]
+            if key in ARDUPILOT_APPROXIMATED and other.kind == "ardupilot" \
+                    and rotor.kind != "ardupilot":
+                continue  # declared in the notes by _ardupilot_values
             check.numbers("rotors", rotor.name, key, x, y, abs(x) if math.isfinite(x) else 0.0)
         rows.append({"rotor": rotor.name, "joint": rotor.joint,
                      "number": [rotor.motor_number, other.motor_number],
@@ -270,6 +276,28 @@ def compare_vehicle(original: Robot, port: Robot, proof: Proof, config, fly: boo
         check.same("hover", "robot", "verdict", flights["original"]["status"],
                    flights["port"]["status"])
         proof.side_by_side["hover"] = flights
+
+
+# What ArduPilot's plugin cannot carry from a motor model: its joint PID has one time
+# constant (the port sets it to timeConstantUp), and LiftDrag blades have no rotor drag or
+# rolling moment coefficient.
+ARDUPILOT_APPROXIMATED = ("time_constant_down_s", "rotor_drag_coefficient",
+                          "rolling_moment_coefficient")
+
+
+def _ardupilot_values(port: Robot, rotor, original, proof: Proof) -> dict:
+    """A port rotor driven by ArduPilotPlugin: its time constant as hover-test derives it
+    from the joint PID, and a note for each number the plugin cannot carry."""
+    from reedtool.physics.rotors import ardupilot_time_constant
+
+    tau = ardupilot_time_constant(port, rotor).time_constant_s
+    proof.notes.append(
+        f"{original.name}: not carried by ArduPilotPlugin: time_constant_down_s "
+        f"{original.time_constant_down_s:g} (its joint PID has one time constant, set from "
+        f"timeConstantUp), rotor_drag_coefficient {original.rotor_drag_coefficient:g} and "
+        f"rolling_moment_coefficient {original.rolling_moment_coefficient:g} (LiftDrag "
+        "blades model neither)")
+    return {"time_constant_up_s": tau, "time_constant_down_s": tau}
 
 
 def _fly(vehicle, config) -> dict:

@@ -37,8 +37,10 @@ SCHEMA = "reedtool.migrate/1"
 @click.option("--velocity-control", is_flag=True,
               help="Add gz's MulticopterVelocityControl (twist commands), gains derived as "
                    "new-package --sim gz derives them.")
-@click.option("--autopilot", type=click.Choice(["px4"]), default=None,
-              help="Also write the autopilot's rotor table: a PX4 gz airframe (px4/).")
+@click.option("--autopilot", type=click.Choice(["px4", "ardupilot"]), default=None,
+              help="Also write the autopilot's files: a PX4 gz airframe (px4/), or an "
+                   "ArduPilot .parm (ardupilot/) with the ArduPilotPlugin and LiftDrag blades "
+                   "driving the rotors in place of the motor models.")
 @click.option("--force", is_flag=True,
               help="Write into an existing output directory, replacing the files migrate writes.")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",

@@ -225,6 +225,8 @@ class GzPort:
     meshes: dict[str, object] = field(default_factory=dict)   # uri -> model.Mesh
     namespace: str = ""
     options: "PortOptions" = None
+    # --autopilot ardupilot: the velocity motor plugins ArduPilotPlugin drives, with their rows
+    ardupilot_rotors: list[tuple[Plugin, PortRow]] = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -463,6 +465,21 @@ def _motor(port: GzPort, robot, plugin: Plugin, family: Family, fold, by_name) -
         port.rows.append(PortRow(plugin.loc, _plugin_label(plugin), "dropped", "",
                                  f"motorType '{motor_type}': gz-sim's motor model spins "
                                  "velocity motors only; port this actuator by hand"))
+        return
+    if port.options is not None and port.options.autopilot == "ardupilot":
+        # ArduPilot SITL drives joints through its own plugin; the blades make the thrust.
+        # The whole-vehicle parts (channels from the frame match, PID gains from the rotor
+        # inertia) are built by assembly.migration, which fills in this row's target.
+        row = PortRow(plugin.loc, _plugin_label(plugin), "mapped",
+                      f"plugin ArduPilotPlugin <control channel=\"{plugin.param('motorNumber')}\"> "
+                      "+ 2 gz-sim-lift-drag-system blades",
+                      "ArduPilot SITL spins the rotor (VELOCITY control, joint PID) and two "
+                      "LiftDrag blades give its thrust and drag torque, sized so thrust = "
+                      "motorConstant w^2 and drag torque = momentConstant x thrust exactly",
+                      _carried(node, ("motorNumber", "turningDirection", "motorConstant",
+                                      "momentConstant", "maxRotVelocity", "timeConstantUp")))
+        port.rows.append(row)
+        port.ardupilot_rotors.append((plugin, row))
         return
     out = _gz_plugin(MOTOR_SYSTEM)
     carried: dict[str, str] = {}
