@@ -251,3 +251,13 @@ def _mesh_loc(port: GzPort, uri: str):
             if getattr(shape.geometry, "uri", None) == uri:
                 return shape.loc
     return port.links[0].loc
+
+
+def elements_text(elements: list[Element], indent: int = 0) -> str:
+    """Elements as indented XML text (for a template to place inside a <gazebo> block)."""
+    out = []
+    for element in elements:
+        node = _to_xml(element)
+        etree.indent(node, space="  ", level=indent // 2)
+        out.append(" " * indent + etree.tostring(node, encoding="unicode").rstrip())
+    return "\n".join(out)
