@@ -389,3 +389,37 @@ def test_ardupilot_refuses_a_layout_it_has_no_frame_for(tmp_path):
                          "-o", tmp_path, "--autopilot", "ardupilot")
     assert code == 2 and "no ArduPilot frame" in text
     assert not any(tmp_path.iterdir())
+
+
+# ------------------------------------------------------------------ the ROS 2 form
+
+def test_urdf_form_is_the_same_vehicle_with_gz_systems(tmp_path):
+    """--urdf: check_urdf (urdfdom) parses it; its rotors are the gz motor systems with the
+    original numbers and spins; its hover trim equals the original's (to 1e-9)."""
+    import shutil
+    import subprocess
+
+    from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
+    from reedtool.physics.rotors import discover_rotors, lift_rotors
+    from reedtool.physics.trim import solve_trim
+
+    code, _document, target = migrate(tmp_path, SEED_MODEL, SEED_ARGS, "--urdf")
+    assert code == 0
+    urdf = target / "urdf" / "reed_quad_x.urdf"
+    check_urdf = shutil.which("check_urdf")
+    if check_urdf is not None:
+        done = subprocess.run([check_urdf, str(urdf)], capture_output=True, text=True)
+        assert done.returncode == 0, done.stdout + done.stderr
+    text = urdf.read_text()
+    assert "librotors" not in text
+    original, ported = original_robot(SEED_MODEL, SEED_ARGS), load_robot(urdf, {}, [])
+    rotors = {r.joint: r for r in discover_rotors(ported)}
+    assert {r.kind for r in rotors.values()} == {"gz"}
+    for rotor in discover_rotors(original):
+        assert (rotors[rotor.joint].motor_number, rotors[rotor.joint].direction) == \
+            (rotor.motor_number, rotor.direction)
+    trims = []
+    for robot in (original, ported):
+        props = whole_robot_pinocchio(robot)
+        trims.append(solve_trim(props.mass_kg, props.com_m, lift_rotors(discover_rotors(robot))))
+    np.testing.assert_allclose(trims[1].thrust_N, trims[0].thrust_N, rtol=1e-9, atol=0)

@@ -39,6 +39,7 @@ class MigrateRequest:
     velocity_control: bool = False
     autopilot: str | None = None
     force: bool = False
+    urdf: bool = False                      # also the ROS 2 form, urdf/<name>.urdf
     hover_config: object | None = None      # sim.HoverConfig; None: hover-test's defaults
     fly: bool = True
 
@@ -106,6 +107,12 @@ def migrate(request: MigrateRequest) -> MigrateResult:
         extra_plugins += plugins
         extra_files.append(WrittenFile(PurePosixPath("ardupilot", f"{name}.parm"),
                                        parm.encode("utf-8")))
+    if request.urdf:
+        from reedtool.scaffold.sdf_writer import mesh_targets
+        from reedtool.scaffold.urdf_writer import ros2_urdf
+
+        extra_files.append(WrittenFile(PurePosixPath("urdf", f"{name}.urdf"), ros2_urdf(
+            original, port, mesh_targets(port), extra_plugins)))
     written, mesh_rows = port_files(port, source, extra_plugins, extra_files)
     rows = [*port.rows, *mesh_rows]
     if request.velocity_control:

@@ -34,6 +34,10 @@ SCHEMA = "reedtool.migrate/1"
               required=True, help="Directory to create the model directory NAME in.")
 @click.option("--name", default=None,
               help="Model (and directory) name (default: the robot's name).")
+@click.option("--urdf", is_flag=True,
+              help="Also write the ROS 2 form, urdf/NAME.urdf: the links and joints as URDF "
+                   "with the gz systems in <gazebo> elements (robot_state_publisher, "
+                   "ros_gz_sim create).")
 @click.option("--velocity-control", is_flag=True,
               help="Add gz's MulticopterVelocityControl (twist commands), gains derived as "
                    "new-package --sim gz derives them.")
@@ -47,8 +51,8 @@ SCHEMA = "reedtool.migrate/1"
               show_default=True, help="Output format.")
 def command(model: Path | None, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
             model_name: str | None, launch_file: Path | None, to: str, output_dir: Path,
-            name: str | None, velocity_control: bool, autopilot: str | None, force: bool,
-            fmt: str) -> int:
+            name: str | None, urdf: bool, velocity_control: bool, autopilot: str | None,
+            force: bool, fmt: str) -> int:
     """Port MODEL (.urdf, .xacro with NAME:=VALUE arguments, or Classic .sdf) to a Gazebo
     Sim model directory OUTPUT_DIR/NAME, then read it back and compare it with the
     original: links, joints, masses, inertias, poses, rotors, hover trim, hover-test
@@ -75,7 +79,7 @@ def command(model: Path | None, mappings: tuple[str, ...], package_paths: tuple[
         raise ReedtoolError("model file not found", file=model,
                             hint="pass the path of a .urdf, .xacro or .sdf file")
     result = migrate(MigrateRequest(model, output_dir, request, name, velocity_control,
-                                    autopilot, force))
+                                    autopilot, force, urdf))
     if fmt == "json":
         from reedtool.report.json_format import envelope
 
