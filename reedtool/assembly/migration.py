@@ -123,7 +123,8 @@ def migrate(request: MigrateRequest) -> MigrateResult:
                             "motor model with its constants and direction",
                             target=extra_plugins[0]))
     for row in rows:
-        line = written.lines.get(id(row.target)) if row.target is not None else None
+        line = written.lines.get(id(row.target)) if row.target is not None else \
+            written.lines.get(row.target_key) if row.target_key is not None else None
         if line is not None:
             row.output = f"model.sdf:{line} {row.output}"
     atomic_write_many([(target.joinpath(*f.path.parts), f.data) for f in written.files],

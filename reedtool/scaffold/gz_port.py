@@ -177,6 +177,7 @@ class PortRow:
     carried: dict[str, str] = field(default_factory=dict)   # number name -> text as written
     target: Element | None = None  # the output element, for its line in model.sdf
     covers: tuple[SourceLoc, ...] = ()  # every source location inside the element
+    target_key: tuple[str, str] | None = None   # ('link' | 'joint', name) written in model.sdf
 
     def to_dict(self) -> dict:
         return {"source": str(self.source), "element": self.element, "action": self.action,
@@ -296,7 +297,20 @@ def _structure(robot: Robot):
                         [(v.T_link_geom, v) for v in link.visuals],
                         [(c.T_link_geom, c) for c in link.collisions], link.loc)
 
+    def link_row(link, parent) -> None:
+        carried = {}
+        if link.inertial is not None:
+            carried["mass"] = _num(link.inertial.mass_kg)
+            I = link.inertial.inertia_kg_m2
+            carried.update({key: _num(I[i, j]) for key, (i, j) in (
+                ("ixx", (0, 0)), ("ixy", (0, 1)), ("ixz", (0, 2)), ("iyy", (1, 1)),
+                ("iyz", (1, 2)), ("izz", (2, 2)))})
+        rows.append(PortRow(link.loc, f"link {link.name}", "mapped", f"link {link.name}",
+                            "posed relative to its parent link" if parent else "the root link",
+                            carried, target_key=("link", link.name)))
+
     links[root] = port_link(robot.link_map[root], None, np.eye(4))
+    link_row(robot.link_map[root], None)
     queue = [root]
     while queue:
         parent_name = queue.pop(0)
@@ -324,6 +338,15 @@ def _structure(robot: Robot):
             else:
                 fold[child.name] = (child.name, np.eye(4))
                 links[child.name] = port_link(child, survivor, T_survivor_child)
+                link_row(child, survivor)
+                sdf_type = "revolute (unbounded)" if joint.type == "continuous" else joint.type
+                rows.append(PortRow(joint.loc, f"joint {joint.name} ({joint.type})", "mapped",
+                                    f"joint {joint.name} ({sdf_type})",
+                                    f"{survivor} -> {child.name}; the joint frame at the child "
+                                    "link, as URDF has it",
+                                    {"pose": _pose_text(T_survivor_child),
+                                     "axis": " ".join(_num(v) for v in joint.axis)},
+                                    target_key=("joint", joint.name)))
                 limit = joint.limit
                 joints.append(PortJoint(
                     joint.name, joint.type, survivor, child.name,

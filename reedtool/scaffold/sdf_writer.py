@@ -34,7 +34,7 @@ class WrittenFile:
 @dataclass
 class PortFiles:
     files: list[WrittenFile]
-    lines: dict[int, int]          # id(Element) -> its line in model.sdf
+    lines: dict            # id(Element) or ('link' | 'joint', name) -> its line in model.sdf
 
 
 def _to_xml(element: Element, parent=None):
@@ -174,6 +174,9 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
     tree = root.getroottree()
     lines = {id(element): reread.xpath(tree.getpath(node))[0].sourceline
              for element, node in written}
+    for kind in ("link", "joint"):
+        for node in reread.iterfind(f"./model/{kind}"):
+            lines[(kind, node.get("name"))] = node.sourceline
     return data, lines
 
 
