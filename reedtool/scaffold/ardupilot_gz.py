@@ -251,18 +251,16 @@ def _imu_name(port: GzPort) -> str:
 
 # ------------------------------------------------------------------ new-package
 
-def package_block(spec) -> str:
+def package_block(spec, positions: np.ndarray, com: np.ndarray) -> str:
     """new-package --sim gz --autopilot ardupilot: the <gazebo> content (XML text) for the
-    generated frame, rotors named as the template names them (rotor_N, rotor_N_joint,
-    N the motor number = the channel), the body IMU as base_link::imu."""
+    generated frame (rotor hubs at `positions`, the whole model's COM at `com`), rotors
+    named as the template names them (rotor_N, rotor_N_joint, N the motor number = the
+    channel), the body IMU as base_link::imu."""
     from reedtool.physics.inertia import box_inertia
-    from reedtool.scaffold.autopilot import _com_m
     from reedtool.scaffold.package_spec import ROTOR_BLADE_THICKNESS_M, ROTOR_BLADE_WIDTH_M
     from reedtool.scaffold.sdf_writer import elements_text
 
     frame = spec.frame
-    positions = frame.rotor_positions_m(spec["arm_length"], spec["rotor_offset_top"])
-    com = _com_m(spec, positions)
     # The template's rotor inertia: a blade box of mass_rotor * slowdown (RotorS), its
     # origin at the joint: izz is the moment about the joint axis.
     blade = (spec["radius_rotor"], ROTOR_BLADE_WIDTH_M, ROTOR_BLADE_THICKNESS_M)

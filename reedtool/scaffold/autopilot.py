@@ -108,6 +108,7 @@ def autopilot_context(spec, autopilot: str | None) -> dict:
     if autopilot == "ardupilot" and spec.kind == "multirotor" and spec.sim == "gz":
         from reedtool.scaffold.ardupilot_gz import package_block
 
-        return {"ardupilot_block": package_block(spec)}
+        positions = spec.frame.rotor_positions_m(spec["arm_length"], spec["rotor_offset_top"])
+        return {"ardupilot_block": package_block(spec, positions, _com_m(spec, positions))}
     return {"ardupilot_block": ""}
 
