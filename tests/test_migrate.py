@@ -239,7 +239,8 @@ def test_position_servos_become_joint_position_controllers(tmp_path):
 def test_px4_airframe_matches_the_port(tmp_path):
     """--autopilot px4: validate --airframe on the port finds no flight-stack error, and
     each SIM_GZ_EC_FUNC output is the actuator_number + 1 of a motor system."""
-    from cli_helpers import run_cli as run
+    from reedtool.checks.runner import run_checks
+    from reedtool.flightstack.px4 import load_px4_params
 
     model = FIXTURES / "migrate" / "firefly_hex.xacro"
     code, _document, target = migrate(tmp_path, model, (), "--autopilot", "px4")
@@ -254,11 +255,9 @@ def test_px4_airframe_matches_the_port(tmp_path):
     for motor in sdf.findall(f".//plugin[@filename='{MOTOR_SYSTEM}']"):
         assert motor.findtext("commandSubTopic") == "command/motor_speed"
         assert motor.find("robotNamespace") is None
-    reset_inputs()
-    status, out = run("validate", target / "model.sdf", "--airframe", airframe, "--format",
-                      "json")
-    codes = {f["code"] for m in json.loads(out)["models"] for f in m["findings"]
-             if f["severity"] == "error"}
+    port = load_robot(target / "model.sdf", {}, [])
+    codes = {f.code for f in run_checks(port, flight_params=[load_px4_params(airframe)])
+             if f.severity == "error"}
     assert not {c for c in codes if c.startswith("C")}, codes
 
 
