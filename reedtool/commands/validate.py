@@ -17,7 +17,7 @@ import click
 
 from reedtool.assembly.models import ModelRequest, model_arguments, targets_of
 from reedtool.assembly.validation import selection_for
-from reedtool.commands.params import model_option
+from reedtool.commands.params import ignore_option, model_inputs
 from reedtool.errors import ReedtoolError
 
 FORMATS = ("text", "json", "github", "sarif", "junit")
@@ -121,14 +121,7 @@ def print_settings(targets, options: RunOptions) -> int:
 # ------------------------------------------------------------------ the command
 
 @click.command(name="validate")
-@click.argument("inputs", nargs=-1, metavar="[MODEL|DIR|GLOB]... [NAME:=VALUE]...")
-@click.option("--package-path", "package_paths", multiple=True, metavar="DIR",
-              type=click.Path(path_type=Path, file_okay=False),
-              help="Directory to search for ROS packages first (repeatable).")
-@model_option
-@click.option("--launch", "launch_file", type=click.Path(path_type=Path, dir_okay=False),
-              metavar="FILE", help="Read the model and its xacro arguments from a roslaunch "
-                                   "XML or ROS 2 (XML or Python) launch file.")
+@model_inputs(metavar="[MODEL|DIR|GLOB|PACKAGE]... [NAME:=VALUE]...")
 @click.option("--format", "fmt", type=click.Choice(FORMATS), default="text",
               show_default=True, help="Output format.")
 @click.option("--output-file", "-o", "output_file", type=click.Path(path_type=Path,
@@ -138,8 +131,7 @@ def print_settings(targets, options: RunOptions) -> int:
               help="Overwrite an existing --output-file or --diagram file.")
 @click.option("--select", multiple=True, metavar="CODE,...",
               help="Run only rules whose code starts with these prefixes (or these rule names).")
-@click.option("--ignore", multiple=True, metavar="CODE,...",
-              help="Skip rules whose code starts with these prefixes (or these rule names).")
+@ignore_option
 @click.option("--explain", "explain_code", metavar="CODE",
               help="Print the documentation of one rule (code or name) and exit.")
 @click.option("--strict/--no-strict", default=None,
@@ -170,8 +162,9 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
             no_color: bool, controller_files: tuple[Path, ...] = (),
             airframe_files: tuple[Path, ...] = (), autopilot_files: tuple[Path, ...] = (),
             diagram: Path | None = None) -> int:
-    """Check models (.urdf, .xacro or .sdf files, directories, globs, ROS packages) for
-    mistakes; NAME:=VALUE words are xacro arguments for every model.
+    """Check models for mistakes: .urdf, .xacro (.urdf.xacro), .gazebo, .sdf or .world
+    files, directories, globs and ROS packages; NAME:=VALUE words are xacro arguments for
+    every model.
 
     Exit 0 when there is no error, 1 when there are errors (or warnings with --strict),
     2 on bad usage or when a model could not be read.
@@ -179,24 +172,12 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
     if explain_code:
         return explain(explain_code)
 
-    from reedtool.io.mappings import MAPPING_SEPARATOR, parse_mappings
+    from reedtool.assembly.models import request_from_words
 
-    mappings = parse_mappings([w for w in inputs if MAPPING_SEPARATOR in w])
-    paths = [w for w in inputs if MAPPING_SEPARATOR not in w]
-    request = ModelRequest(mappings=mappings, package_paths=list(package_paths),
-                           select=select, ignore=ignore, model_name=model_name,
-                           launch_file=launch_file)
+    paths, request = request_from_words(inputs, package_paths=package_paths,
+                                        model_name=model_name, launch_file=launch_file,
+                                        select=select, ignore=ignore)
     options = RunOptions(request=request, diagram=diagram, force=force)
-    if launch_file is not None:
-        from reedtool.io.launch import read_launch
-
-        request.launch = read_launch(launch_file, package_paths=list(package_paths))
-        if not paths:
-            if request.launch.model is None:
-                raise ReedtoolError("the launch file's xacro call names no model reedtool "
-                                    "can evaluate", file=launch_file,
-                                    hint="pass the model path before the options")
-            paths = [str(request.launch.model)]
     if not paths:
         raise click.UsageError("missing argument 'MODEL' (or use --explain CODE)")
     if len(paths) == 1 and not Path(paths[0]).exists() and not re.search(r"[*?\[]", paths[0]):
