@@ -56,6 +56,11 @@ class RunOptions:
     force: bool = False
 
 
+def check_target(target, options: RunOptions) -> list:
+    """check_model for a Target (what --jobs hands each worker)."""
+    return check_model(target.name, target.path, options)
+
+
 def check_model(name: str, model: Path, options: RunOptions) -> list:
     """The ModelResults of one model path (several for a world). Input errors of the
     model itself become a result with `error`; configuration errors raise."""
@@ -155,13 +160,16 @@ def print_settings(targets, options: RunOptions) -> int:
               help="ArduPilot .parm file to cross-check (FRAME_CLASS/TYPE, SERVOn_FUNCTION).")
 @click.option("--diagram", type=click.Path(path_type=Path, dir_okay=False), default=None,
               help="Also draw the rotor layout (.svg/.png), rotors named by findings in red.")
+@click.option("--jobs", "-j", type=click.IntRange(min=0), default=1, show_default=True,
+              metavar="N", help="Check the models in N processes (0: one per available "
+                                "CPU); the report keeps the models' order.")
 def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name: str | None,
             launch_file: Path | None, fmt: str, output_file: Path | None, force: bool,
             select: tuple[str, ...], ignore: tuple[str, ...], explain_code: str | None,
             strict: bool | None, exit_zero: bool, show_statistics: bool, show_settings: bool,
             no_color: bool, controller_files: tuple[Path, ...] = (),
             airframe_files: tuple[Path, ...] = (), autopilot_files: tuple[Path, ...] = (),
-            diagram: Path | None = None) -> int:
+            diagram: Path | None = None, jobs: int = 1) -> int:
     """Check models for mistakes: .urdf, .xacro (.urdf.xacro), .gazebo, .sdf or .world
     files, directories, globs and ROS packages; NAME:=VALUE words are xacro arguments for
     every model.
@@ -197,9 +205,16 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
         options.flight_params = load_flight_params(airframe_files, autopilot_files)
     options.diagram_per_model = len(targets) > 1
 
+    import functools
+
+    from reedtool.assembly.parallel import map_models
     from reedtool.config import load_config
     from reedtool.report import ModelResult, render
 
+    checkable = [t for t in targets if t.skipped is None and t.path is not None]
+    checked = dict(zip((id(t) for t in checkable),
+                       map_models(functools.partial(check_target, options=options), checkable,
+                                  jobs)))
     results = []
     failed = False       # a finding at its model's failing severity
     strict_any = False
@@ -212,7 +227,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
                 raise ReedtoolError(target.error, file=target.name)
             results.append(ModelResult(target.name, error=target.error, error_file=target.name))
             continue
-        model_results = check_model(target.name, target.path, options)
+        model_results = checked[id(target)]
         results.extend(model_results)
         if len(targets) == 1 and results[-1].error is not None:
             # One model: its input error is the one-line error of every command.

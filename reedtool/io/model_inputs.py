@@ -77,7 +77,8 @@ def _top_level(files: list[Path], include_tree: Callable[[Path], Sequence[Path]]
     candidates = [f for f in files if not is_macro_library(f)]
     included: set[Path] = set()
     for candidate in candidates:
-        if candidate.suffix.lower() not in (".sdf", ".world"):
+        # SDF is not xacro, and a .urdf is read as written: neither includes a xacro part.
+        if candidate.suffix.lower() not in (".sdf", ".world", ".urdf"):
             included.update(p.resolve() for p in include_tree(candidate)[1:])
     return [c for c in candidates if c.resolve() not in included]
 
