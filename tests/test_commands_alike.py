@@ -311,3 +311,13 @@ def test_refusal_groups_by_code():
                  "R308", "R312", "C404", "C416"):
         assert not refuses(code, needs), code
     assert not refuses("I203", ("structure",)) and refuses("S113", ("structure",))
+
+
+def test_the_documented_refusal_table_is_the_code():
+    """docs/commands.md shows refusal_table(); regenerate the block when the rules change."""
+    from reedtool.assembly.validation import refusal_table
+
+    doc = (Path(__file__).parent.parent / "docs" / "commands.md").read_text()
+    block = doc.split("<!-- refusal-table")[1].split("<!-- end refusal-table -->")[0]
+    rows = [line for line in block.splitlines() if line.startswith("| `")]
+    assert rows == ["| `%s` | %s | %s |" % row for row in refusal_table()]

@@ -21,11 +21,11 @@ def why_line(refusing: Sequence, reported: Sequence, refused: bool, action: str,
     codes = sorted({f.code for f in refusing})
     line = f"validate reports {_plural(total, 'error')} for this model"
     if refusing:
-        line += (f"; {len(refusing)} of them make the result meaningless "
-                 f"({', '.join(codes)})")
+        verb = "makes" if len(refusing) == 1 else "make"
+        line += f"; {len(refusing)} of them {verb} the result meaningless ({', '.join(codes)})"
     if refused:
         return (f"FAILED: {line}; not {action} (--ignore {','.join(codes)} or "
-                f"--ignore-validation: {action} anyway)")
+                "--ignore-validation goes ahead)")
     if refusing and ignore_validation:
         return f"{line}; {action} anyway (--ignore-validation)"
     return f"{line}; none of them makes the result meaningless: {action}"
