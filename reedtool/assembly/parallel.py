@@ -25,8 +25,12 @@ def available_cpus() -> int:
         return os.cpu_count() or 1
 
 
-def _call(job):
-    func, item = job
+# The function a forked worker runs: set before the pool forks, so it (and what it holds,
+# e.g. robots already loaded) is inherited rather than pickled for every item.
+_forked_func: Callable | None = None
+
+
+def _call(func, item):
     try:
         return True, func(item)
     except ReedtoolError as exc:
@@ -34,11 +38,19 @@ def _call(job):
         return False, (exc.message, exc.file, exc.line, exc.hint)
 
 
+def _call_forked(item):
+    return _call(_forked_func, item)
+
+
+def _call_pickled(job):
+    return _call(*job)
+
+
 def map_models(func: Callable[[T], R], items: Sequence[T], jobs: int = 1) -> list[R]:
     """[func(item) for item in items], in `jobs` processes (0: one per available CPU).
 
-    `func` and the items must pickle (a module-level function, or a functools.partial of
-    one). A ReedtoolError raised for an item is raised here, the first in item order.
+    The items and results must pickle (and `func` too where processes cannot fork). A
+    ReedtoolError raised for an item is raised here, the first in item order.
     """
     jobs = available_cpus() if jobs == 0 else jobs
     if jobs <= 1 or len(items) < 2:
@@ -46,11 +58,20 @@ def map_models(func: Callable[[T], R], items: Sequence[T], jobs: int = 1) -> lis
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
-    first = _call((func, items[0]))     # warms imports and caches for the forked workers
-    methods = multiprocessing.get_all_start_methods()
-    context = multiprocessing.get_context("fork" if "fork" in methods else None)
-    with ProcessPoolExecutor(max_workers=min(jobs, len(items) - 1), mp_context=context) as pool:
-        outcomes = [first, *pool.map(_call, [(func, item) for item in items[1:]])]
+    global _forked_func
+
+    first = _call(func, items[0])     # warms imports and caches for the forked workers
+    fork = "fork" in multiprocessing.get_all_start_methods()
+    context = multiprocessing.get_context("fork" if fork else None)
+    _forked_func = func
+    try:
+        with ProcessPoolExecutor(max_workers=min(jobs, len(items) - 1),
+                                 mp_context=context) as pool:
+            rest = (pool.map(_call_forked, items[1:]) if fork
+                    else pool.map(_call_pickled, [(func, item) for item in items[1:]]))
+            outcomes = [first, *rest]
+    finally:
+        _forked_func = None
     results = []
     for ok, value in outcomes:
         if not ok:
