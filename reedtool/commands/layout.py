@@ -40,6 +40,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
     check_writable(output, force)         # a device, FIFO or existing file is refused here
     model, request = one_model_request("layout", inputs, package_paths, model_name,
                                        launch_file, ignore)
+    note_input(model)
     from reedtool.assembly.assemble import load_robot_for
     from reedtool.assembly.diagram import write_diagram
     from reedtool.assembly.validation import judge
