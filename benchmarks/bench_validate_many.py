@@ -14,10 +14,16 @@ pair's ratio is taken and the median printed, for wall time and for CPU time (us
 sys of the child processes, from getrusage), which holds on a machine that is busy with
 other work.
 
-Recorded (2-core AMD EPYC, shared and loaded; medians of 5 pairs):
-    15 models: before this benchmark existed 0.50x CPU, 0.49x wall (R350's spin-order
-               search dominated); after vectorising it 0.36x CPU, 0.36x wall.
-See the closing figures printed by a run for this machine.
+Recorded (2-core AMD EPYC, shared with other work, load average 7-12; medians of pairs):
+
+    models  reedtool before this benchmark   reedtool now           (wall / CPU ratio)
+    15      0.52x / 0.53x                    0.25x / 0.31x
+    60      -                                0.17x / 0.18x  (--jobs 2: 0.21x / 0.20x;
+                                                             the cores were busy)
+
+"Before" is the code this benchmark was written against (R350's spin-order search was
+most of a hexacopter's time; every model re-read the shared meshes and re-crawled the
+package roots); see docs/validate.md.
 """
 
 from __future__ import annotations

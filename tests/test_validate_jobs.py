@@ -78,3 +78,55 @@ def test_a_mesh_edited_between_runs_is_read_again(capsys, tmp_path):
 def test_bad_jobs_is_a_usage_error(capsys, jobs):
     code, _, err = run_validate([MODELS[0], "--jobs", jobs], capsys)
     assert code == 2 and "--jobs" in err
+
+
+def _mesh_model(path: Path, package: str) -> None:
+    path.write_text(
+        f'<robot name="{path.stem}"><link name="base_link"><visual><geometry>'
+        f'<mesh filename="package://{package}/meshes/body.stl"/></geometry></visual>'
+        '<inertial><mass value="1"/>'
+        '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>'
+        '</link></robot>')
+
+
+def _package(root: Path, name: str) -> None:
+    (root / name / "meshes").mkdir(parents=True)
+    (root / name / "package.xml").write_text(
+        f'<package format="2"><name>{name}</name></package>')
+    (root / name / "meshes" / "body.stl").write_text(
+        "solid x\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 0.1 0 0\n"
+        "   vertex 0 0.1 0\n  endloop\n endfacet\nendsolid x\n")
+
+
+def test_a_run_crawls_each_package_root_once(capsys, tmp_path, monkeypatch):
+    from reedtool.io import packages
+
+    workspace = tmp_path / "ws"
+    for i in range(5):
+        _package(workspace / f"repo{i}", f"pkg{i}")
+    models = tmp_path / "models"
+    models.mkdir()
+    for i in range(4):
+        _mesh_model(models / f"m{i}.urdf", f"pkg{i}")
+    crawled = []
+    real = packages._crawl
+    monkeypatch.setattr(packages, "_crawl",
+                        lambda root, *a, **k: crawled.append(Path(root)) or real(root, *a, **k))
+    code, out, _ = run_validate([models, "--package-path", workspace, "--select", "S115"],
+                                capsys)
+    assert code == 0, out
+    assert crawled.count(workspace) == 1
+
+
+def test_a_package_added_between_runs_is_found(capsys, tmp_path):
+    """Crawls are shared within a run only: the next run sees the workspace as it is."""
+    workspace = tmp_path / "ws"
+    workspace.mkdir()
+    model = tmp_path / "m.urdf"
+    _mesh_model(model, "late_pkg")
+    args = [model, "--package-path", workspace, "--select", "S115", "--format", "json"]
+    first = run_validate(args, capsys)
+    assert [f["code"] for f in json.loads(first[1])["findings"]] == ["S115"]
+    _package(workspace, "late_pkg")
+    second = run_validate(args, capsys)
+    assert second[0] == 0 and json.loads(second[1])["findings"] == []

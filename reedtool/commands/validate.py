@@ -219,7 +219,11 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
         return explain(explain_code)
 
     from reedtool.assembly.models import request_from_words
+    from reedtool.io.packages import shared_crawls
 
+    context = click.get_current_context(silent=True)
+    if context is not None:       # every model of the run resolves against the same roots
+        context.with_resource(shared_crawls())
     paths, request = request_from_words(inputs, package_paths=package_paths,
                                         model_name=model_name, launch_file=launch_file,
                                         select=select, ignore=ignore)
