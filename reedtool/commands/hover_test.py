@@ -115,6 +115,11 @@ def check_batch_resources(every_rotor, samples: int | None, max_memory_bytes: in
                    "needs pip install 'reedtool[fast]').")
 @click.option("--min-pass-rate", type=FiniteFloatRange(0.0, 1.0), default=0.95,
               show_default=True, help="Batch pass rate needed to exit 0.")
+@click.option("--require", "require", default="stable", show_default=True,
+              metavar="hover|stable|margin:DEG",
+              help="What exit 0 needs: a hover trim (hover); and a vehicle some controller "
+                   "can stabilise (stable); and recovery from a start tilted DEG degrees "
+                   "(margin:DEG).")
 @click.option("--ignore-validation", is_flag=True,
               help="Fly a model that `validate` reports errors for (by default it is "
                    "refused: exit 1 without flying).")
@@ -126,7 +131,7 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
             max_memory_mb: int, seed: int,
             mass_spread: float, com_spread_m: float, inertia_spread: float,
             motor_spread: float, engine: str, min_pass_rate: float,
-            ignore_validation: bool = False) -> int:
+            require: str = "stable", ignore_validation: bool = False) -> int:
     """Trim MODEL (.urdf or .xacro, with xacro NAME:=VALUE arguments) for hover and fly it.
 
     Starts from a disturbance (default 0.5 m off the setpoint, rolled 0.2 rad) and passes
@@ -136,6 +141,13 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     """
     from reedtool.errors import check_plausible
     from reedtool.sim import HoverConfig
+    from reedtool.sim.verdict import Requirement
+
+    try:
+        requirement = Requirement.parse(require)
+    except ValueError as exc:
+        raise ReedtoolError(f"bad option: {exc}",
+                            hint="e.g. --require stable, or --require margin:10") from exc
 
     check_plausible("rate", rate_hz, "--rate")
     check_plausible("duration", duration_s, "--duration")
@@ -221,7 +233,8 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
                         spreads=(mass_spread, com_spread_m, inertia_spread, motor_spread),
                         record=bool(plot_path or csv_path), show_progress=fmt == "text",
                         engine=engine, envelope=plot_path is not None,
-                        max_memory_bytes=max_memory_mb * 1024 * 1024)
+                        max_memory_bytes=max_memory_mb * 1024 * 1024,
+                        requirement=requirement)
     batch = report.get("batch")
     if batch is not None:
         batch["min_pass_rate"] = min_pass_rate
@@ -264,11 +277,14 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
                spreads: tuple[float, float, float, float] = (0.1, 0.01, 0.1, 0.05),
                record: bool = False, show_progress: bool = False,
                engine: str = "numpy", envelope: bool = False,
-               max_memory_bytes: int = DEFAULT_MAX_MEMORY_MB * 1024 * 1024) -> dict:
+               max_memory_bytes: int = DEFAULT_MAX_MEMORY_MB * 1024 * 1024,
+               requirement=None) -> dict:
     """Trim, simulate and (optionally) batch one robot; the JSON-ready report.
 
-    Keys: "model", "trim", "sim" (None when the trim failed), "batch" (None without
-    samples), "passed"; plus "_run" (the HoverRun, for CSV/plot) and "_omega_max".
+    Keys: "model", "trim", "sim" (None when not flown), "batch" (None without samples),
+    "verdict" (sim.verdict: what the vehicle can do, with its cause), "status" (the
+    verdict's), "message", "passed" (the verdict against `requirement`); plus "_run" (the
+    HoverRun, for CSV/plot) and "_omega_max".
     """
     import numpy as np
 
@@ -280,8 +296,18 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
         rotor_table,
     )
     from reedtool.physics.trim import solve_trim, solve_trim_6dof
-    from reedtool.sim import ExitStatus
+    from reedtool.sim import verdict as judge
     from reedtool.sim.params import VehicleParams, check_rotor_dynamics
+
+    requirement = requirement or judge.Requirement()
+
+    def conclude(found) -> dict:
+        report["verdict"] = found.to_dict()
+        report["status"] = found.verdict.value
+        report["message"] = found.message
+        report["passed"] = found.passes(requirement)
+        report["require"] = str(requirement)
+        return report
 
     # Hover is held by the lift rotors: a VTOL's pusher or a plane's puller stays off.
     every_rotor = discover_rotors(robot)
@@ -312,17 +338,10 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
         "_omega_max": np.array([r.max_rot_velocity_rad_s for r in rotors], dtype=float),
     }
     if not trim.feasible:
-        report["status"] = ExitStatus.TRIM_INFEASIBLE.value
-        report["message"] = f"no hover trim: {trim.message}"
-        return report
-
+        return conclude(judge.HoverVerdict(judge.Verdict.CANNOT_HOVER,
+                                           f"no hover trim: {trim.message}"))
     if omni:
-        raise ReedtoolError(
-            f"{robot.name}: {trim.message}; hover-test's flight controller cannot fly an "
-            "omnidirectional frame (reversible or many-direction rotors): it commands thrust "
-            "and three torques from rotors that push one way",
-            file=robot.source_file,
-            hint="`reedtool validate` checks this frame's 6-DoF hover trim and allocation")
+        return conclude(judge.omnidirectional(trim.message))
     rotors, derived = _ardupilot_motor_response(robot, rotors)
     report["model"]["derived"] = derived
     check_rotor_dynamics(rotors)
@@ -331,36 +350,56 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
                             "be simulated", file=robot.source_file,
                             hint="run `reedtool inertia` on the model")
     params = VehicleParams.from_rotors(props.mass_kg, props.com_m, props.inertia_kg_m2, rotors)
+    from reedtool.sim.rigid import locked_joints
 
+    report["model"]["locked_joints"] = [
+        lj.to_dict() for lj in locked_joints(robot, every_rotor, props.com_m)]
+    controllable, acai = judge.stabilisable(params)
+    if not controllable:
+        return conclude(judge.uncontrollable(acai))
+
+    from reedtool.sim.controller import ControllerGains
     from reedtool.sim.run import simulate_hover
 
+    gains = ControllerGains.from_params(params)
     with _still_working(f"flying {config.duration_s:g} s at {config.rate_hz:g} Hz",
                         show_progress):
-        run = simulate_hover(params, config, record=record, engine=engine)
+        run = simulate_hover(params, config, record=record, engine=engine, gains=gains)
+        found = judge.judge_flight(
+            params, config, run,
+            lambda start: simulate_hover(params, start, record=False, engine=engine,
+                                         gains=gains), requirement)
     sim = run.to_dict()
     sim["trim_omega_rad_s"] = dict(zip(params.rotor_names,
                                        (float(w) for w in trim.omega_rad_s)))
     report["sim"] = sim
     report["_run"] = run
-    report["status"] = run.status.value
-    report["message"] = run.message
-    report["passed"] = run.passed
+    conclude(found)
 
     if samples:
         from reedtool.sim.batch import Spreads, robustness_batch
 
+        # The batch flies from the start the nominal vehicle recovers from: the start
+        # itself when it flies, its recoverable margin when it is marginal.
+        scale = 1.0
+        if found.verdict is judge.Verdict.MARGINAL and found.start_tilt_deg:
+            scale = (found.recoverable_tilt_deg or 0.0) / found.start_tilt_deg
+        elif found.verdict is judge.Verdict.MARGINAL and found.start_offset_m:
+            scale = (found.recoverable_offset_m or 0.0) / found.start_offset_m
+        batch_config = judge.scaled_start(config, scale)
         mass_rel, com_m, inertia_rel, motor_rel = spreads
         spread = Spreads(mass_rel=mass_rel, com_m=com_m, inertia_rel=inertia_rel,
                          motor_constant_rel=motor_rel)
         if show_progress:
             with click.progressbar(length=config.n_steps, file=sys.stderr,
                                    label=f"flying {samples} vehicles") as bar:
-                batch = robustness_batch(params, samples, config, spread, seed,
+                batch = robustness_batch(params, samples, batch_config, spread, seed,
                                          progress=bar.update, engine=engine, record=envelope)
         else:
-            batch = robustness_batch(params, samples, config, spread, seed, engine=engine,
-                                     record=envelope)
+            batch = robustness_batch(params, samples, batch_config, spread, seed,
+                                     engine=engine, record=envelope)
         report["batch"] = batch.to_dict()
+        report["batch"]["start_scale"] = scale
         report["_envelope"] = batch.envelope
     return report
 
@@ -436,6 +475,15 @@ def render_text(report: dict) -> str:
                                                          for r in others))
     for line in model.get("derived", ()):
         lines.append(f"derived: {line}")
+    for lj in model.get("locked_joints", ()):
+        # Passive joints (no plugin drives them) are flown rigid: say so, with what the
+        # mass beyond them adds to the inertia about the COM.
+        added = [lj["inertia_about_com_kg_m2"][i][i] for i in range(3)]
+        total = [model["inertia_kg_m2"][i][i] for i in range(3)]
+        share = ", ".join(f"{axis} {a:.3g} kg*m^2 ({100 * a / t:.0f}%)" if t > 0 else
+                          f"{axis} {a:.3g} kg*m^2" for axis, a, t in zip("xyz", added, total))
+        lines.append(f"locked rigid: {lj['joint']} ({lj['type']}, no plugin drives it; "
+                     f"{lj['mass_kg']:.3g} kg beyond it adds {share} about the COM)")
     if trim["feasible"]:
         lines.append(f"trim: {trim['message']}")
     else:
@@ -452,7 +500,10 @@ def render_text(report: dict) -> str:
                      f"hover: roll {a['roll']:.3g}, pitch {a['pitch']:.3g}, "
                      f"yaw {a['yaw']:.3g} N*m")
     if sim is not None:
+        from reedtool.sim.verdict import tuning_line
+
         c = sim["config"]
+        lines.append(f"tuning: {tuning_line(sim['gains'])}")
         lines.append(f"sim: {sim['status'].upper()}: {sim['message']}")
         lines.append(f"  start {c['offset_m']} m off, roll {c['roll_rad']:g} pitch "
                      f"{c['pitch_rad']:g} yaw {c['yaw_rad']:g} rad; {c['duration_s']:g} s at "
@@ -478,6 +529,9 @@ def render_text(report: dict) -> str:
             lines.append(f"  #{w['index']}: {w['status']}: {w['message']} "
                          f"(mass {w['mass_kg']:.4g} kg, COM shift "
                          f"{', '.join(f'{1000 * v:.1f}' for v in w['com_shift_m'])} mm)")
+    verdict = report.get("verdict")
+    if verdict is not None:
+        lines.append(f"verdict: {verdict['status'].upper()}: {verdict['message']}")
     lines.append("PASSED" if report["passed"] else f"FAILED: {report.get('message', '')}")
     return "\n".join(lines)
 

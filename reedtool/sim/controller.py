@@ -43,6 +43,7 @@ class ControllerDesign:
     # acceleration the rotors can give from hover about the weakest of roll and pitch.
     design_tilt_rad: float = 0.2
     authority_cap: bool = True        # False: omega_a capped by the motors only
+    aerodynamic_stiffening: bool = True  # raise omega_a against the rotors' drag moments
     # Motors slower than the attitude loop needs get a lead on their speed command
     # (the first-order lag inverted, as an ESC's speed loop does) down to
     # fraction / omega_a; False flies the bare lag and caps omega_a by it instead.
@@ -148,6 +149,13 @@ class ControllerGains:
         tau_up = np.asarray(params.time_constant_up_s, dtype=float)
         tau_down = np.asarray(params.time_constant_down_s, dtype=float)
         omega_a, limited_by = design.attitude_natural_frequency_rad_s, "design"
+        # The rotors' drag and rolling moments tilt the body in proportion to its speed
+        # through the air; a loop too soft for them turns the position loop into a spiral
+        # (docs/hover-test.md, "Tuning"). Stiff enough: the cross-coupling they cause
+        # no faster than the position loop's damping.
+        omega_aero = aerodynamic_bandwidth_rad_s(params, pinv, design)
+        if design.aerodynamic_stiffening and omega_aero > omega_a:
+            omega_a, limited_by = omega_aero, "rotor drag"
         lead_up, lead_down = tau_up, tau_down
         if design.motor_lead and omega_a > 0:
             # Lead each lag down to what omega_a needs, by at most MAX_MOTOR_LEAD.
@@ -223,6 +231,34 @@ class ControllerGains:
 # than MAX_MOTOR_LEAD times what the attitude loop needs caps the loop instead.
 MAX_MOTOR_LEAD = 8.0
 MIN_ATTITUDE_BANDWIDTH_RAD_S = 1.0
+
+
+def aerodynamic_torque_per_speed(params: VehicleParams, allocation_pinv: np.ndarray) -> float:
+    """[N*m / (m/s)] The roll/pitch torque the rotors' drag (through its lever about the
+    COM) and rolling moments put on the body per m/s of horizontal airspeed at the hover
+    speeds (the plant's RotorS terms, sim.motor.drag_matrices): the 2-norm of that 2x2
+    block."""
+    from reedtool.sim.motor import drag_matrices
+
+    hover = allocation_pinv @ np.array([params.weight_N, 0.0, 0.0, 0.0])
+    omega = np.sqrt(np.clip(hover / params.motor_constant, 0.0, params.omega_max_rad_s ** 2))
+    K = drag_matrices(params.rotor_position_m, params.rotor_axis,
+                      params.rotor_drag_coefficient, params.rolling_moment_coefficient)
+    torque = np.einsum("ijn,n->ij", K[3:6, 0:3] + K[6:9, 0:3], omega)
+    return float(np.linalg.norm(torque[0:2, 0:2], 2))
+
+
+def aerodynamic_bandwidth_rad_s(params: VehicleParams, allocation_pinv: np.ndarray,
+                                design: ControllerDesign) -> float:
+    """The attitude bandwidth at which the drag moments' cross-coupling, g C / (J w_a^2)
+    (C the torque per speed above: tilt per m/s times g), equals the position loop's
+    damping kd = 3 ratio w_a: w_a = (g C / (3 ratio J))^(1/3), J the smaller of the
+    roll and pitch inertias."""
+    C = aerodynamic_torque_per_speed(params, allocation_pinv)
+    J = float(min(params.inertia_kg_m2[0, 0], params.inertia_kg_m2[1, 1]))
+    if not (C > 0 and J > 0):
+        return 0.0
+    return (params.g_m_s2 * C / (3.0 * design.position_to_attitude_ratio * J)) ** (1.0 / 3.0)
 
 
 def angular_authority_rad_s2(params: VehicleParams, allocation_pinv: np.ndarray) -> float:
