@@ -118,6 +118,18 @@ def recovered(run, config: HoverConfig) -> bool:
     return run.passed and run.longest_saturation_s < config.saturation_limit_s - 1e-9
 
 
+def batch_start_scale(found: HoverVerdict) -> float:
+    """The start the robustness batch flies, as a fraction of the test's: all of it when
+    the nominal vehicle flies it, its recoverable margin when marginal."""
+    if found.verdict is not Verdict.MARGINAL:
+        return 1.0
+    if found.start_tilt_deg:
+        return (found.recoverable_tilt_deg or 0.0) / found.start_tilt_deg
+    if found.start_offset_m:
+        return (found.recoverable_offset_m or 0.0) / found.start_offset_m
+    return 1.0
+
+
 def stabilisable(params: VehicleParams) -> tuple[bool, float]:
     """(ACAI > 0 with full rank, ACAI) of the vehicle about hover (physics.authority)."""
     from reedtool.physics.authority import authority
