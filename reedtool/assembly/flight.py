@@ -35,7 +35,8 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
                record: bool = False, progress: Progress | None = None,
                engine: str = "numpy", envelope: bool = False,
                max_memory_bytes: int = DEFAULT_MAX_MEMORY_MB * 1024 * 1024,
-               vehicle: Vehicle | None = None, requirement=None) -> dict:
+               vehicle: Vehicle | None = None, requirement=None,
+               auto_duration: bool = False) -> dict:
     """Trim, simulate and (optionally) batch one robot; the JSON-ready report.
 
     Keys: "model", "trim", "sim" (None when not flown), "batch" (None without samples),
@@ -97,6 +98,10 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
     from reedtool.sim.run import simulate_hover
 
     gains = ControllerGains.from_params(params)
+    if auto_duration:
+        # A slowly tuned vehicle (a heavy one, little authority) gets the time its
+        # position loop needs to settle, not a fixed 10 s.
+        config = judge.with_time_to_settle(config, gains)
     with progress.flying(f"flying {config.duration_s:g} s at {config.rate_hz:g} Hz"):
         run = simulate_hover(params, config, record=record, engine=engine, gains=gains)
         found = judge.judge_flight(

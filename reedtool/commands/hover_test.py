@@ -29,6 +29,7 @@ MAX_COM_SPREAD_M = 1.0
 # (`--duration 1e9`) that would keep the machine busy for days.
 MAX_STEPS = 10_000_000
 SCHEMA = "reedtool.hover-test/1"
+DEFAULT_DURATION_S = 10.0
 
 
 def _validation_json(errors, refused: bool) -> dict:
@@ -41,8 +42,9 @@ PROGRESS_AFTER_S = 2.0
 
 @click.command(name="hover-test")
 @model_arguments
-@click.option("--duration", "duration_s", type=float, default=10.0, show_default=True,
-              help="Simulated time [s].")
+@click.option("--duration", "duration_s", type=float, default=None,
+              help="Simulated time [s]. Default 10 s, longer when the vehicle's tuned "
+                   "position loop needs more to settle (the text and JSON say how long).")
 @click.option("--rate", "rate_hz", type=float, default=1000.0, show_default=True,
               help="Integration and control rate [Hz] (fixed step).")
 @click.option("--offset", "offset_m", type=float, nargs=3, default=(0.5, 0.0, 0.0),
@@ -116,6 +118,8 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
                             hint="e.g. --require stable, or --require margin:10") from exc
 
     check_plausible("rate", rate_hz, "--rate")
+    auto_duration = duration_s is None
+    duration_s = DEFAULT_DURATION_S if auto_duration else duration_s
     check_plausible("duration", duration_s, "--duration")
     for axis, value in zip("xyz", offset_m):
         check_plausible("offset", value, f"--offset {axis}", magnitude=True)
@@ -199,7 +203,8 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
                         progress=TerminalProgress() if fmt == "text" else None,
                         engine=engine, envelope=plot_path is not None,
                         max_memory_bytes=max_memory_mb * 1024 * 1024,
-                        vehicle=assembled.vehicle, requirement=requirement)
+                        vehicle=assembled.vehicle, requirement=requirement,
+                        auto_duration=auto_duration)
     batch = report.get("batch")
     if batch is not None:
         batch["min_pass_rate"] = min_pass_rate

@@ -118,6 +118,24 @@ def recovered(run, config: HoverConfig) -> bool:
     return run.passed and run.longest_saturation_s < config.saturation_limit_s - 1e-9
 
 
+# A position PID with a triple pole at w_p, started at rest from an offset, is within 10 %
+# of it (the 5 cm of a 0.5 m start) after w_p t = 5.3: (1 + x + x^2 / 2) e^-x = 0.1.
+SETTLE_BANDWIDTHS = 5.3
+SETTLE_MARGIN = 1.5          # for the attitude loop's lag and the saturated start
+MAX_AUTO_DURATION_S = 60.0
+
+
+def with_time_to_settle(config: HoverConfig, gains) -> HoverConfig:
+    """`config` with a duration long enough for the tuned position loop to settle and
+    hold: SETTLE_MARGIN * SETTLE_BANDWIDTHS / w_p + the hold time, rounded up to whole
+    seconds, never shorter than asked nor longer than MAX_AUTO_DURATION_S."""
+    need = SETTLE_MARGIN * SETTLE_BANDWIDTHS / gains.position_bandwidth_rad_s + config.hold_s
+    need = min(float(math.ceil(need)), MAX_AUTO_DURATION_S)
+    if need <= config.duration_s:
+        return config
+    return dataclasses.replace(config, duration_s=need)
+
+
 def batch_start_scale(found: HoverVerdict) -> float:
     """The start the robustness batch flies, as a fraction of the test's: all of it when
     the nominal vehicle flies it, its recoverable margin when marginal."""
