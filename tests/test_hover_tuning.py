@@ -8,6 +8,7 @@ and the project's reversible omnidirectional frame.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import re
@@ -268,9 +269,7 @@ def test_a_slowly_tuned_vehicle_gets_the_time_to_settle():
 
     # w_p = 0.5 rad/s: 1.5 * 5.3 / 0.5 + 1 s hold = 16.9 s -> 17 s
     gains = ControllerGains.from_params(symmetric_multirotor(4))
-    slow = type(gains).__new__(type(gains))
-    slow.__dict__.update(gains.__dict__)
-    object.__setattr__(slow, "position_bandwidth_rad_s", 0.5)
+    slow = dataclasses.replace(gains, position_bandwidth_rad_s=0.5)
     assert with_time_to_settle(HoverConfig(), slow).duration_s == 17.0
     # the 1.5 kg quad (w_p = 2 rad/s) keeps its 10 s; a longer run asked for stays
     assert with_time_to_settle(HoverConfig(), gains).duration_s == 10.0
