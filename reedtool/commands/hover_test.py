@@ -350,7 +350,9 @@ def render_text(report: dict) -> str:
                      f"{100 * batch['min_pass_rate']:.0f}%): {counts}")
         lines.append(f"  spreads: mass +-{100 * s['mass_rel']:g}%, COM +-{1000 * s['com_m']:g} mm, "
                      f"inertia +-{100 * s['inertia_rel']:g}%, motor constant "
-                     f"+-{100 * s['motor_constant_rel']:g}%; seed {batch['seed']}")
+                     f"+-{100 * s['motor_constant_rel']:g}%; seed {batch['seed']}"
+                     + (f"; from {batch['start_scale']:.3g} of the start (the recoverable margin)"
+                        if batch.get("start_scale", 1.0) != 1.0 else ""))
         for w in batch["worst"]:
             lines.append(f"  #{w['index']}: {w['status']}: {w['message']} "
                          f"(mass {w['mass_kg']:.4g} kg, COM shift "
