@@ -274,3 +274,10 @@ def test_a_slowly_tuned_vehicle_gets_the_time_to_settle():
     # the 1.5 kg quad (w_p = 2 rad/s) keeps its 10 s; a longer run asked for stays
     assert with_time_to_settle(HoverConfig(), gains).duration_s == 10.0
     assert with_time_to_settle(HoverConfig(duration_s=30.0), slow).duration_s == 30.0
+
+
+def test_margin_from_a_level_start_flies_the_required_tilt():
+    code, report = hover_json(TUNING / "racing_tw10.urdf", "--roll", "0", "--require",
+                              "margin:10", "--duration", "5")
+    assert code == 0 and report["verdict"]["recoverable_tilt_deg"] == pytest.approx(10)
+    assert report["verdict"]["flights"] == 1

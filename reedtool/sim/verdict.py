@@ -177,16 +177,21 @@ def judge_flight(params: VehicleParams, config: HoverConfig, run, fly,
         verdict = HoverVerdict(Verdict.FLIES, run.message, tilt0, offset0,
                                tilt0, offset0)
         if requirement.level == "margin" and requirement.margin_deg > tilt0 + 1e-9:
-            # The start did not ask that much: fly the required tilt itself.
-            scale = requirement.margin_deg / tilt0 if tilt0 > 0 else math.inf
-            if math.isfinite(scale):
-                flights += 1
-                if not recovered(fly(scaled_start(config, scale)), config):
-                    verdict.message += (f"; does not recover from the {requirement.margin_deg:g}"
-                                        " deg required")
-                else:
-                    verdict.recoverable_tilt_deg = requirement.margin_deg
-                    verdict.recoverable_offset_m = scale * offset0
+            # The start did not ask that much: fly the required tilt itself (the start
+            # scaled up to it, or rolled by it when the start is level).
+            if tilt0 > 0:
+                scale = requirement.margin_deg / tilt0
+                start = scaled_start(config, scale)
+            else:
+                scale = 1.0
+                start = dataclasses.replace(config, roll_rad=math.radians(requirement.margin_deg))
+            flights += 1
+            if not recovered(fly(start), config):
+                verdict.message += (f"; does not recover from the {requirement.margin_deg:g}"
+                                    " deg required")
+            else:
+                verdict.recoverable_tilt_deg = requirement.margin_deg
+                verdict.recoverable_offset_m = scale * offset0
         verdict.flights = flights
         return verdict
     lo, hi = 0.0, 1.0            # recovers at lo (trivially: the trim), not at hi
