@@ -171,6 +171,16 @@ def test_engines_agree_with_the_motor_lead():
         fast_batch = simulate_batch(params, config, engine="numba")
         np.testing.assert_allclose(fast_batch.final_omega_rad_s, batch.final_omega_rad_s,
                                    rtol=1e-9)
+        # several vehicles: the compiled block kernel's lead (_w_motors)
+        from reedtool.sim.batch import Spreads, perturbed_plant, sample_perturbations
+
+        plant = perturbed_plant(params, sample_perturbations(3, 4, Spreads(), 1))
+        ref = simulate_batch(params, config, plant)
+        got = simulate_batch(params, config, plant, engine="numba")
+        assert got.status_code.tolist() == ref.status_code.tolist()
+        np.testing.assert_allclose(got.final_omega_rad_s, ref.final_omega_rad_s, rtol=1e-9)
+        np.testing.assert_allclose(got.max_position_error_m, ref.max_position_error_m,
+                                   rtol=1e-9)
 
 
 # ------------------------------------------------------------------ passive joints
