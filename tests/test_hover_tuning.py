@@ -291,3 +291,16 @@ def test_margin_from_a_level_start_flies_the_required_tilt():
                               "margin:10", "--duration", "5")
     assert code == 0 and report["verdict"]["recoverable_tilt_deg"] == pytest.approx(10)
     assert report["verdict"]["flights"] == 1
+
+
+def test_a_tilt_rotor_frame_is_not_flown_and_says_why():
+    # Two rotors on servos a plugin drives: the fixed-axis allocation has rank 2, but the
+    # frame steers with the tilt. (validate's R305 still errors on it: --ignore-validation.)
+    code, report = hover_json(TUNING / "bicopter_servos.urdf", "--ignore-validation")
+    assert (code, report["status"], report["sim"]) == (0, "not-flown", None)
+    assert report["message"].startswith("tilt-rotor frame (rotor_0 on servo_0_joint, "
+                                         "rotor_1 on servo_1_joint")
+    assert report["trim"]["cause"] == "rank-deficient"
+    # the same frame with nothing driving the tilt cannot hover: still a failure
+    code, report = hover_json(TUNING / "bicopter_passive.urdf", "--ignore-validation")
+    assert (code, report["status"]) == (1, "cannot-hover")

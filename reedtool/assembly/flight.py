@@ -77,6 +77,13 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
         return report
 
     if not trim.feasible:
+        from reedtool.sim.rigid import tilting_joints
+
+        # Rotors on driven tilt joints get roll/pitch/yaw from the tilt: a fixed-axis
+        # trim that finds no torque balance says nothing about such a frame.
+        tilting = tilting_joints(robot, every_rotor)
+        if tilting and trim.cause is not None and trim.cause.value in judge.TILT_CAUSES:
+            return conclude(judge.tilt_rotor(trim.message, tilting))
         return conclude(judge.HoverVerdict(judge.Verdict.CANNOT_HOVER,
                                            f"no hover trim: {trim.message}"))
     if vehicle.omnidirectional:

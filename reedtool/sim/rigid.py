@@ -103,3 +103,23 @@ def describe(locked: list[LockedJoint], total_inertia_kg_m2) -> str:
                           f"{axis} {v:.3g} kg*m^2" for axis, v, t in zip("xyz", d, J))
         lines.append(f"{lj.name} ({lj.type}, {lj.mass_kg:.3g} kg beyond it): {share}")
     return "\n".join(lines)
+
+
+def tilting_joints(robot, rotors) -> list[tuple[str, str]]:
+    """(rotor, joint) for each rotor whose link rides on a moving joint that a plugin
+    drives (a tilt servo), other than its own spinning joint: a tilt-rotor frame, whose
+    attitude control uses the tilt that the fixed-axis trim and controller do not model."""
+    parent_joint = {j.child: j for j in robot.joints if j.child}
+    rotor_joints = {r.joint for r in rotors if r.joint}
+    named = _plugin_names(robot)
+    out = []
+    for rotor in rotors:
+        link, seen = rotor.link, set()
+        while link in parent_joint and link not in seen:
+            seen.add(link)
+            joint = parent_joint[link]
+            if joint.moves and joint.name not in rotor_joints and joint.name in named:
+                out.append((rotor.name, joint.name))
+                break
+            link = joint.parent
+    return out

@@ -226,6 +226,20 @@ def omnidirectional(trim_message: str) -> HoverVerdict:
         "trim above is what was checked (`reedtool validate` checks its allocation)")
 
 
+# Trim failures a tilt-rotor's servos resolve (thrust-to-weight is not one of them).
+TILT_CAUSES = ("rank-deficient", "yaw-unbalanced", "com-unbalanced")
+
+
+def tilt_rotor(trim_message: str, tilting: list[tuple[str, str]]) -> HoverVerdict:
+    pairs = ", ".join(f"{rotor} on {joint}" for rotor, joint in tilting)
+    return HoverVerdict(
+        Verdict.NOT_FLOWN,
+        f"tilt-rotor frame ({pairs}: a plugin drives the joint the rotor tilts on, a "
+        f"servo or swashplate); with the rotors fixed there is no hover trim "
+        f"({trim_message}), but its flight controller steers with the tilt, which "
+        "hover-test's fixed-axis trim and controller do not model")
+
+
 def tuning_line(gains: dict) -> str:
     """One line from ControllerGains.to_dict(): the bandwidths used and what limited them."""
     lead = ""
