@@ -1,4 +1,5 @@
-"""Passive joints flown rigid: which joints hover-test locks, and what that adds.
+"""The model's moving joints against the rigid-body flight: passive joints flown locked
+(which, and what that adds), and rotors that tilt on driven joints (a tilt-rotor frame).
 
 The hover simulation is one rigid body. A model may have joints that move in Gazebo but
 that no plugin drives: a pendulum, an unactuated gimbal, a manipulator's arms. They are
