@@ -5,9 +5,10 @@ Position: a PID on the position error whose closed loop has a triple pole at
 offset a mis-estimated mass or thrust constant would leave (the robustness batch flies
 perturbed vehicles on the nominal controller). Attitude: Lee, Leok and McClamroch (2010),
 tau = -J (kR e_R + kw e_w) + w x J w with kR = omega_a^2, kw = 2 zeta omega_a, so the
-torque scales with the model's full inertia tensor. The natural frequencies are chosen
-once for every model; the only model-dependent cap is the motor lag, which an attitude
-loop faster than about a third of the motors' bandwidth would fight. Allocation: the
+torque scales with the model's full inertia tensor. The bandwidths follow from the
+vehicle (ControllerGains.from_params; docs/hover-test.md, "Tuning"): 12 rad/s, raised
+against the rotors' drag moments, capped by the torque authority for the design tilt and
+by the motors' lag (which a lead on their speed command shortens). Allocation: the
 pseudo-inverse of the nominal allocation matrix.
 
 `control` is the batched law used by the batch engine (columns are vehicles); the
@@ -156,6 +157,13 @@ class ControllerGains:
         omega_aero = aerodynamic_bandwidth_rad_s(params, pinv, design)
         if design.aerodynamic_stiffening and omega_aero > omega_a:
             omega_a, limited_by = omega_aero, "rotor drag"
+        alpha = angular_authority_rad_s2(params, pinv)
+        omega_auth = math.sqrt(max(alpha, 0.0) / design.design_tilt_rad)
+        if design.authority_cap and omega_auth < omega_a:
+            # A vehicle with no authority at all is not flown (sim.verdict); the floor
+            # only keeps the gains finite for the flights that do happen (a rotor failure).
+            omega_a, limited_by = max(omega_auth, MIN_ATTITUDE_BANDWIDTH_RAD_S), \
+                "torque authority"
         lead_up, lead_down = tau_up, tau_down
         if design.motor_lead and omega_a > 0:
             # Lead each lag down to what omega_a needs, by at most MAX_MOTOR_LEAD.
@@ -165,13 +173,6 @@ class ControllerGains:
         tau_motor_s = float(np.max(np.maximum(lead_up, lead_down))) if len(tau_up) else 0.0
         if tau_motor_s > 0 and design.motor_bandwidth_fraction / tau_motor_s < omega_a:
             omega_a, limited_by = design.motor_bandwidth_fraction / tau_motor_s, "motor lag"
-        alpha = angular_authority_rad_s2(params, pinv)
-        omega_auth = math.sqrt(max(alpha, 0.0) / design.design_tilt_rad)
-        if design.authority_cap and omega_auth < omega_a:
-            # A vehicle with no authority at all is not flown (hover_verdict); the floor
-            # only keeps the gains finite for the flights that do happen (a rotor failure).
-            omega_a, limited_by = max(omega_auth, MIN_ATTITUDE_BANDWIDTH_RAD_S), \
-                "torque authority"
         omega_p = design.position_to_attitude_ratio * omega_a
         g = params.g_m_s2
         ki = omega_p ** 3
