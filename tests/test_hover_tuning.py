@@ -301,6 +301,22 @@ def test_a_tilt_rotor_frame_is_not_flown_and_says_why():
     assert report["message"].startswith("tilt-rotor frame (rotor_0 on servo_0_joint, "
                                          "rotor_1 on servo_1_joint")
     assert report["trim"]["cause"] == "rank-deficient"
+    # rotors pointing forward at zero tilt: no thrust upward, but the servos tilt them up
+    # (their 2 x 6.0 N at full speed exceed the 9.4 N weight)
+    code, report = hover_json(TUNING / "bicopter_sideways.urdf", "--ignore-validation")
+    assert (code, report["status"], report["trim"]["cause"]) == (0, "not-flown",
+                                                                  "insufficient-thrust")
     # the same frame with nothing driving the tilt cannot hover: still a failure
     code, report = hover_json(TUNING / "bicopter_passive.urdf", "--ignore-validation")
+    assert (code, report["status"]) == (1, "cannot-hover")
+
+
+def test_a_tilt_rotor_frame_too_weak_for_its_weight_still_fails(tmp_path):
+    # A tenth of the motor constant: 2 x 0.60 N at full speed for 9.4 N of weight, however
+    # the servos point them.
+    text = (TUNING / "bicopter_sideways.urdf").read_text()
+    weak = tmp_path / "weak.urdf"
+    weak.write_text(text.replace("<motorConstant>8.54858e-06</motorConstant>",
+                                 "<motorConstant>8.54858e-07</motorConstant>"))
+    code, report = hover_json(weak, "--ignore-validation")
     assert (code, report["status"]) == (1, "cannot-hover")

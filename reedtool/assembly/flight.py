@@ -77,12 +77,18 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
         return report
 
     if not trim.feasible:
+        from reedtool.sim.params import STANDARD_GRAVITY_M_S2
         from reedtool.sim.rigid import tilting_joints
 
         # Rotors on driven tilt joints get roll/pitch/yaw from the tilt: a fixed-axis
         # trim that finds no torque balance says nothing about such a frame.
         tilting = tilting_joints(robot, every_rotor)
-        if tilting and trim.cause is not None and trim.cause.value in judge.TILT_CAUSES:
+        # Their tilt can also turn the thrust upward: only all of it at full speed falling
+        # short of the weight (thrust-to-weight < 1 along any axis) still fails.
+        lift_N = sum(r.max_thrust_N for r in every_rotor)
+        if tilting and trim.cause is not None and (
+                trim.cause.value in judge.TILT_CAUSES
+                or (trim.cause.value == "insufficient-thrust" and lift_N >= props.mass_kg * STANDARD_GRAVITY_M_S2)):
             return conclude(judge.tilt_rotor(trim.message, tilting))
         return conclude(judge.HoverVerdict(judge.Verdict.CANNOT_HOVER,
                                            f"no hover trim: {trim.message}"))

@@ -226,8 +226,9 @@ def omnidirectional(trim_message: str) -> HoverVerdict:
         "trim above is what was checked (`reedtool validate` checks its allocation)")
 
 
-# Trim failures a tilt-rotor's servos resolve (thrust-to-weight is not one of them).
-TILT_CAUSES = ("rank-deficient", "yaw-unbalanced", "com-unbalanced")
+# Trim failures a tilt-rotor's servos resolve (thrust-to-weight is not one of them);
+# "no-rotors" here is a frame whose only rotors point sideways at zero tilt (skycat).
+TILT_CAUSES = ("rank-deficient", "yaw-unbalanced", "com-unbalanced", "no-rotors")
 
 
 def tilt_rotor(trim_message: str, tilting: list[tuple[str, str]]) -> HoverVerdict:
