@@ -1,0 +1,108 @@
+"""`reedtool view`: the model in 3-D as Gazebo would place it, as GLB, PNG or HTML."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from reedtool.commands.params import model_arguments
+from reedtool.errors import ReedtoolError
+
+FORMATS = (".glb", ".png", ".html")
+
+
+def output_format(path: Path) -> str:
+    suffix = path.suffix.lower()
+    if suffix not in FORMATS:
+        raise ReedtoolError(f"cannot tell the output format from '{path.suffix or path.name}'",
+                            file=path, hint="name the output .glb, .png or .html")
+    return suffix[1:]
+
+
+def _findings(model: Path, robot) -> list:
+    """What `validate` reports for the loaded robot (its config's selection and
+    suppressions), every severity."""
+    from reedtool.checks.runner import apply_suppressions, parse_selectors, run_checks
+    from reedtool.commands.validate import selection_for
+    from reedtool.config import load_config
+
+    config = load_config(model)
+    origin = str(config.path) if config.path else "config"
+    kept, _ = apply_suppressions(
+        run_checks(robot, selection_for(config)),
+        lambda file: parse_selectors(config.ignores_for(file or model), origin=origin))
+    return kept
+
+
+@click.command("view")
+@model_arguments
+@click.option("--launch", "launch_file", type=click.Path(path_type=Path, dir_okay=False),
+              metavar="FILE", help="Read the model's xacro arguments (and the model, when "
+                                   "MODEL is '-') from a roslaunch or ROS 2 launch file.")
+@click.option("-o", "--output", "output", type=click.Path(path_type=Path, dir_okay=False),
+              required=True, help="File to write: .glb (glTF), .png (picture) or .html (page).")
+@click.option("--collision", is_flag=True, help="Show the collision geometry, not the visuals.")
+@click.option("--findings", "show_findings", is_flag=True,
+              help="Colour the links validate's findings name, by severity.")
+@click.option("--force", is_flag=True, help="Overwrite an existing output file.")
+def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
+            model_name: str | None, launch_file: Path | None, output: Path, collision: bool,
+            show_findings: bool, force: bool) -> int:
+    """Show MODEL in 3-D: links where Gazebo puts them, rotor discs coloured by spin
+    (blue ccw, orange cw), thrust axes, COM, base axes, a scale bar.
+
+    .glb opens in any glTF viewer (Blender, VS Code, browsers); .png is an offline render
+    for CI and READMEs; .html is one page showing the GLB (it loads the model-viewer
+    script from the network).
+    """
+    from reedtool.io.fileio import atomic_write_bytes, check_writable
+    from reedtool.io.mappings import parse_mappings
+
+    fmt = output_format(output)
+    check_writable(output, force)         # a device, FIFO or existing file is refused here
+    arguments: dict[str, str] = {}
+    if launch_file is not None:
+        from reedtool.io.launch import read_launch
+
+        call = read_launch(launch_file, package_paths=list(package_paths))
+        arguments.update(call.mappings)
+        if str(model) == "-":
+            if call.model is None:
+                raise ReedtoolError("the launch file's xacro call names no model reedtool "
+                                    "can evaluate", file=launch_file,
+                                    hint="pass the model path instead of '-'")
+            model = Path(call.model)
+    if not model.is_file():
+        raise ReedtoolError("model file not found", file=model,
+                            hint="pass the path of a .urdf, .xacro or .sdf file")
+    arguments.update(parse_mappings(mappings))
+
+    from reedtool.io.loader import load_robot
+    from reedtool.report.scene import build_scene
+
+    robot = load_robot(model, arguments, list(package_paths), model_name=model_name)
+    findings = _findings(model, robot) if show_findings else None
+    view = build_scene(robot, collision=collision, findings=findings)
+    title = f"{robot.name} ({'collision' if collision else 'visual'} geometry)"
+    if fmt == "glb":
+        from reedtool.report.scene import glb_bytes
+
+        data = glb_bytes(view)
+    elif fmt == "png":
+        from reedtool.report.render_png import render_png
+
+        data = render_png(view, title)
+    else:
+        from reedtool.report.html_viewer import render_html
+
+        data = render_html(view, title).encode("utf-8")
+    atomic_write_bytes(output, data, force=force)
+    for note in view.notes:
+        click.echo(f"note: {note}", err=True)
+    if findings is not None:
+        named = len(view.link_severity)
+        click.echo(f"{len(findings)} findings, {named} links coloured"
+                   + ("" if not findings else " (run `reedtool validate` for the messages)"))
+    click.echo(f"wrote {output}: {view.framing.caption()}")
+    return 0
