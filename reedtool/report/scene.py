@@ -167,7 +167,8 @@ def _yourdfpy_scene(robot, collision: bool, notes: list[str]):
     urdf = yourdfpy.URDF.load(io.BytesIO(robot.urdf_xml.encode("utf-8")),
                               build_scene_graph=not collision, load_meshes=False,
                               build_collision_scene_graph=collision,
-                              load_collision_meshes=False, filename_handler=filename_handler)
+                              load_collision_meshes=False, force_collision_mesh=False,
+                              filename_handler=filename_handler)
     built = urdf.collision_scene if collision else urdf.scene
     scene = trimesh.Scene(base_frame=ROOT_NODE)
     scene.graph.update(frame_from=ROOT_NODE, frame_to=urdf.base_link, matrix=T_GLTF_ROS)
@@ -248,9 +249,11 @@ def _reedtool_scene(robot, collision: bool, notes: list[str]):
     base = robot.base_link
     scene = trimesh.Scene(base_frame=ROOT_NODE)
     scene.graph.update(frame_from=ROOT_NODE, frame_to=base, matrix=T_GLTF_ROS)
-    for joint in robot.joints:
+    placed = {base}
+    for joint in robot.joints:         # the first joint to a child, as link_poses keeps it
         if joint.child in T_base_link and joint.parent in T_base_link \
-                and joint.child != base and not scene.graph.transforms.has_node(joint.child):
+                and joint.child not in placed:
+            placed.add(joint.child)
             scene.graph.update(frame_from=joint.parent, frame_to=joint.child,
                                matrix=joint.T_parent_joint)
     for link in robot.links:
