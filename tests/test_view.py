@@ -335,3 +335,18 @@ def test_view_help_imports_no_heavy_library():
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                             check=True)
     assert result.stdout.strip().splitlines()[-1] == "[]"
+
+
+def test_spin_arrow_turns_the_way_the_rotor_spins():
+    """The arc starts at 150 degrees and sweeps 240 in the spin's sense about the thrust
+    axis: its head ends near 150 + 240 = 30 degrees for ccw, 150 - 240 = -90 for cw."""
+    import math
+
+    view = build_scene(load_robot(GZ / "x3_quad.urdf"))
+    for disc in view.discs:
+        arrow = view.scene.geometry[view.scene.graph[f"spin_arrow/{disc.name}"][1]]
+        head = np.asarray(arrow.vertices)[-3:].mean(axis=0)     # the head's three corners
+        angle = math.degrees(math.atan2(head[1], head[0]))
+        expected = 30.0 if disc.turning_sign > 0 else -90.0
+        # the head reaches 0.28 r past the arc's end along the tangent: a few degrees on
+        assert abs((angle - expected + 180.0) % 360.0 - 180.0) < 15.0, disc.name

@@ -80,14 +80,22 @@ def render_png(view: ViewScene, title: str) -> bytes:
         shaded = _shaded(triangles, colours, view_dir)
         # edges in the face colour close the anti-aliasing seams between triangles
         ax.add_collection3d(Poly3DCollection(triangles, facecolors=shaded, edgecolors=shaded,
-                                             linewidths=0.3))
+                                             linewidths=0.3, zorder=1))
         low, high = triangles.reshape(-1, 3).min(axis=0), triangles.reshape(-1, 3).max(axis=0)
     else:
         low, high = view.framing.bounds_m
-    centre, half = (low + high) / 2.0, max(float(np.max(high - low)) / 2.0, 1e-9)
-    for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):
-        setter(c - half, c + half)
-    ax.set_box_aspect((1.0, 1.0, 1.0))
+    # one scale on all three axes, each axis no shorter than 30 % of the longest, so a
+    # flat multirotor is not lost in an empty cube
+    centre = (low + high) / 2.0
+    halves = np.maximum((high - low) / 2.0, 0.3 * max(float(np.max(high - low)) / 2.0, 1e-9))
+    for setter, c, h in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre, halves):
+        setter(c - h, c + h)
+    if view.com_m is not None:
+        # drawn over the meshes: the COM usually sits inside the body
+        ax.computed_zorder = False
+        ax.scatter(*view.com_m, marker="x", s=80, linewidths=2.5, color="black", zorder=9,
+                   depthshade=False)
+    ax.set_box_aspect(tuple(halves), zoom=1.05)
     ax.view_init(elev=VIEW_ELEVATION_DEG, azim=VIEW_AZIMUTH_DEG)
     ax.set_xlabel("x [m]", fontsize=8)
     ax.set_ylabel("y [m]", fontsize=8)
@@ -96,9 +104,9 @@ def render_png(view: ViewScene, title: str) -> bytes:
     framing = view.framing
     bar_at = framing.bounds_m[0] + [framing.scale_bar_m / 2.0,
                                     -0.05 * float(np.max(framing.extent_m)), 0.0]
-    ax.text(bar_at[0], bar_at[1] - 0.06 * float(np.max(framing.extent_m)), bar_at[2],
+    ax.text(bar_at[0], bar_at[1], bar_at[2] + 0.03 * float(np.max(framing.extent_m)),
             length_text(framing.scale_bar_m), fontsize=9, fontweight="bold", ha="center",
-            va="top", zorder=10)
+            va="bottom", zorder=10)
     ax.set_title(title, fontsize=10)
     notes = [framing.caption()]
     if stride > 1:
