@@ -350,3 +350,13 @@ def test_spin_arrow_turns_the_way_the_rotor_spins():
         expected = 30.0 if disc.turning_sign > 0 else -90.0
         # the head reaches 0.28 r past the arc's end along the tangent: a few degrees on
         assert abs((angle - expected + 180.0) % 360.0 - 180.0) < 15.0, disc.name
+
+
+def test_docs_show_the_pictures_they_link_and_keep_them_small():
+    doc = ROOT / "docs" / "view.md"
+    links = re.findall(r"!\[[^\]]*\]\(([^)]+\.png)\)", doc.read_text())
+    assert len(links) >= 2
+    for link in links:
+        picture = doc.parent / link
+        assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", link
+        assert picture.stat().st_size < 200_000, link
