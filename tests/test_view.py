@@ -360,3 +360,19 @@ def test_docs_show_the_pictures_they_link_and_keep_them_small():
         picture = doc.parent / link
         assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", link
         assert picture.stat().st_size < 200_000, link
+
+
+def test_meshes_are_sized_as_gazebo_sizes_them_collada_unit_and_scale(tmp_path):
+    """A COLLADA box of 30 x 20 x 10 units with <unit meter="0.01"> (centimetres) and a
+    <mesh scale="2 1 1">: Gazebo shows 0.6 x 0.2 x 0.1 m. trimesh alone keeps the unit as
+    metadata and would show 60 x 20 x 10."""
+    from mesh_helpers import box_triangles, write_dae
+
+    write_dae(tmp_path / "body.dae", box_triangles([30.0, 20.0, 10.0]), meter=0.01)
+    model = tmp_path / "r.urdf"
+    model.write_text('<robot name="r"><link name="base"><visual><geometry>'
+                     '<mesh filename="body.dae" scale="2 1 1"/></geometry></visual></link>'
+                     '</robot>')
+    view = build_scene(load_robot(model))
+    # decimal text through float64 and one multiplication by 0.01: ~1e-16 relative
+    assert np.allclose(view.framing.extent_m, [0.6, 0.2, 0.1], rtol=1e-12, atol=0)
