@@ -376,3 +376,17 @@ def test_meshes_are_sized_as_gazebo_sizes_them_collada_unit_and_scale(tmp_path):
     view = build_scene(load_robot(model))
     # decimal text through float64 and one multiplication by 0.01: ~1e-16 relative
     assert np.allclose(view.framing.extent_m, [0.6, 0.2, 0.1], rtol=1e-12, atol=0)
+
+
+def test_a_urdf_yourdfpy_cannot_read_is_drawn_from_reedtools_reading():
+    # 'one' is not a number: yourdfpy stops there, reedtool records it and reads on
+    view = build_scene(load_robot(ROOT / "tests/fixtures/core/broken_numbers.urdf"))
+    assert view.source == "reedtool"
+    assert any("yourdfpy cannot read this URDF" in note for note in view.notes)
+
+
+def test_a_file_without_links_is_one_line_exit_2(tmp_path):
+    model = tmp_path / "macros.urdf"
+    model.write_text('<robot name="parts"/>')
+    code, text = run_cli("view", model, "-o", tmp_path / "m.png")
+    assert code == 2 and "no links" in text and not (tmp_path / "m.png").exists()

@@ -25,6 +25,8 @@ viewers show the robot standing.
 
 from __future__ import annotations
 
+import contextlib
+import logging
 import math
 from dataclasses import dataclass, field
 
@@ -42,6 +44,8 @@ SPIN_RGBA = {1: (31, 119, 180, 255), -1: (230, 126, 34, 255), 0: (127, 127, 127,
 SEVERITY_RGBA = {"error": (214, 39, 40, 255), "warning": (255, 191, 0, 255),
                  "info": (23, 190, 207, 255)}
 DEFAULT_RGBA = (178, 178, 178, 255)
+# What yourdfpy raises on a URDF it cannot read (a bad number, a missing attribute).
+YOURDFPY_ERRORS = (ValueError, TypeError, KeyError, AttributeError, IndexError)
 DECORATION_PREFIXES = ("rotor_disc/", "spin_arrow/", "thrust_axis/", "com", "base_axes/",
                        "scale_bar")
 
@@ -164,11 +168,19 @@ def _yourdfpy_scene(robot, collision: bool, notes: list[str]):
         path = paths.get(fname)
         return str(path) if path is not None else fname
 
-    urdf = yourdfpy.URDF.load(io.BytesIO(robot.urdf_xml.encode("utf-8")),
-                              build_scene_graph=not collision, load_meshes=False,
-                              build_collision_scene_graph=collision,
-                              load_collision_meshes=False, force_collision_mesh=False,
-                              filename_handler=filename_handler)
+    with _quiet(yourdfpy.urdf._logger):
+        urdf = yourdfpy.URDF.load(io.BytesIO(robot.urdf_xml.encode("utf-8")),
+                                  build_scene_graph=not collision, load_meshes=False,
+                                  build_collision_scene_graph=collision,
+                                  load_collision_meshes=False, force_collision_mesh=False,
+                                  filename_handler=filename_handler)
+    from reedtool.physics.kinematics import link_poses
+
+    connected = link_poses(robot)
+    for link in robot.links:
+        if link.name not in connected:
+            notes.append(f"link '{link.name}' is not connected to '{urdf.base_link}': "
+                         f"yourdfpy draws it at the base frame")
     built = urdf.collision_scene if collision else urdf.scene
     scene = trimesh.Scene(base_frame=ROOT_NODE)
     scene.graph.update(frame_from=ROOT_NODE, frame_to=urdf.base_link, matrix=T_GLTF_ROS)
@@ -216,6 +228,17 @@ def _yourdfpy_scene(robot, collision: bool, notes: list[str]):
                                                             collision_geometry=collision))
                    for link in urdf.robot.links}
     return scene, urdf.base_link, T_base_link
+
+
+@contextlib.contextmanager
+def _quiet(logger):
+    """yourdfpy logs what it works around; reedtool reports it as notes instead."""
+    level = logger.level
+    logger.setLevel(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        logger.setLevel(level)
 
 
 def _has_own_colour(mesh) -> bool:
@@ -509,11 +532,27 @@ def robot_bounds(scene, exclude=DECORATION_PREFIXES) -> np.ndarray | None:
 def build_scene(robot, *, collision: bool = False, findings=None,
                 com_m: np.ndarray | None = None) -> ViewScene:
     """`robot` as a ViewScene: URDF/xacro through yourdfpy, SDF through reedtool's reader."""
+    from reedtool.errors import ReedtoolError
+
     notes: list[str] = []
+    if not robot.links:
+        raise ReedtoolError("the model has no links: nothing to show", file=robot.source_file,
+                            hint="pass the top-level model, not a file of macros it includes")
+    if not robot.root_links():
+        raise ReedtoolError("no root link: every link is some joint's child, so nothing "
+                            "says where the robot is", file=robot.source_file,
+                            hint="run `reedtool validate` on the model; it names the loop")
+    scene = None
     if robot.source_format == "urdf" and robot.urdf_xml:
-        scene, base, T_base_link = _yourdfpy_scene(robot, collision, notes)
-        source = "yourdfpy"
-    else:
+        try:
+            scene, base, T_base_link = _yourdfpy_scene(robot, collision, notes)
+            source = "yourdfpy"
+        except YOURDFPY_ERRORS as exc:
+            # reedtool records content errors and reads on; yourdfpy stops at the first
+            notes.append(f"yourdfpy cannot read this URDF ({type(exc).__name__}: {exc}): "
+                         f"drawn from reedtool's reading; `reedtool validate` names the "
+                         f"problem")
+    if scene is None:
         scene, base, T_base_link = _reedtool_scene(robot, collision, notes)
         source = "reedtool"
     bounds = robot_bounds(scene)
@@ -539,7 +578,7 @@ def _com_m(robot) -> np.ndarray | None:
 
     try:
         props = whole_robot(robot)
-    except (ValueError, ZeroDivisionError):
+    except (ValueError, KeyError, ZeroDivisionError):   # a broken tree: validate says why
         return None
     com = np.asarray(props.com_m, dtype=float)
     return com if props.mass_kg > 0 and np.all(np.isfinite(com)) else None
