@@ -28,8 +28,8 @@ from lxml import etree
 from cli_helpers import run_cli
 from reedtool.io.loader import load_robot
 from reedtool.physics.kinematics import link_poses
-from reedtool.report.scene import (DECORATION_PREFIXES, SEVERITY_RGBA, build_scene, glb_bytes,
-                                   nice_length)
+from reedtool.assembly.view import view_robot
+from reedtool.report.scene import DECORATION_PREFIXES, SEVERITY_RGBA, glb_bytes, nice_length
 
 ROOT = Path(__file__).resolve().parents[1]
 SEED_QUAD = ROOT / "examples/reed_quad_x/urdf/mav_generic_odometry_sensor.gazebo"
@@ -66,7 +66,7 @@ def seed_quad():
 def test_glb_has_one_node_per_link_at_reedtools_link_pose(model):
     robot = load_robot(model)
     T_base = link_poses(robot)
-    read = _read_glb(glb_bytes(build_scene(robot)))
+    read = _read_glb(glb_bytes(view_robot(robot)))
     nodes = list(read.graph.nodes)
     for link in robot.links:
         assert nodes.count(link.name) == 1, link.name
@@ -79,7 +79,7 @@ def test_glb_has_one_node_per_link_at_reedtools_link_pose(model):
 
 
 def test_glb_root_turns_ros_z_up_into_gltf_y_up(seed_quad):
-    read = _read_glb(glb_bytes(build_scene(seed_quad)))
+    read = _read_glb(glb_bytes(view_robot(seed_quad)))
     T_world_base = read.graph.get(seed_quad.base_link)[0]
     # base z (up) is glTF +y, base x (forward) stays +x
     assert np.allclose(T_world_base[:3, :3] @ [0, 0, 1], [0, 1, 0], atol=1e-15)
@@ -93,7 +93,7 @@ def test_a_disc_at_each_rotor_coloured_by_its_spin(model):
     robot = load_robot(model)
     spins = _expected_spins(robot.urdf_xml)
     assert sorted(set(spins.values())) == sorted({CCW_RGB, CW_RGB})   # both spins present
-    view = build_scene(robot)
+    view = view_robot(robot)
     read = _read_glb(glb_bytes(view))
     T_base = link_poses(robot)
     rotors = discover_rotors(robot)
@@ -110,8 +110,8 @@ def test_a_disc_at_each_rotor_coloured_by_its_spin(model):
 
 
 def test_sdf_and_urdf_of_one_robot_give_the_same_scene():
-    urdf = build_scene(load_robot(GZ / "x3_quad.urdf"))
-    sdf = build_scene(load_robot(GZ / "x3_quad.sdf"))
+    urdf = view_robot(load_robot(GZ / "x3_quad.urdf"))
+    sdf = view_robot(load_robot(GZ / "x3_quad.sdf"))
     assert (urdf.source, sdf.source) == ("yourdfpy", "reedtool")
     assert urdf.base_link == sdf.base_link
     assert sorted(urdf.T_base_link) == sorted(sdf.T_base_link)
@@ -168,9 +168,10 @@ def test_the_urdf_path_goes_through_yourdfpy_and_the_sdf_path_does_not(monkeypat
         return real_load(*args, **kwargs)
 
     monkeypatch.setattr(yourdfpy.URDF, "load", staticmethod(spy))
-    build_scene(load_robot(SEED_QUAD))
+    # view_robot -> report.scene.build_scene -> yourdfpy on the URDF path
+    view_robot(load_robot(SEED_QUAD))
     assert len(calls) == 1 and callable(calls[0])
-    build_scene(load_robot(GZ / "x3_quad.sdf"))
+    view_robot(load_robot(GZ / "x3_quad.sdf"))
     assert len(calls) == 1
 
 
@@ -184,7 +185,7 @@ def test_yourdfpy_filename_handler_resolves_package_uris_with_reedtools_packages
     model.parent.mkdir()
     model.write_text("""<robot name="r"><link name="base"><visual><geometry>
       <mesh filename="package://my_pkg/meshes/body.stl"/></geometry></visual></link></robot>""")
-    view = build_scene(load_robot(model, package_paths=[pkg]))
+    view = view_robot(load_robot(model, package_paths=[pkg]))
     assert view.notes == []
     assert np.allclose(view.framing.extent_m, [0.3, 0.2, 0.1], atol=1e-12)
 
@@ -193,7 +194,7 @@ def test_x3_framing_matches_its_hand_derived_extent():
     # box 0.47 x 0.47 x 0.11 about the origin; rotor discs of radius 0.1 at (+-0.13, +-0.22):
     # x: max(0.235, 0.13 + 0.1) = 0.235; y: 0.22 + 0.1 = 0.32; z: the box's 0.055.
     # trimesh's 32-section cylinder has vertices at 0 and 90 degrees, so the extent is exact.
-    view = build_scene(load_robot(GZ / "x3_quad.urdf"))
+    view = view_robot(load_robot(GZ / "x3_quad.urdf"))
     assert np.allclose(view.framing.bounds_m, [[-0.235, -0.32, -0.055], [0.235, 0.32, 0.055]],
                        atol=1e-12)
     assert view.framing.scale_bar_m == pytest.approx(0.1, rel=1e-15)   # 0.64 / 4 -> 0.1
@@ -208,7 +209,7 @@ def test_scale_bar_is_a_1_2_5_length_not_above_the_quarter_extent(length, bar):
 def test_scale_bar_of_the_seed_quad_and_its_millimetre_mesh_differ_by_1000(tmp_path, seed_quad):
     """The seed quad's own geometry exported as one STL in millimetres (no <mesh scale>):
     the mistake the picture must make obvious."""
-    quad = build_scene(seed_quad)
+    quad = view_robot(seed_quad)
     read = _read_glb(glb_bytes(quad))
     parts = []
     for node in read.graph.nodes_geometry:
@@ -230,7 +231,7 @@ def test_scale_bar_of_the_seed_quad_and_its_millimetre_mesh_differ_by_1000(tmp_p
     bar_a = float(re.search(r"scale bar ([0-9.e+-]+) m", out_a).group(1))
     bar_b = float(re.search(r"scale bar ([0-9.e+-]+) m", out_b).group(1))
     assert (bar_a, bar_b) == (0.1, 100.0)
-    mm = build_scene(load_robot(tmp_path / "quad_mm.urdf"))
+    mm = view_robot(load_robot(tmp_path / "quad_mm.urdf"))
     # STL stores float32: the corners agree to float32's 6e-8 relative, the bar exactly
     assert np.allclose(mm.framing.bounds_m, 1000.0 * quad.framing.bounds_m, rtol=1e-6)
     assert mm.framing.scale_bar_m / quad.framing.scale_bar_m == pytest.approx(1000.0, rel=1e-12)
@@ -342,7 +343,7 @@ def test_spin_arrow_turns_the_way_the_rotor_spins():
     axis: its head ends near 150 + 240 = 30 degrees for ccw, 150 - 240 = -90 for cw."""
     import math
 
-    view = build_scene(load_robot(GZ / "x3_quad.urdf"))
+    view = view_robot(load_robot(GZ / "x3_quad.urdf"))
     for disc in view.discs:
         arrow = view.scene.geometry[view.scene.graph[f"spin_arrow/{disc.name}"][1]]
         head = np.asarray(arrow.vertices)[-3:].mean(axis=0)     # the head's three corners
@@ -373,14 +374,14 @@ def test_meshes_are_sized_as_gazebo_sizes_them_collada_unit_and_scale(tmp_path):
     model.write_text('<robot name="r"><link name="base"><visual><geometry>'
                      '<mesh filename="body.dae" scale="2 1 1"/></geometry></visual></link>'
                      '</robot>')
-    view = build_scene(load_robot(model))
+    view = view_robot(load_robot(model))
     # decimal text through float64 and one multiplication by 0.01: ~1e-16 relative
     assert np.allclose(view.framing.extent_m, [0.6, 0.2, 0.1], rtol=1e-12, atol=0)
 
 
 def test_a_urdf_yourdfpy_cannot_read_is_drawn_from_reedtools_reading():
     # 'one' is not a number: yourdfpy stops there, reedtool records it and reads on
-    view = build_scene(load_robot(ROOT / "tests/fixtures/core/broken_numbers.urdf"))
+    view = view_robot(load_robot(ROOT / "tests/fixtures/core/broken_numbers.urdf"))
     assert view.source == "reedtool"
     assert any("yourdfpy cannot read this URDF" in note for note in view.notes)
 

@@ -90,13 +90,19 @@ def check_model_path(model: Path, request: ModelRequest, *, controllers=(),
     return out
 
 
-def validation_errors(model: Path, robot) -> list:
-    """The error findings `validate` reports for an already loaded robot (its config's
-    selection, severities and suppressions): what hover-test refuses to fly."""
+def validation_findings(model: Path, robot) -> list:
+    """The findings `validate` reports for an already loaded robot (its config's
+    selection, severities and suppressions), every severity."""
     from reedtool.checks.runner import apply_suppressions, run_checks
     from reedtool.config import load_config
 
     config = load_config(model)
     findings = run_checks(robot, selection_for(config))
     kept, _ = apply_suppressions(findings, _ignores_for(config, model))
-    return [f for f in kept if f.severity == "error"]
+    return kept
+
+
+def validation_errors(model: Path, robot) -> list:
+    """The error findings `validate` reports for an already loaded robot: what hover-test
+    refuses to fly."""
+    return [f for f in validation_findings(model, robot) if f.severity == "error"]

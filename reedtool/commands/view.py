@@ -20,21 +20,6 @@ def output_format(path: Path) -> str:
     return suffix[1:]
 
 
-def _findings(model: Path, robot) -> list:
-    """What `validate` reports for the loaded robot (its config's selection and
-    suppressions), every severity."""
-    from reedtool.checks.runner import apply_suppressions, parse_selectors, run_checks
-    from reedtool.commands.validate import selection_for
-    from reedtool.config import load_config
-
-    config = load_config(model)
-    origin = str(config.path) if config.path else "config"
-    kept, _ = apply_suppressions(
-        run_checks(robot, selection_for(config)),
-        lambda file: parse_selectors(config.ignores_for(file or model), origin=origin))
-    return kept
-
-
 @click.command("view")
 @model_arguments
 @click.option("--launch", "launch_file", type=click.Path(path_type=Path, dir_okay=False),
@@ -56,35 +41,33 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     for CI and READMEs; .html is one page showing the GLB (it loads the model-viewer
     script from the network).
     """
+    from reedtool.assembly.models import ModelRequest
     from reedtool.io.fileio import atomic_write_bytes, check_writable
     from reedtool.io.mappings import parse_mappings
 
     fmt = output_format(output)
     check_writable(output, force)         # a device, FIFO or existing file is refused here
-    arguments: dict[str, str] = {}
+    request = ModelRequest(mappings=parse_mappings(mappings), package_paths=list(package_paths),
+                           model_name=model_name, launch_file=launch_file)
     if launch_file is not None:
         from reedtool.io.launch import read_launch
 
-        call = read_launch(launch_file, package_paths=list(package_paths))
-        arguments.update(call.mappings)
+        request.launch = read_launch(launch_file, package_paths=list(package_paths))
         if str(model) == "-":
-            if call.model is None:
+            if request.launch.model is None:
                 raise ReedtoolError("the launch file's xacro call names no model reedtool "
                                     "can evaluate", file=launch_file,
                                     hint="pass the model path instead of '-'")
-            model = Path(call.model)
+            model = Path(request.launch.model)
     if not model.is_file():
         raise ReedtoolError("model file not found", file=model,
                             hint="pass the path of a .urdf, .xacro or .sdf file")
-    arguments.update(parse_mappings(mappings))
 
-    from reedtool.io.loader import load_robot
-    from reedtool.report.scene import build_scene
+    from reedtool.assembly.view import view_model
 
-    robot = load_robot(model, arguments, list(package_paths), model_name=model_name)
-    findings = _findings(model, robot) if show_findings else None
-    view = build_scene(robot, collision=collision, findings=findings)
-    title = f"{robot.name} ({'collision' if collision else 'visual'} geometry)"
+    view, findings = view_model(model, request, collision=collision,
+                                with_findings=show_findings)
+    title = f"{view.name} ({'collision' if collision else 'visual'} geometry)"
     if fmt == "glb":
         from reedtool.report.scene import glb_bytes
 

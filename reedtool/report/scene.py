@@ -21,6 +21,9 @@ axis, coloured by spin direction (the `layout` picture's colours) with an arrow 
 the spin, the thrust axis, the centre of mass, the base frame's axes and a scale bar.
 Above the base link a root node turns ROS's z-up into glTF's y-up (glTF 2.0, 3.4), so
 viewers show the robot standing.
+
+This module draws and computes nothing about the robot: the link poses, rotors, centre of
+mass and the links findings name come from assembly/view.py.
 """
 
 from __future__ import annotations
@@ -88,6 +91,7 @@ class ViewScene:
     com_m: np.ndarray | None = None
     link_severity: dict[str, str] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)   # what could not be drawn, and why
+    name: str = ""                  # the robot's
 
 
 def length_text(length_m: float) -> str:
@@ -155,7 +159,7 @@ def _mesh_paths(robot, collision: bool) -> dict[str, object]:
     return paths
 
 
-def _yourdfpy_scene(robot, collision: bool, notes: list[str]):
+def _yourdfpy_scene(robot, collision: bool, T_base_link: dict, notes: list[str]):
     """URDF/xacro: yourdfpy's scene (link tree, primitives, colours), meshes added by us."""
     import io
 
@@ -174,11 +178,8 @@ def _yourdfpy_scene(robot, collision: bool, notes: list[str]):
                                   build_collision_scene_graph=collision,
                                   load_collision_meshes=False, force_collision_mesh=False,
                                   filename_handler=filename_handler)
-    from reedtool.physics.kinematics import link_poses
-
-    connected = link_poses(robot)
     for link in robot.links:
-        if link.name not in connected:
+        if link.name not in T_base_link:
             notes.append(f"link '{link.name}' is not connected to '{urdf.base_link}': "
                          f"yourdfpy draws it at the base frame")
     built = urdf.collision_scene if collision else urdf.scene
@@ -224,10 +225,10 @@ def _yourdfpy_scene(robot, collision: bool, notes: list[str]):
             scene.add_geometry(mesh, node_name=f"{link.name}/mesh_{number}",
                                geom_name=f"{link.name}/mesh_{number}",
                                parent_node_name=link.name, transform=origin)
-    T_base_link = {link.name: np.asarray(urdf.get_transform(link.name, urdf.base_link,
-                                                            collision_geometry=collision))
-                   for link in urdf.robot.links}
-    return scene, urdf.base_link, T_base_link
+    T_scene = {link.name: np.asarray(urdf.get_transform(link.name, urdf.base_link,
+                                                        collision_geometry=collision))
+               for link in urdf.robot.links}
+    return scene, urdf.base_link, T_scene
 
 
 @contextlib.contextmanager
@@ -261,24 +262,37 @@ def _read_mesh(path, scale, link_name: str, notes: list[str]):
         return None
 
 
-def _reedtool_scene(robot, collision: bool, notes: list[str]):
-    """SDF: the link tree and poses as reedtool reads them, shapes as yourdfpy makes them."""
+def _tree_joints(robot, base: str) -> list:
+    """The joints of the tree from `base`, breadth first, the first joint to reach a link
+    kept: the walk physics.kinematics.link_poses makes, so each node's pose is its own."""
+    children: dict[str, list] = {}
+    for joint in robot.joints:
+        if joint.parent is not None and joint.child is not None:
+            children.setdefault(joint.parent, []).append(joint)
+    placed, queue, tree = {base}, [base], []
+    while queue:
+        parent = queue.pop(0)
+        for joint in children.get(parent, ()):
+            if joint.child not in placed:
+                placed.add(joint.child)
+                tree.append(joint)
+                queue.append(joint.child)
+    return tree
+
+
+def _reedtool_scene(robot, collision: bool, T_base_link: dict, notes: list[str]):
+    """SDF: the link tree and poses as reedtool reads them, shapes as yourdfpy makes them.
+    Each link hangs from its parent by the joint that gave it its pose in `T_base_link`."""
     import trimesh
 
     from reedtool.model import Box, Cylinder, Mesh, Sphere
-    from reedtool.physics.kinematics import link_poses
 
-    T_base_link = link_poses(robot)
     base = robot.base_link
     scene = trimesh.Scene(base_frame=ROOT_NODE)
     scene.graph.update(frame_from=ROOT_NODE, frame_to=base, matrix=T_GLTF_ROS)
-    placed = {base}
-    for joint in robot.joints:         # the first joint to a child, as link_poses keeps it
-        if joint.child in T_base_link and joint.parent in T_base_link \
-                and joint.child not in placed:
-            placed.add(joint.child)
-            scene.graph.update(frame_from=joint.parent, frame_to=joint.child,
-                               matrix=joint.T_parent_joint)
+    for joint in _tree_joints(robot, base):
+        scene.graph.update(frame_from=joint.parent, frame_to=joint.child,
+                           matrix=joint.T_parent_joint)
     for link in robot.links:
         if link.name not in T_base_link:
             notes.append(f"link '{link.name}' not shown (not connected to '{base}')")
@@ -305,35 +319,10 @@ def _reedtool_scene(robot, collision: bool, notes: list[str]):
             node = f"{link.name}/{'collision' if collision else 'visual'}_{number}"
             scene.add_geometry(mesh, node_name=node, geom_name=node,
                                parent_node_name=link.name, transform=shape.T_link_geom)
-    return scene, base, T_base_link
+    return scene, base, {name: T for name, T in T_base_link.items() if name in robot.link_map}
 
 
 # ---------------------------------------------------------------- decorations
-
-def disc_radii_m(robot, rotors) -> list[float]:
-    """Each rotor's disc radius: its link's cylinder (collision, else visual), else 0.45 of
-    the smallest gap between rotors in the top view, as the layout picture draws it."""
-    from reedtool.model import Cylinder
-
-    positions = np.array([r.position_m for r in rotors], dtype=float).reshape(-1, 3)
-    xy = positions[:, :2]
-    gaps = [float(np.linalg.norm(a - b)) for i, a in enumerate(xy) for b in xy[i + 1:]]
-    gaps = [g for g in gaps if g > 1e-6 and math.isfinite(g)]
-    reach = [float(np.linalg.norm(p)) for p in xy if math.isfinite(float(np.linalg.norm(p)))]
-    default = (0.45 * min(gaps) if gaps else
-               0.3 * max(reach) if reach and max(reach) > 0 else 0.1)
-    radii = []
-    for rotor in rotors:
-        link = robot.link_map.get(rotor.link) if rotor.link else None
-        radius = None
-        if link is not None:
-            for shape in [*link.collisions, *link.visuals]:
-                if isinstance(shape.geometry, Cylinder) and shape.geometry.radius_m > 0:
-                    radius = float(shape.geometry.radius_m)
-                    break
-        radii.append(radius or default)
-    return radii
-
 
 def _frame_along(origin: np.ndarray, axis: np.ndarray) -> np.ndarray:
     """A pose at `origin` whose z axis is `axis` (unit), x and y completed right-handed."""
@@ -426,18 +415,20 @@ def _add(scene, mesh, node: str, parent: str, T: np.ndarray, rgba) -> None:
                        transform=T)
 
 
-def _decorate(view: ViewScene, robot) -> None:
+def _decorate(view: ViewScene, robot, rotors) -> None:
     """Rotor discs, spin arrows, thrust axes, COM, base axes and the scale bar."""
     import trimesh
 
-    from reedtool.physics.rotors import discover_rotors
+    from reedtool.report.layout_picture import rotor_marks
 
     scene, base = view.scene, view.base_link
     size_m = float(np.max(view.framing.extent_m))
-    rotors = [r for r in discover_rotors(robot)
+    rotors = [r for r in rotors
               if np.all(np.isfinite(r.position_m)) and np.all(np.isfinite(r.axis))
               and np.linalg.norm(r.axis) > 0]
-    for rotor, radius in zip(rotors, disc_radii_m(robot, rotors)):
+    # the disc radius `layout` draws: the rotor link's cylinder, else from the rotor gaps
+    radii = [mark.radius_m for mark in rotor_marks(robot, rotors)]
+    for rotor, radius in zip(rotors, radii):
         T_base_disc = _frame_along(np.asarray(rotor.position_m, dtype=float),
                                    np.asarray(rotor.axis, dtype=float))
         rgba = SPIN_RGBA[int(np.sign(rotor.turning_sign))]
@@ -474,27 +465,6 @@ def _decorate(view: ViewScene, robot) -> None:
 
 # -------------------------------------------------------------------- findings
 
-def link_severities(robot, findings) -> dict[str, str]:
-    """link -> the worst severity of the findings that name it (a link, the child link of
-    a named joint, or a named rotor's link)."""
-    from reedtool.physics.rotors import discover_rotors
-
-    rank = {"error": 0, "warning": 1, "info": 2}
-    names = {link.name: link.name for link in robot.links}
-    names.update({j.name: j.child for j in robot.joints if j.child})
-    for rotor in discover_rotors(robot):
-        if rotor.link:
-            names.setdefault(rotor.name, rotor.link)
-    worst: dict[str, str] = {}
-    for finding in findings:
-        link = names.get(finding.subject or "")
-        if link is None:
-            continue
-        if link not in worst or rank[finding.severity] < rank[worst[link]]:
-            worst[link] = finding.severity
-    return worst
-
-
 def _colour_findings(view: ViewScene) -> None:
     scene = view.scene
     for node in scene.graph.nodes_geometry:
@@ -529,23 +499,17 @@ def robot_bounds(scene, exclude=DECORATION_PREFIXES) -> np.ndarray | None:
     return np.array([allp.min(axis=0), allp.max(axis=0)])
 
 
-def build_scene(robot, *, collision: bool = False, findings=None,
-                com_m: np.ndarray | None = None) -> ViewScene:
-    """`robot` as a ViewScene: URDF/xacro through yourdfpy, SDF through reedtool's reader."""
-    from reedtool.errors import ReedtoolError
-
+def build_scene(robot, T_base_link: dict[str, np.ndarray], rotors=(), *,
+                com_m: np.ndarray | None = None, collision: bool = False,
+                link_severity: dict[str, str] | None = None) -> ViewScene:
+    """`robot` as a ViewScene: URDF/xacro through yourdfpy, SDF with `T_base_link` (the
+    link poses reedtool computes), with a disc for each of `rotors`, the COM `com_m`, and
+    the links of `link_severity` coloured by their worst finding."""
     notes: list[str] = []
-    if not robot.links:
-        raise ReedtoolError("the model has no links: nothing to show", file=robot.source_file,
-                            hint="pass the top-level model, not a file of macros it includes")
-    if not robot.root_links():
-        raise ReedtoolError("no root link: every link is some joint's child, so nothing "
-                            "says where the robot is", file=robot.source_file,
-                            hint="run `reedtool validate` on the model; it names the loop")
     scene = None
     if robot.source_format == "urdf" and robot.urdf_xml:
         try:
-            scene, base, T_base_link = _yourdfpy_scene(robot, collision, notes)
+            scene, base, T_scene = _yourdfpy_scene(robot, collision, T_base_link, notes)
             source = "yourdfpy"
         except YOURDFPY_ERRORS as exc:
             # reedtool records content errors and reads on; yourdfpy stops at the first
@@ -553,35 +517,21 @@ def build_scene(robot, *, collision: bool = False, findings=None,
                          f"drawn from reedtool's reading; `reedtool validate` names the "
                          f"problem")
     if scene is None:
-        scene, base, T_base_link = _reedtool_scene(robot, collision, notes)
+        scene, base, T_scene = _reedtool_scene(robot, collision, T_base_link, notes)
         source = "reedtool"
     bounds = robot_bounds(scene)
     if bounds is None:
-        # no geometry at all: frame the link origins (and a decimetre around a lone link)
-        origins = np.array([T[:3, 3] for T in T_base_link.values()] or [np.zeros(3)])
+        # no geometry at all: frame the link origins (and 5 cm around them)
+        origins = np.array([T[:3, 3] for T in T_scene.values()] or [np.zeros(3)])
         bounds = np.array([origins.min(axis=0) - 0.05, origins.max(axis=0) + 0.05])
         notes.append("the model has no geometry to show: framed its link origins")
     framing = Framing(bounds, nice_length(float(np.max(bounds[1] - bounds[0])) / 4.0))
-    if com_m is None:
-        com_m = _com_m(robot)
-    view = ViewScene(scene, base, T_base_link, framing, source, com_m=com_m, notes=notes)
-    if findings:
-        view.link_severity = link_severities(robot, findings)
+    view = ViewScene(scene, base, T_scene, framing, source, com_m=com_m, notes=notes,
+                     link_severity=dict(link_severity or {}), name=robot.name)
+    if view.link_severity:
         _colour_findings(view)
-    _decorate(view, robot)
+    _decorate(view, robot, rotors)
     return view
-
-
-def _com_m(robot) -> np.ndarray | None:
-    """The whole robot's centre of mass in the base frame (reedtool's own sum), if any."""
-    from reedtool.physics.inertia import whole_robot
-
-    try:
-        props = whole_robot(robot)
-    except (ValueError, KeyError, ZeroDivisionError):   # a broken tree: validate says why
-        return None
-    com = np.asarray(props.com_m, dtype=float)
-    return com if props.mass_kg > 0 and np.all(np.isfinite(com)) else None
 
 
 def glb_bytes(view: ViewScene) -> bytes:
