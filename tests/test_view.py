@@ -299,7 +299,7 @@ def test_html_is_one_page_with_the_glb_embedded(tmp_path):
     assert "bounding box 0.575 m x 0.575 m x 0.06 m" in page and "scale bar 0.1 m" in page
     # the one network resource: the model-viewer script
     assert re.findall(r'(?:src|href)="(https?://[^"]+)"', page) == [
-        "https://ajax.googleapis.com/ajax/libs/model-viewer/3.5.0/model-viewer.min.js"]
+        "https://cdn.jsdelivr.net/npm/@google/model-viewer@4.0.0/dist/model-viewer.min.js"]
 
 
 def test_existing_output_is_refused_without_force(tmp_path):

@@ -1,8 +1,8 @@
 """A ViewScene as one HTML page: the GLB embedded as a data URI, shown by <model-viewer>.
 
 The page is a single file to attach to a CI run or open from disk. It loads one thing
-from the network: Google's <model-viewer> web component (MODEL_VIEWER_URL), a script of
-the browser's; nothing is vendored into reedtool. Offline, the page still shows the
+from the network: Google's <model-viewer> web component, a pinned version from the jsDelivr
+CDN (MODEL_VIEWER_URL), fetched by the browser; nothing is vendored into reedtool. Offline, the page still shows the
 caption (bounding box, scale bar, notes) and says the viewer could not load.
 """
 
@@ -13,7 +13,7 @@ import html
 
 from reedtool.report.scene import SEVERITY_RGBA, SPIN_RGBA, ViewScene, glb_bytes
 
-MODEL_VIEWER_URL = "https://ajax.googleapis.com/ajax/libs/model-viewer/3.5.0/model-viewer.min.js"
+MODEL_VIEWER_URL = "https://cdn.jsdelivr.net/npm/@google/model-viewer@4.0.0/dist/model-viewer.min.js"
 
 _PAGE = """<!doctype html>
 <html lang="en">
