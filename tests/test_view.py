@@ -391,3 +391,22 @@ def test_a_file_without_links_is_one_line_exit_2(tmp_path):
     model.write_text('<robot name="parts"/>')
     code, text = run_cli("view", model, "-o", tmp_path / "m.png")
     assert code == 2 and "no links" in text and not (tmp_path / "m.png").exists()
+
+
+def test_a_flat_mesh_is_drawn_and_an_empty_one_is_named(tmp_path):
+    """A flat propeller decal (one square, two triangles) has no volume but is a picture;
+    a mesh without triangles cannot be drawn and is named on stderr, the rest drawn."""
+    from mesh_helpers import write_stl
+
+    square = np.array([[[0, 0, 0], [0.2, 0, 0], [0.2, 0.1, 0]],
+                       [[0, 0, 0], [0.2, 0.1, 0], [0, 0.1, 0]]], dtype=float)
+    write_stl(tmp_path / "decal.stl", square)
+    write_stl(tmp_path / "empty.stl", np.zeros((0, 3, 3)))
+    model = tmp_path / "r.urdf"
+    model.write_text('<robot name="r"><link name="base">'
+                     '<visual><geometry><mesh filename="decal.stl"/></geometry></visual>'
+                     '<visual><geometry><mesh filename="empty.stl"/></geometry></visual>'
+                     '</link></robot>')
+    view = view_robot(load_robot(model))
+    assert np.allclose(view.framing.extent_m, [0.2, 0.1, 0.0], atol=1e-7)   # float32 STL
+    assert len(view.notes) == 1 and "empty.stl" in view.notes[0]

@@ -3,7 +3,7 @@
 The page is a single file to attach to a CI run or open from disk. It loads one thing
 from the network: Google's <model-viewer> web component, a pinned version from the jsDelivr
 CDN (MODEL_VIEWER_URL), fetched by the browser; nothing is vendored into reedtool. Offline, the page still shows the
-caption (bounding box, scale bar, notes) and says the viewer could not load.
+caption (bounding box, scale bar, notes) and says the viewer needs the network.
 """
 
 from __future__ import annotations
@@ -40,9 +40,9 @@ _PAGE = """<!doctype html>
 </header>
 <model-viewer src="data:model/gltf-binary;base64,{glb}" camera-controls
   camera-orbit="-40deg 65deg auto" shadow-intensity="0.6" alt="{title}">
-  <div slot="poster">The 3-D viewer (model-viewer, {script}) did not load: this page needs
-  the network for it. The .glb file (reedtool view -o MODEL.glb) opens offline in Blender
-  or VS Code.</div>
+  <div slot="poster">Loading the 3-D viewer (model-viewer, {script}). If this text stays,
+  the page could not reach it: it needs the network. The .glb file
+  (reedtool view MODEL -o MODEL.glb) opens offline in Blender or VS Code.</div>
 </model-viewer>
 </body>
 </html>

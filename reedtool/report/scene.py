@@ -121,10 +121,16 @@ def _mesh_from_triangles(triangles_m: np.ndarray):
 
 
 def mesh_file_geometry(path, scale) -> object:
-    """A mesh file as Gazebo sizes it (COLLADA <unit> applied), then `<mesh scale>`."""
-    from reedtool.io.meshes import load_triangles
+    """A mesh file as Gazebo sizes it (COLLADA <unit> applied), then `<mesh scale>`.
+    A flat or open mesh is drawn as it is (mass properties are not asked of it here);
+    triangles with a non-finite corner are left out, an empty mesh is refused."""
+    from reedtool.errors import ReedtoolError
+    from reedtool.io.meshes import read_mesh
 
-    triangles = load_triangles(path) * np.asarray(scale, dtype=float).reshape(1, 1, 3)
+    triangles = read_mesh(path).triangles_m * np.asarray(scale, dtype=float).reshape(1, 1, 3)
+    triangles = triangles[np.all(np.isfinite(triangles), axis=(1, 2))]
+    if not len(triangles):
+        raise ReedtoolError("the mesh has no triangles with finite corners", file=path)
     return _mesh_from_triangles(triangles)
 
 
