@@ -410,3 +410,26 @@ def test_a_flat_mesh_is_drawn_and_an_empty_one_is_named(tmp_path):
     view = view_robot(load_robot(model))
     assert np.allclose(view.framing.extent_m, [0.2, 0.1, 0.0], atol=1e-7)   # float32 STL
     assert len(view.notes) == 1 and "empty.stl" in view.notes[0]
+
+
+def test_a_generated_hexacopter_shows_six_discs_three_each_way_on_one_circle(tmp_path):
+    """`new-package --frame hex-x`: six rotors on a circle, spins alternating (3 ccw, 3 cw),
+    neighbours 60 degrees apart."""
+    import math
+
+    assert run_cli("new-package", "hexa", "--frame", "hex-x", "--ros", "2",
+                   "-o", tmp_path)[0] == 0
+    view = view_robot(load_robot(tmp_path / "hexa/urdf/hexa.urdf.xacro"))
+    assert len(view.discs) == 6
+    assert sorted(d.rgba[:3] for d in view.discs) == sorted([CCW_RGB] * 3 + [CW_RGB] * 3)
+    centres = np.array([d.T_base_disc[:3, 3] for d in view.discs])
+    radii = np.hypot(centres[:, 0], centres[:, 1])
+    # the generator writes positions as decimal text of their doubles; reading them back
+    # and composing one transform rounds at ~1e-16, far under 1e-9
+    assert np.ptp(radii) < 1e-9 * radii.max()
+    order = np.argsort(np.arctan2(centres[:, 1], centres[:, 0]))
+    angles = np.degrees(np.unwrap(np.arctan2(centres[order, 1], centres[order, 0])))
+    assert np.allclose(np.diff(angles), 60.0, atol=1e-6)   # 1e-9 m at 0.2 m: ~3e-7 degrees
+    spins = [view.discs[i].turning_sign for i in order]
+    assert all(a == -b for a, b in zip(spins, spins[1:] + spins[:1]))   # alternating
+    assert math.isclose(view.framing.scale_bar_m, 0.1)
