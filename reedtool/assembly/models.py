@@ -29,6 +29,9 @@ class ModelRequest:
     launch_file: Path | None = None
     select: tuple[str, ...] = ()
     ignore: tuple[str, ...] = ()
+    # Models loaded while deciding what a named file means (io.model_inputs), kept so the
+    # check does not expand them twice: resolved path -> load_models pairs.
+    preloaded: dict = field(default_factory=dict)
 
 
 def _config_line(path: Path | None, name: str) -> int | None:
@@ -104,9 +107,10 @@ def load_models(model: Path, mappings, package_paths, model_name):
 
 
 def targets_of(paths: Sequence[str], request: ModelRequest):
-    """The models that command-line paths (files, directories, globs, packages) name."""
-    from reedtool.config import load_config
-    from reedtool.io.model_inputs import expand_targets, include_tree_of
+    """The models that command-line paths (files, directories, globs, packages, a changed
+    configuration) name; arguments mean "this model" (io.model_inputs)."""
+    from reedtool.config import find_config, load_config
+    from reedtool.io.model_inputs import expand_targets, include_globs_of, include_tree_of
     from reedtool.report import display_path
 
     def mappings_for(path: Path) -> dict[str, str]:
@@ -116,5 +120,39 @@ def targets_of(paths: Sequence[str], request: ModelRequest):
             return dict(request.mappings)
         return model_arguments(path, config, request)[0]
 
+    def has_arguments(path: Path) -> bool:
+        """Arguments meant for this file: typed, from --launch, or a per-file table.
+        (The config's `args` reach every model of a repository, so they do not say the
+        file is a model: whether it expands alone with them does.)"""
+        if request.mappings or (request.launch is not None and request.launch.mappings):
+            return True
+        try:
+            config = load_config(path)
+        except ReedtoolError:
+            return False
+        return set(config.args_for(path)[0].items()) != set(config.args.items())
+
+    def stands_alone(path: Path) -> bool:
+        """Loads alone into a robot with links; the robots are kept for the check."""
+        key = path.resolve()
+        if key in request.preloaded:
+            return True
+        try:
+            pairs = load_models(path, mappings_for(path), request.package_paths,
+                                request.model_name)
+        except ReedtoolError:
+            return False
+        if not any(robot.links for _, robot in pairs):
+            return False
+        request.preloaded[key] = pairs
+        return True
+
+    def configures_models(path: Path) -> bool:
+        found = find_config(path)
+        return found is not None and found[0] == path.resolve()
+
     return expand_targets(paths, include_tree_of(mappings_for, request.package_paths),
-                          display=lambda p: display_path(str(p)) or str(p))
+                          display=lambda p: display_path(str(p)) or str(p),
+                          include_globs=include_globs_of(mappings_for, request.package_paths),
+                          has_arguments=has_arguments, stands_alone=stands_alone,
+                          configures_models=configures_models)

@@ -78,7 +78,8 @@ def check_model_path(model: Path, request: ModelRequest, *, controllers=(),
     mappings, given, origins, checked = model_arguments(model, config, request)
     try:
         arguments = argument_use(model, mappings, given, origins, checked, config, request)
-        pairs = load_models(model, mappings, request.package_paths, request.model_name)
+        pairs = (request.preloaded.pop(model.resolve(), None)
+                 or load_models(model, mappings, request.package_paths, request.model_name))
     except ReedtoolError as exc:
         return CheckedPath(error=exc)
     out = CheckedPath()

@@ -54,6 +54,7 @@ class RunOptions:
     diagram: Path | None = None           # --diagram: the rotor layout picture
     diagram_per_model: bool = False       # several models: NAME.svg -> NAME-MODEL.svg
     force: bool = False
+    notes: list[str] = field(default_factory=list)   # one line per clean cross-check
 
 
 def check_model(name: str, model: Path, options: RunOptions) -> list:
@@ -71,9 +72,40 @@ def check_model(name: str, model: Path, options: RunOptions) -> list:
     results = []
     for one in checked.models:
         results.append(ModelResult(name + one.suffix, one.findings, suppressed=one.suppressed))
+        if not one.suppressed:     # a silenced flight-stack finding is no agreement
+            options.notes += _agreement_lines(model, one.robot, one.findings, options,
+                                              name + one.suffix)
         if options.diagram is not None:
             _write_diagram(one.robot, one.findings, options, several=len(checked.models) > 1)
     return results
+
+
+def _agreement_lines(path: Path, robot, findings, options: RunOptions, model: str
+                     ) -> list[str]:
+    """One line per --airframe/--autopilot-params file the model agrees with: every rule
+    of that flight stack ran and none found anything above information."""
+    if not options.flight_params or any(f.code.startswith("S") and f.severity == "error"
+                                        for f in findings):
+        return []     # a broken tree: the flight-stack rules did not look
+    from reedtool.checks.registry import all_rules
+    from reedtool.config import load_config
+    from reedtool.flightstack.params_files import agreement_line
+    from reedtool.physics.rotors import discover_rotors
+
+    selection = selection_for(load_config(path), options.request.select,
+                              options.request.ignore)
+    rotors = discover_rotors(robot)
+    lines = []
+    for params in options.flight_params:
+        rules = [r for r in all_rules() if r.check.__module__.endswith(".flightstack_rules")
+                 and r.slug.startswith(params.kind)]
+        ran = all(selection.enabled(r.code) for r in rules)
+        quiet = not any(f.code in {r.code for r in rules} and f.severity != "info"
+                        for f in findings)
+        counted = rotors if params.kind == "px4" else [r for r in rotors if r.role == "lift"]
+        if rules and ran and quiet and counted:
+            lines.append(agreement_line(params, len(counted), model))
+    return lines
 
 
 def _write_diagram(robot, findings, options: RunOptions, several: bool) -> None:
@@ -170,7 +202,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
             no_color: bool, controller_files: tuple[Path, ...] = (),
             airframe_files: tuple[Path, ...] = (), autopilot_files: tuple[Path, ...] = (),
             diagram: Path | None = None) -> int:
-    """Check models (.urdf, .xacro or .sdf files, directories, globs, ROS packages) for
+    """Check models (.urdf, .xacro, .gazebo, .sdf or .world files, directories, globs, ROS
+    packages, or a changed pyproject.toml/reedtool.toml: the models it configures) for
     mistakes; NAME:=VALUE words are xacro arguments for every model.
 
     Exit 0 when there is no error, 1 when there are errors (or warnings with --strict),
@@ -183,6 +216,13 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
 
     mappings = parse_mappings([w for w in inputs if MAPPING_SEPARATOR in w])
     paths = [w for w in inputs if MAPPING_SEPARATOR not in w]
+    from reedtool.io.mappings import suggest_mapping
+
+    for word in paths:
+        if not Path(word).exists() and suggest_mapping(word) is not None:
+            # `mav_name=foo` names no file: an argument missing its `:`, not a model.
+            raise ReedtoolError(f"'{word}' is not a file; xacro arguments are written "
+                                "name:=value", hint=f"did you mean '{suggest_mapping(word)}'?")
     request = ModelRequest(mappings=mappings, package_paths=list(package_paths),
                            select=select, ignore=ignore, model_name=model_name,
                            launch_file=launch_file)
@@ -201,7 +241,11 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
         raise click.UsageError("missing argument 'MODEL' (or use --explain CODE)")
     if len(paths) == 1 and not Path(paths[0]).exists() and not re.search(r"[*?\[]", paths[0]):
         # One model that is not there: the one-line error of every command, exit 2.
-        raise ReedtoolError("file not found", file=paths[0], hint="check the model path")
+        from reedtool.io.model_inputs import not_found_message
+
+        message = not_found_message(paths[0])
+        raise ReedtoolError(message, file=paths[0],
+                            hint=None if message != "file not found" else "check the model path")
 
     targets = targets_of(paths, request)
     if show_settings:
@@ -232,6 +276,13 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
             results.append(ModelResult(target.name, error=target.error, error_file=target.name))
             continue
         model_results = check_model(target.name, target.path, options)
+        if target.checked_for is not None:
+            for result in model_results:
+                if result.error is not None:
+                    # The failure is this model's; name the file it was checked for.
+                    result.error += (f" [checked for {target.checked_for}, which it includes; "
+                                     f"give {target.checked_for} its arguments (name:=value) "
+                                     "to validate it as a model of its own]")
         results.extend(model_results)
         if len(targets) == 1 and results[-1].error is not None:
             # One model: its input error is the one-line error of every command.
@@ -251,6 +302,9 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
         atomic_write_text(output_file, text, force=force)
     else:
         click.echo(text, nl=False, color=color)
+    for note in options.notes:
+        # Text on the terminal carries it; machine formats and files stay as they are.
+        click.echo(note, err=fmt != "text" or output_file is not None)
     if any(r.error is not None for r in results):
         return 2
     if exit_zero:
