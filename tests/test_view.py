@@ -322,7 +322,7 @@ def test_launch_file_gives_the_model_and_its_arguments(tmp_path):
   <param name="robot_description"
          command="$(find xacro)/xacro '{SEED_QUAD}' mav_name:=launched namespace:=launched"/>
 </launch>""")
-    code, _ = run_cli("view", "-", "--launch", launch, "-o", tmp_path / "l.glb")
+    code, _ = run_cli("view", "--launch", launch, "-o", tmp_path / "l.glb")
     assert code == 0
     read = _read_glb((tmp_path / "l.glb").read_bytes())
     assert "launched/base_link" in read.graph.nodes
@@ -433,3 +433,11 @@ def test_a_generated_hexacopter_shows_six_discs_three_each_way_on_one_circle(tmp
     spins = [view.discs[i].turning_sign for i in order]
     assert all(a == -b for a, b in zip(spins, spins[1:] + spins[:1]))   # alternating
     assert math.isclose(view.framing.scale_bar_m, 0.1)
+
+
+def test_a_ros_package_names_its_one_model_as_in_every_model_command(tmp_path):
+    """The shared model inputs (docs/commands.md): the seed quad's package is its model."""
+    code, out = run_cli("view", ROOT / "examples/reed_quad_x", "-o", tmp_path / "p.glb")
+    assert code == 0
+    read = _read_glb((tmp_path / "p.glb").read_bytes())
+    assert {link.name for link in load_robot(SEED_QUAD).links} <= set(read.graph.nodes)

@@ -73,5 +73,5 @@ def view_model(model: Path, request: ModelRequest, *, collision: bool = False,
     from reedtool.assembly.validation import validation_findings
 
     robot, _ = load_robot_for(model, request, require_sound=False)
-    findings = validation_findings(model, robot) if with_findings else None
+    findings = validation_findings(model, robot, request) if with_findings else None
     return view_robot(robot, collision=collision, findings=findings), findings

@@ -19,7 +19,12 @@ import click
 
 from reedtool.assembly.flight import Progress
 from reedtool.assembly.vehicle import DEFAULT_MAX_MEMORY_MB
-from reedtool.commands.params import FiniteFloatRange, model_arguments
+from reedtool.commands.params import (
+    FiniteFloatRange,
+    model_inputs,
+    one_model_request,
+    validation_options,
+)
 from reedtool.errors import ReedtoolError
 
 SPREAD_HELP = "Half-width of the uniform perturbation"
@@ -31,16 +36,12 @@ MAX_STEPS = 10_000_000
 SCHEMA = "reedtool.hover-test/1"
 
 
-def _validation_json(errors, refused: bool) -> dict:
-    return {"errors": [f.to_dict() for f in errors], "refused": refused}
-
-
 # A run longer than this on a terminal shows that it is still working.
 PROGRESS_AFTER_S = 2.0
 
 
 @click.command(name="hover-test")
-@model_arguments
+@model_inputs()
 @click.option("--duration", "duration_s", type=float, default=10.0, show_default=True,
               help="Simulated time [s].")
 @click.option("--rate", "rate_hz", type=float, default=1000.0, show_default=True,
@@ -81,24 +82,26 @@ PROGRESS_AFTER_S = 2.0
                    "needs pip install 'reedtool[fast]').")
 @click.option("--min-pass-rate", type=FiniteFloatRange(0.0, 1.0), default=0.95,
               show_default=True, help="Batch pass rate needed to exit 0.")
-@click.option("--ignore-validation", is_flag=True,
-              help="Fly a model that `validate` reports errors for (by default it is "
-                   "refused: exit 1 without flying).")
-def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
-            model_name: str | None,
+@validation_options
+def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
+            model_name: str | None, launch_file: Path | None,
             duration_s: float, rate_hz: float, offset_m: tuple[float, float, float],
             roll_rad: float, pitch_rad: float, yaw_rad: float, plot_path: Path | None,
             csv_path: Path | None, force: bool, fmt: str, samples: int | None,
             max_memory_mb: int, seed: int,
             mass_spread: float, com_spread_m: float, inertia_spread: float,
             motor_spread: float, engine: str, min_pass_rate: float,
-            ignore_validation: bool = False) -> int:
-    """Trim MODEL (.urdf or .xacro, with xacro NAME:=VALUE arguments) for hover and fly it.
+            ignore: tuple[str, ...] = (), ignore_validation: bool = False) -> int:
+    """Trim MODEL for hover and fly it.
+
+    MODEL is a .urdf, .xacro (.urdf.xacro), .gazebo, .sdf or .world file, or a directory,
+    glob or ROS package holding one model; NAME:=VALUE words are its xacro arguments.
 
     Starts from a disturbance (default 0.5 m off the setpoint, rolled 0.2 rad) and passes
-    when it settles within 5 cm and 2 deg and stays there. A model `validate` reports
-    errors for is not flown (exit 1) unless --ignore-validation is given: a hover of a
-    model Gazebo would simulate differently is not a pass.
+    when it settles within 5 cm and 2 deg and stays there. validate's rules run first: a
+    model with a structure, mass or rotor error (the flight would be another vehicle's) is
+    not flown (exit 1) unless --ignore CODE or --ignore-validation is given; other errors
+    are listed and the model flown.
     """
     from reedtool.errors import check_plausible
     from reedtool.sim import HoverConfig
@@ -129,7 +132,9 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
                                 hint="or use --engine numpy (the default)")
     from reedtool.io.fileio import check_writable, note_input
 
-    note_input(model)           # the model is never an output of its own test
+    for word in inputs:         # the model is never an output of its own test
+        if Path(word).is_file():
+            note_input(Path(word))
     if plot_path is not None:   # fail before flying, not after
         check_writable(plot_path, force)
     if csv_path is not None:
@@ -138,21 +143,19 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     if plot_path is not None and plot_path.suffix.lower() not in (".png", ".svg"):
         raise ReedtoolError(f"cannot tell the plot format from '{plot_path.suffix or plot_path.name}'",
                             file=plot_path, hint="name the --plot file .png or .svg")
-    if not model.is_file():
-        raise ReedtoolError("model file not found", file=model,
-                            hint="pass the path of a .urdf or .xacro file")
+    model, request = one_model_request("hover-test", inputs, package_paths, model_name,
+                                       launch_file, ignore)
+    note_input(model)
 
     from reedtool.assembly.assemble import assemble
-    from reedtool.assembly.models import ModelRequest
-    from reedtool.io.mappings import parse_mappings
 
-    request = ModelRequest(mappings=parse_mappings(mappings),
-                           package_paths=list(package_paths), model_name=model_name)
     # A model or batch too large for the machine is refused before any rule runs on it.
-    assembled = assemble(model, request, samples=samples,
+    assembled = assemble(model, request, "hover-test", samples=samples,
                          max_memory_bytes=max_memory_mb * 1024 * 1024)
-    robot, errors, every_rotor = assembled.robot, assembled.errors, assembled.vehicle.every_rotor
-    if errors and not ignore_validation:
+    robot, verdict = assembled.robot, assembled.verdict
+    every_rotor = assembled.vehicle.every_rotor
+    refused = bool(verdict.refusing) and not ignore_validation
+    if refused:
         # Bad input (exit 2) comes before what validate finds (exit 1): unreadable rotor
         # parameters.
         from reedtool.sim.params import check_rotor_dynamics
@@ -160,25 +163,22 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
         # ArduPilotPlugin rotors carry no time constants: hover_test derives them from
         # the joint's velocity PID (or refuses with the reason) only when it flies.
         check_rotor_dynamics([r for r in every_rotor if r.kind != "ardupilot"])
-    if errors:
-        from reedtool.report import ModelResult, render
+    from reedtool.report.validation_note import validation_json, validation_text, why_line
 
-        refused = not ignore_validation
-        why = (f"validate reports {len(errors)} error{'s' if len(errors) != 1 else ''} for "
-               f"this model; " + ("not flying it (--ignore-validation flies it anyway)"
-                                  if refused else "flying it anyway (--ignore-validation)"))
-        if fmt == "text":
-            click.echo(render([ModelResult(str(model), errors)], "text"), nl=False)
-            click.echo(why if not refused else f"FAILED: {why}")
-        if refused:
-            if fmt == "json":
-                from reedtool.report.json_format import envelope
+    if fmt == "text":
+        click.echo(validation_text(str(model), verdict.refusing, verdict.reported, refused,
+                                   "flying it", ignore_validation), nl=False)
+    if refused:
+        if fmt == "json":
+            from reedtool.report.json_format import envelope
 
-                click.echo(json.dumps({**envelope(SCHEMA), "model": {"file": str(model)},
-                                       "validation": _validation_json(errors, True),
-                                       "passed": False, "status": "refused",
-                                       "message": why}, indent=2))
-            return 1
+            click.echo(json.dumps({**envelope(SCHEMA), "model": {"file": str(model)},
+                                   "validation": validation_json(verdict.refusing,
+                                                                 verdict.reported, True),
+                                   "passed": False, "status": "refused",
+                                   "message": why_line(verdict.refusing, verdict.reported,
+                                                       True, "flying it")}, indent=2))
+        return 1
     from reedtool.assembly.flight import hover_test
 
     report = hover_test(robot, config, samples=samples, seed=seed,
@@ -219,7 +219,7 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
         from reedtool.report.json_format import envelope
 
         document = {**envelope(SCHEMA), **report,
-                    "validation": _validation_json(errors, False)}
+                    "validation": validation_json(verdict.refusing, verdict.reported, False)}
         click.echo(json.dumps(_finite(document), indent=2, allow_nan=False))
     else:
         click.echo(render_text(report))

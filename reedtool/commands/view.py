@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from reedtool.commands.params import model_arguments
+from reedtool.commands.params import ignore_option, model_inputs, one_model_request
 from reedtool.errors import ReedtoolError
 
 FORMATS = (".glb", ".png", ".html")
@@ -21,47 +21,37 @@ def output_format(path: Path) -> str:
 
 
 @click.command("view")
-@model_arguments
-@click.option("--launch", "launch_file", type=click.Path(path_type=Path, dir_okay=False),
-              metavar="FILE", help="Read the model's xacro arguments (and the model, when "
-                                   "MODEL is '-') from a roslaunch or ROS 2 launch file.")
+@model_inputs()
 @click.option("-o", "--output", "output", type=click.Path(path_type=Path, dir_okay=False),
               required=True, help="File to write: .glb (glTF), .png (picture) or .html (page).")
 @click.option("--collision", is_flag=True, help="Show the collision geometry, not the visuals.")
 @click.option("--findings", "show_findings", is_flag=True,
               help="Colour the links validate's findings name, by severity.")
+@ignore_option
 @click.option("--force", is_flag=True, help="Overwrite an existing output file.")
-def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
-            model_name: str | None, launch_file: Path | None, output: Path, collision: bool,
-            show_findings: bool, force: bool) -> int:
+def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name: str | None,
+            launch_file: Path | None, output: Path, collision: bool, show_findings: bool,
+            ignore: tuple[str, ...], force: bool) -> int:
     """Show MODEL in 3-D: links where Gazebo puts them, rotor discs coloured by spin
     (blue ccw, orange cw), thrust axes, COM, base axes, a scale bar.
 
+    MODEL is a .urdf, .xacro (.urdf.xacro), .gazebo, .sdf or .world file, or a directory,
+    glob or ROS package holding one model; NAME:=VALUE words are its xacro arguments.
     .glb opens in any glTF viewer (Blender, VS Code, browsers); .png is an offline render
     for CI and READMEs; .html is one page showing the GLB (it loads the model-viewer
-    script from the network).
+    script from the network). A picture refuses no model for validate's errors: with
+    --findings they colour the links they name.
     """
-    from reedtool.assembly.models import ModelRequest
-    from reedtool.io.fileio import atomic_write_bytes, check_writable
-    from reedtool.io.mappings import parse_mappings
+    from reedtool.io.fileio import atomic_write_bytes, check_writable, note_input
 
     fmt = output_format(output)
+    for word in inputs:              # the model is never the picture
+        if Path(word).is_file():
+            note_input(Path(word))
     check_writable(output, force)         # a device, FIFO or existing file is refused here
-    request = ModelRequest(mappings=parse_mappings(mappings), package_paths=list(package_paths),
-                           model_name=model_name, launch_file=launch_file)
-    if launch_file is not None:
-        from reedtool.io.launch import read_launch
-
-        request.launch = read_launch(launch_file, package_paths=list(package_paths))
-        if str(model) == "-":
-            if request.launch.model is None:
-                raise ReedtoolError("the launch file's xacro call names no model reedtool "
-                                    "can evaluate", file=launch_file,
-                                    hint="pass the model path instead of '-'")
-            model = Path(request.launch.model)
-    if not model.is_file():
-        raise ReedtoolError("model file not found", file=model,
-                            hint="pass the path of a .urdf, .xacro or .sdf file")
+    model, request = one_model_request("view", inputs, package_paths, model_name,
+                                       launch_file, ignore)
+    note_input(model)
 
     from reedtool.assembly.view import view_model
 
@@ -84,8 +74,7 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     for note in view.notes:
         click.echo(f"note: {note}", err=True)
     if findings is not None:
-        named = len(view.link_severity)
-        click.echo(f"{len(findings)} findings, {named} links coloured"
+        click.echo(f"{len(findings)} findings, {len(view.link_severity)} links coloured"
                    + ("" if not findings else " (run `reedtool validate` for the messages)"))
     click.echo(f"wrote {output}: {view.framing.caption()}")
     return 0
