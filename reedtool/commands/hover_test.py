@@ -34,6 +34,7 @@ MAX_COM_SPREAD_M = 1.0
 # (`--duration 1e9`) that would keep the machine busy for days.
 MAX_STEPS = 10_000_000
 SCHEMA = "reedtool.hover-test/1"
+DEFAULT_DURATION_S = 10.0
 
 
 # A run longer than this on a terminal shows that it is still working.
@@ -42,8 +43,9 @@ PROGRESS_AFTER_S = 2.0
 
 @click.command(name="hover-test")
 @model_inputs()
-@click.option("--duration", "duration_s", type=float, default=10.0, show_default=True,
-              help="Simulated time [s].")
+@click.option("--duration", "duration_s", type=float, default=None,
+              help="Simulated time [s]. Default 10 s, longer when the vehicle's tuned "
+                   "position loop needs more to settle (the text and JSON say how long).")
 @click.option("--rate", "rate_hz", type=float, default=1000.0, show_default=True,
               help="Integration and control rate [Hz] (fixed step).")
 @click.option("--offset", "offset_m", type=float, nargs=3, default=(0.5, 0.0, 0.0),
@@ -82,6 +84,11 @@ PROGRESS_AFTER_S = 2.0
                    "needs pip install 'reedtool[fast]').")
 @click.option("--min-pass-rate", type=FiniteFloatRange(0.0, 1.0), default=0.95,
               show_default=True, help="Batch pass rate needed to exit 0.")
+@click.option("--require", "require", default="stable", show_default=True,
+              metavar="hover|stable|margin:DEG",
+              help="What exit 0 needs: a hover trim (hover); and a vehicle some controller "
+                   "can stabilise (stable); and recovery from a start tilted DEG degrees "
+                   "(margin:DEG).")
 @validation_options
 def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
             model_name: str | None, launch_file: Path | None,
@@ -91,6 +98,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
             max_memory_mb: int, seed: int,
             mass_spread: float, com_spread_m: float, inertia_spread: float,
             motor_spread: float, engine: str, min_pass_rate: float,
+            require: str = "stable",
             ignore: tuple[str, ...] = (), ignore_validation: bool = False) -> int:
     """Trim MODEL for hover and fly it.
 
@@ -105,8 +113,17 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
     """
     from reedtool.errors import check_plausible
     from reedtool.sim import HoverConfig
+    from reedtool.sim.verdict import Requirement
+
+    try:
+        requirement = Requirement.parse(require)
+    except ValueError as exc:
+        raise ReedtoolError(f"bad option: {exc}",
+                            hint="e.g. --require stable, or --require margin:10") from exc
 
     check_plausible("rate", rate_hz, "--rate")
+    auto_duration = duration_s is None
+    duration_s = DEFAULT_DURATION_S if auto_duration else duration_s
     check_plausible("duration", duration_s, "--duration")
     for axis, value in zip("xyz", offset_m):
         check_plausible("offset", value, f"--offset {axis}", magnitude=True)
@@ -187,7 +204,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
                         progress=TerminalProgress() if fmt == "text" else None,
                         engine=engine, envelope=plot_path is not None,
                         max_memory_bytes=max_memory_mb * 1024 * 1024,
-                        vehicle=assembled.vehicle)
+                        vehicle=assembled.vehicle, requirement=requirement,
+                        auto_duration=auto_duration)
     batch = report.get("batch")
     if batch is not None:
         batch["min_pass_rate"] = min_pass_rate
@@ -284,6 +302,15 @@ def render_text(report: dict) -> str:
                                                          for r in others))
     for line in model.get("derived", ()):
         lines.append(f"derived: {line}")
+    for lj in model.get("locked_joints", ()):
+        # Passive joints (no plugin drives them) are flown rigid: say so, with what the
+        # mass beyond them adds to the inertia about the COM.
+        added = [lj["inertia_about_com_kg_m2"][i][i] for i in range(3)]
+        total = [model["inertia_kg_m2"][i][i] for i in range(3)]
+        share = ", ".join(f"{axis} {a:.3g} kg*m^2 ({100 * a / t:.0f}%)" if t > 0 else
+                          f"{axis} {a:.3g} kg*m^2" for axis, a, t in zip("xyz", added, total))
+        lines.append(f"locked rigid: {lj['joint']} ({lj['type']}, no plugin drives it; "
+                     f"{lj['mass_kg']:.3g} kg beyond it adds {share} about the COM)")
     if trim["feasible"]:
         lines.append(f"trim: {trim['message']}")
     else:
@@ -300,7 +327,10 @@ def render_text(report: dict) -> str:
                      f"hover: roll {a['roll']:.3g}, pitch {a['pitch']:.3g}, "
                      f"yaw {a['yaw']:.3g} N*m")
     if sim is not None:
+        from reedtool.sim.verdict import tuning_line
+
         c = sim["config"]
+        lines.append(f"tuning: {tuning_line(sim['gains'])}")
         lines.append(f"sim: {sim['status'].upper()}: {sim['message']}")
         lines.append(f"  start {c['offset_m']} m off, roll {c['roll_rad']:g} pitch "
                      f"{c['pitch_rad']:g} yaw {c['yaw_rad']:g} rad; {c['duration_s']:g} s at "
@@ -321,11 +351,16 @@ def render_text(report: dict) -> str:
                      f"{100 * batch['min_pass_rate']:.0f}%): {counts}")
         lines.append(f"  spreads: mass +-{100 * s['mass_rel']:g}%, COM +-{1000 * s['com_m']:g} mm, "
                      f"inertia +-{100 * s['inertia_rel']:g}%, motor constant "
-                     f"+-{100 * s['motor_constant_rel']:g}%; seed {batch['seed']}")
+                     f"+-{100 * s['motor_constant_rel']:g}%; seed {batch['seed']}"
+                     + (f"; from {batch['start_scale']:.3g} of the start (the recoverable margin)"
+                        if batch.get("start_scale", 1.0) != 1.0 else ""))
         for w in batch["worst"]:
             lines.append(f"  #{w['index']}: {w['status']}: {w['message']} "
                          f"(mass {w['mass_kg']:.4g} kg, COM shift "
                          f"{', '.join(f'{1000 * v:.1f}' for v in w['com_shift_m'])} mm)")
+    verdict = report.get("verdict")
+    if verdict is not None:
+        lines.append(f"verdict: {verdict['status'].upper()}: {verdict['message']}")
     lines.append("PASSED" if report["passed"] else f"FAILED: {report.get('message', '')}")
     return "\n".join(lines)
 

@@ -12,22 +12,13 @@ from pathlib import Path
 
 import click
 
-from reedtool.errors import ReedtoolError
+from reedtool.commands.params import model_inputs, one_model_request
 
 SCHEMA = "reedtool.migrate/1"
 
 
 @click.command(name="migrate")
-@click.argument("model", type=click.Path(path_type=Path, dir_okay=False), required=False)
-@click.argument("mappings", nargs=-1)
-@click.option("--package-path", "package_paths", multiple=True, metavar="DIR",
-              type=click.Path(path_type=Path, file_okay=False),
-              help="Directory to search for ROS packages first (repeatable).")
-@click.option("--model", "model_name", metavar="NAME", default=None,
-              help="In an SDF world holding several models, the one to port.")
-@click.option("--launch", "launch_file", type=click.Path(path_type=Path, dir_okay=False),
-              metavar="FILE", help="Read the model and its xacro arguments from a roslaunch "
-                                   "XML or ROS 2 (XML or Python) launch file.")
+@model_inputs()
 @click.option("--to", "to", type=click.Choice(["gz"]), required=True,
               help="Target simulator: gz (Gazebo Sim, Harmonic and later).")
 @click.option("-o", "--output-dir", type=click.Path(path_type=Path, file_okay=False),
@@ -49,7 +40,7 @@ SCHEMA = "reedtool.migrate/1"
               help="Write into an existing output directory, replacing the files migrate writes.")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
               show_default=True, help="Output format.")
-def command(model: Path | None, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
+def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
             model_name: str | None, launch_file: Path | None, to: str, output_dir: Path,
             name: str | None, urdf: bool, velocity_control: bool, autopilot: str | None,
             force: bool, fmt: str) -> int:
@@ -59,25 +50,9 @@ def command(model: Path | None, mappings: tuple[str, ...], package_paths: tuple[
     verdict and validate's findings.
     """
     from reedtool.assembly.migration import MigrateRequest, migrate
-    from reedtool.assembly.models import ModelRequest
-    from reedtool.io.mappings import parse_mappings
 
-    request = ModelRequest(mappings=parse_mappings(mappings), package_paths=list(package_paths),
-                           model_name=model_name, launch_file=launch_file)
-    if launch_file is not None:
-        from reedtool.io.launch import read_launch
-
-        request.launch = read_launch(launch_file, package_paths=list(package_paths))
-        if model is None:
-            if request.launch.model is None:
-                raise ReedtoolError("the launch file's xacro call names no model reedtool "
-                                    "can evaluate", file=launch_file, hint="pass MODEL instead")
-            model = Path(request.launch.model)
-    if model is None:
-        raise ReedtoolError("no model given", hint="pass MODEL or --launch FILE")
-    if not model.is_file():
-        raise ReedtoolError("model file not found", file=model,
-                            hint="pass the path of a .urdf, .xacro or .sdf file")
+    model, request = one_model_request("migrate", inputs, package_paths, model_name,
+                                       launch_file)
     result = migrate(MigrateRequest(model, output_dir, request, name, velocity_control,
                                     autopilot, force, urdf))
     if fmt == "json":
