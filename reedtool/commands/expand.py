@@ -25,6 +25,19 @@ def _fix_legacy(model: Path, mappings: dict[str, str], package_paths: list[Path]
                    f"(backup: {display_path(backup) if backup else 'none'})", err=True)
 
 
+def _refuse_non_xacro(model: Path) -> None:
+    """A mesh or an SDF file named as the model: say what it is rather than "malformed XML"
+    or an SDF echoed back under a header telling the user to edit .xacro sources."""
+    from reedtool.io.loader import SDF_SUFFIXES, refuse_mesh
+
+    refuse_mesh(model)
+    if model.is_dir() or model.suffix.lower() in SDF_SUFFIXES:
+        what = "a Gazebo model directory (SDF)" if model.is_dir() else "SDF"
+        raise ReedtoolError(f"is {what}: expand turns xacro into URDF, and SDF needs no "
+                            "expansion", file=model,
+                            hint=f"`reedtool validate {model.name}` checks it as Gazebo reads it")
+
+
 @click.command(name="expand")
 @model_inputs()
 @click.option("-o", "--output", type=click.Path(path_type=Path, dir_okay=False),
@@ -50,6 +63,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
                             "xacro's URDF", hint="drop --model")
     model, request = one_model_request("expand", inputs, package_paths, model_name,
                                        launch_file)
+    _refuse_non_xacro(model)
     from reedtool.assembly.models import model_mappings
 
     mappings = model_mappings(model, request)

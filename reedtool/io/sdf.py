@@ -8,8 +8,9 @@ Supported subset (SDF 1.6 to 1.11, the shape of Gazebo's own multirotor models):
   TinyXML2 accepts and strict XML does not is read (reedtool.io.tolerant_xml), with an
   "xml-tolerated" parse issue.
 * The model read is the `<model>` directly under `<sdf>`, else a model of a `<world>`:
-  the one named by `model_name` (`--model`), else the first non-static one with a
-  motor-model plugin, else the first non-static one (`load_sdf_models` returns them all).
+  the one named by `model_name` (`--model`), else the only non-static one with a
+  motor-model plugin, else the only non-static one; several are refused, naming them
+  (`load_sdf_models` returns them all).
   Nested `<model>`s are flattened with scoped names (`arm::rotor_0`); a plugin of a nested
   model names that model's joints and links, so its jointName/linkName are scoped too. A
   joint's `<parent>`/`<child>` naming a nested model is that model's canonical link (its
@@ -199,7 +200,15 @@ def _pick_model(root: etree._Element, file: Path, sources: SourceMap,
                             file=file, hint="pass one of the model names listed")
     candidates = _candidate_models(root, file, sources)
     with_motors = [m for m in candidates if _has_motor_plugin(m)]
-    return (with_motors or candidates)[0]
+    chosen = with_motors or candidates
+    if len(chosen) > 1:
+        # Taking the first would silently compute on a vehicle the user may not have meant.
+        names = ", ".join(repr(m.get("name")) for m in chosen)
+        raise ReedtoolError(f"the world holds {len(chosen)} models ({names}); this command "
+                            "reads one model at a time", file=file,
+                            hint="name one with --model NAME (`reedtool validate` checks "
+                                 "them all in one run)")
+    return chosen[0]
 
 
 # ------------------------------------------------------------------ frames
