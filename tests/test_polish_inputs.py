@@ -1,6 +1,7 @@
 """Inputs a new user gets wrong, found by using the product: each is one line naming the
 file and what to do, exit 2, and never a computation on a model the user did not name."""
 
+import json
 from pathlib import Path
 
 import pytest
@@ -51,3 +52,34 @@ def test_expand_names_what_it_was_given(model, says):
     assert code == 2
     last = out.strip().splitlines()[-1]
     assert str(model) in last and says in last
+
+
+def test_new_ros2_package_reads_as_one_model(tmp_path):
+    """`new-package --ros 2` writes worlds/NAME.sdf, a stage the launch file spawns the
+    robot into; `validate PKG` used to fail on it (exit 2) and every one-model command
+    refused the package as holding two models."""
+    code, out = run_cli("new-package", "stage_quad", "--ros", "2", "--sim", "gz",
+                        "-o", tmp_path)
+    assert code == 0, out
+    package = tmp_path / "stage_quad"
+    world = package / "worlds" / "stage_quad.sdf"
+    assert world.is_file()
+    code, out = run_cli("validate", package)
+    assert code == 0, out
+    assert "stage_quad.urdf.xacro" in out and "could not be read" not in out
+    code, out = run_cli("inertia", package, "--format", "json")
+    assert code == 0, out
+    code, out = run_cli("validate", world)         # named on its own: says what it is
+    assert code == 2 and "stage_quad.sdf" in out and "spawns the robot" in out and "--launch" in out
+
+
+def test_world_with_an_include_is_still_a_model(tmp_path):
+    """Only a world with nothing but static models is a stage: an included vehicle is read."""
+    (tmp_path / "package.xml").write_text("<package format='3'><name>w</name></package>")
+    (tmp_path / "worlds").mkdir()
+    (tmp_path / "worlds" / "w.sdf").write_text(
+        "<sdf version='1.9'><world name='w'><include><uri>model://x500</uri></include>"
+        "</world></sdf>")
+    code, out = run_cli("hover-test", tmp_path, "--package-path", MODELS, "--format", "json")
+    assert code in (0, 1), out
+    assert json.loads(out)["model"]["name"] == "x500"

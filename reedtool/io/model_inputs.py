@@ -15,7 +15,8 @@ a list of model files:
   passes it when it changes);
 - a directory holding `model.sdf`: that SDF model;
 - a ROS package (a directory with `package.xml`): the top-level models of its `urdf/`
-  (and `models/`, `sdf/` for SDF), skipping xacro macro libraries;
+  (and `models/`, `sdf/`, `worlds/` for SDF), skipping xacro macro libraries and worlds
+  that hold no vehicle (only static models: the launch file spawns the robot);
 - any other directory: the top-level models below it, recursively;
 - a glob (`urdf/*.xacro`, `**/*.urdf`): the matching files, sorted.
 
@@ -90,9 +91,36 @@ def is_macro_library(path: Path) -> bool:
     return bool(children) and all(c in _LIBRARY_CHILDREN for c in children)
 
 
+def is_scene_world(path: Path) -> bool:
+    """An SDF world with no vehicle in it: only static models, lights and systems, no
+    `<include>` (the launch file spawns the robot into it, as `new-package` writes them).
+    Found in a directory it is the stage, not a model; named on its own it is still read
+    (and says it has no model)."""
+    from lxml import etree
+
+    if path.suffix.lower() not in (".sdf", ".world"):
+        return False
+    try:
+        root = etree.parse(str(path), etree.XMLParser(remove_comments=True,
+                                                     resolve_entities=False,
+                                                     no_network=True)).getroot()
+    except (etree.XMLSyntaxError, OSError):
+        return False     # unreadable: let the loader report it
+    worlds = root.findall("world")
+    if root.tag != "sdf" or root.find("model") is not None or not worlds:
+        return False
+    for world in worlds:
+        if world.find("include") is not None:
+            return False
+        for model in world.findall("model"):
+            if (model.findtext("static") or "").strip().lower() not in ("true", "1"):
+                return False
+    return True
+
+
 def _top_level(files: list[Path], include_tree: Callable[[Path], Sequence[Path]],
                include_globs: Callable[[Path], Sequence[str]] | None = None) -> list[Path]:
-    candidates = [f for f in files if not is_macro_library(f)]
+    candidates = [f for f in files if not is_macro_library(f) and not is_scene_world(f)]
     included: set[Path] = set()
     # Every file's includes count, a library's too: a file that only includes the vehicle
     # picked by `$(arg mav_name)` reads like a library and still makes it a part. SDF is

@@ -179,6 +179,11 @@ def _candidate_models(root: etree._Element, file: Path,
         raise ReedtoolError(f"the world's <include> could not be read: {first.reason}",
                             file=first.file, line=first.line,
                             hint="set GZ_SIM_RESOURCE_PATH or pass --package-path DIR")
+    if _children(root, "world"):
+        raise ReedtoolError("no <model> found in the world but static ones: a launch file "
+                            "spawns the robot into such a world", file=file, line=root.sourceline,
+                            hint="name the robot's model file, or its launch file with "
+                                 "--launch FILE")
     raise ReedtoolError("no <model> found in the SDF file", file=file, line=root.sourceline,
                         hint="pass an SDF file that contains a <model>")
 
