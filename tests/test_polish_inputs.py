@@ -83,3 +83,22 @@ def test_world_with_an_include_is_still_a_model(tmp_path):
     code, out = run_cli("hover-test", tmp_path, "--package-path", MODELS, "--format", "json")
     assert code in (0, 1), out
     assert json.loads(out)["model"]["name"] == "x500"
+
+
+def test_authority_refuses_an_omnidirectional_frame():
+    """Its one-way 4-D ACAI called the omnicopter (which trims to hover, T/W 5 by the 6-DoF
+    allocation) 'not controllable at any thrust-to-weight', with thrust-to-weight 1.6e-8."""
+    model = FIXTURES / "omni" / "omni_reversible.sdf"
+    code, out = run_cli("hover-test", model, "--format", "json")
+    assert code == 0, out                      # the 6-DoF trim holds: a frame that hovers
+    code, out = run_cli("authority", model)
+    assert code == 2
+    last = out.strip().splitlines()[-1]
+    assert "omni_reversible.sdf" in last and "omnidirectional" in last
+
+
+def test_authority_on_a_fixed_wing_says_no_rotor_lifts():
+    """A plane has a motor plugin; 'no motor plugins found' was untrue."""
+    code, out = run_cli("authority", FIXTURES / "ardupilot" / "zephyr_pusher.sdf")
+    assert code == 2
+    assert "no lift rotors" in out and "no motor plugins" not in out

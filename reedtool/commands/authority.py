@@ -232,9 +232,21 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
     robot, vehicle, verdict = assembled.robot, assembled.vehicle, assembled.verdict
     # A VTOL's pusher or a plane's puller holds no hover: the lift rotors are analysed.
     rotors = vehicle.rotors
+    if len(rotors) < 1 and vehicle.every_rotor:
+        # A fixed-wing: motors exist, none lifts ("no motor plugins" would be untrue).
+        raise ReedtoolError(f"{vehicle.trim.message}: no hover to analyse", file=model,
+                            hint="authority analyses the lift rotors of a multirotor or VTOL")
     if len(rotors) < 1:
         raise ReedtoolError("no motor plugins found: nothing to analyse", file=model,
                             hint="authority needs RotorS, PX4 or gz-sim motor plugins")
+    if vehicle.omnidirectional:
+        # The ACAI here is the 4-D zonotope of rotors that push one way along body z: on
+        # reversible or many-direction rotors it reports a hovering frame as uncontrollable.
+        raise ReedtoolError(
+            f"{robot.name}: an omnidirectional frame (reversible or many-direction rotors); "
+            "authority's ACAI assumes rotors that push one way (thrust and three torques), "
+            "which does not apply to it", file=model,
+            hint="`reedtool validate` and `reedtool hover-test` check its 6-DoF hover trim")
     refused = bool(verdict.refusing) and not ignore_validation
     if fmt == "text":
         click.echo(validation_text(str(model), verdict.refusing, verdict.reported, refused,
