@@ -22,7 +22,12 @@ from reedtool.checks.rotor_rules import MAX_CONDITION_NUMBER, _normalised_alloca
 if TYPE_CHECKING:
     from reedtool.physics.rotors import Rotor
 
-THRUST_TO_WEIGHT_HIGH = 6.0
+# Above this no multirotor flies: camera and transport frames are built for 2-3, 5-inch
+# racing quads for 8-15, the lightest freestyle builds approach 20, and omnidirectional
+# frames carry margin because half their rotors push against the other half (PX4's
+# omnicopter 9.1, RotorS omav 6.3). 25 leaves room above the lightest real builds; a
+# copied speed or a unit mistake lands far beyond (gz-sim's test quadrotor: 147).
+THRUST_TO_WEIGHT_HIGH = 25.0
 # Whole-robot mass over the cube of the rotor span (2 x the farthest rotor from the COM):
 # real multirotors sit at 10-150 kg/m³ (x500 ~17, a 65 mm whoop ~90); above this the mass
 # belongs to a larger vehicle.
@@ -45,13 +50,17 @@ def _span_m(ctx: CheckContext) -> float:
 
 
 @rule("R340", "thrust-to-weight-high", "warning",
-      "Thrust-to-weight is above 6: the motor constants or speeds belong to another vehicle.")
+      "Thrust-to-weight is above 25: the motor constants or speeds belong to another vehicle.")
 def thrust_to_weight_high(ctx: CheckContext) -> Iterator[Issue]:
-    """Camera and transport multirotors fly with a thrust-to-weight ratio of 2-3, racing
-    quads up to 5-6. Far above that, the motor constant or maxRotVelocity was copied from
-    a larger vehicle or written in other units (gz-sim's test-world quadrotor with
-    maxRotVelocity 8000 reaches 147): the controller's output range then spans far more
-    thrust than the vehicle could have, and every gain tuned on it is wrong.
+    """Camera and transport multirotors fly with a thrust-to-weight ratio of 2-3, 5-inch
+    racing quads with 8-15, the lightest freestyle builds approach 20, and omnidirectional
+    frames need margin (PX4's omnicopter 9.1, RotorS omav 6.3): none of those is
+    suspicious. Above 25 no multirotor flies; the motor constant or maxRotVelocity was
+    copied from a larger vehicle or written in other units (gz-sim's test-world quadrotor
+    with maxRotVelocity 8000 reaches 147): the controller's output range then spans far
+    more thrust than the vehicle could have, and every gain tuned on it is wrong.
+
+    Severity (warning): the model loads and flies; only its numbers are implausible.
     """
     if not _physics_ready(ctx):
         return
