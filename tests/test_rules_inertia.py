@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
 import pytest
 from rule_helpers import FIXTURES, codes
 
-from reedtool.checks.runner import run_checks
+from reedtool.checks.runner import Selection, run_checks
 from reedtool.io.loader import load_robot
 
 CASES = [
@@ -21,7 +22,7 @@ CASES = [
     ("I207_bad_zero_total_mass.urdf", ["I207"]),
     ("I208_bad_massless_inertia.urdf", ["I208"]),
     ("I209_bad_placeholder.urdf", ["I209"]),
-    ("I209_bad_too_small.urdf", ["I209"]),
+    ("I204_bad_too_small_arm.urdf", ["I204"]),
     ("I205_bad_com.urdf", ["I205"]),
     ("I210_bad_mm_mesh.urdf", ["I210"]),
     # Good: zero mass on a fixed frame, a thin but valid cylinder, a mesh in metres.
@@ -60,3 +61,28 @@ def test_mm_mesh_hint_suggests_millimetre_scale():
     (finding,) = run_checks(load_robot(FIXTURES / "I210_bad_mm_mesh.urdf"))
     assert 'scale="0.001 0.001 0.001"' in finding.hint
     assert "60 m" in finding.message  # the 60 mm camera read as metres
+
+
+INERTIA_FIXTURES = Path(__file__).parent / "fixtures" / "inertia"
+
+
+def test_placeholder_links_are_not_compared():
+    """Control surfaces of 1e-8 kg (20,000x their plate) and a 1e-15 kg sonar frame: each
+    is under 0.1 % of the robot's mass and smallest moment, so no inertia finding and the
+    verdict says why. By hand: 1e-6 / Ixx_base 0.0433 = 2.3e-5 < 1e-3."""
+    from reedtool.physics.inertia import compare_links
+
+    robot = load_robot(INERTIA_FIXTURES / "placeholder_surface.urdf")
+    assert [f.code for f in run_checks(robot, Selection(select=("I",)))] == []
+    verdicts = {c.link: c.verdict for c in compare_links(robot)}
+    assert verdicts["left_elevon"] == verdicts["sonar_link"] == "placeholder"
+
+
+def test_placeholder_geometry_is_a_warning_not_an_error():
+    """omav's shape: 0.0004 kg·m² on a 5 mm box of 0.28 kg (box: 0.28·2·0.005²/12 =
+    1.17e-6 per axis, so 343x). Swapping the tensor moves the robot's smallest moment,
+    0.0433 + 0.0004 (the unit on the x axis), by under 1 %: I204 only."""
+    robot = load_robot(INERTIA_FIXTURES / "tilt_unit_placeholder_box.urdf")
+    findings = run_checks(robot, Selection(select=("I",)))
+    assert [(f.code, f.severity) for f in findings] == [("I204", "warning")]
+    assert "343x" in findings[0].message and "placeholder geometry" in findings[0].message

@@ -25,7 +25,7 @@ CASES = [
     ("fixed_wing_puller", ["R319"]),
     ("R316_bad_fixed_wing_negative_k", ["R316", "R319"]),
     ("tiltrotor", []),
-    ("I209_bad_tiltrotor_motor_inertia", ["I209", "I209"]),
+    ("I204_bad_tiltrotor_motor_inertia", ["I204", "I204"]),
     ("rotors_plus_quad", []),
     ("R304_bad_rotors_plus_quad_flipped", ["R304"]),
     ("quad_tailsitter", ["R320"]),

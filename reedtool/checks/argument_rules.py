@@ -16,7 +16,7 @@ from reedtool.checks.registry import rule
 
 
 @rule("S140", "xacro-argument-unknown", "warning",
-      "A name:=value argument names no argument the model declares or reads.")
+      "A name:=value argument names no argument the model declares or reads.", clause="suspicious")
 def argument_unknown(ctx: CheckContext) -> Iterator[Issue]:
     """xacro ignores an argument that no file of the model declares (`<xacro:arg>`) or
     reads (`$(arg ...)`), so a misspelt `mav_nmae:=hex` leaves the default in place without

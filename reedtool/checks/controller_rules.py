@@ -108,7 +108,7 @@ def _relative_gap(a: float, b: float) -> float:
 # --------------------------------------------------------------- table shape
 
 @rule("C401", "controller-rotor-count", "error",
-      "A controller rotor table has a different number of rotors than the model.")
+      "A controller rotor table has a different number of rotors than the model.", clause="flight-stack")
 def controller_rotor_count(ctx: CheckContext) -> Iterator[Issue]:
     """The controller's allocation matrix has one column per table entry and it sends that
     many motor speeds. With fewer entries than motors, some motors never receive a
@@ -125,7 +125,7 @@ def controller_rotor_count(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C402", "controller-rotor-joint-unknown", "error",
-      "A velocity-control rotor names a joint that has no motor plugin.")
+      "A velocity-control rotor names a joint that has no motor plugin.", clause="flight-stack")
 def controller_rotor_joint_unknown(ctx: CheckContext) -> Iterator[Issue]:
     """gz-sim's MulticopterVelocityControl finds each rotor by `<jointName>` and computes
     its arm from that joint's pose. A joint that does not exist makes gz-sim skip the
@@ -156,7 +156,7 @@ def controller_rotor_joint_unknown(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C403", "controller-rotor-order", "error",
-      "A velocity-control rotor's position in the table is not its motor number.")
+      "A velocity-control rotor's position in the table is not its motor number.", clause="flight-stack")
 def controller_rotor_order(ctx: CheckContext) -> Iterator[Issue]:
     """The controller publishes one speed per table entry, in table order; the motor plugin
     with `<motorNumber>k` spins at speed k. Entry i must therefore name the joint of the
@@ -175,7 +175,7 @@ def controller_rotor_order(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C411", "controller-entry-invalid", "error",
-      "A controller table entry is missing a value or cannot be read.")
+      "A controller table entry is missing a value or cannot be read.", clause="refused")
 def controller_entry_invalid(ctx: CheckContext) -> Iterator[Issue]:
     """Every entry needs all of its values: jointName, forceConstant, momentConstant and
     direction for gz-sim (which skips an incomplete rotor), and angle, arm_length,
@@ -194,7 +194,7 @@ def controller_entry_invalid(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C412", "controller-com-link-missing", "error",
-      "MulticopterVelocityControl's comLinkName is missing or names no link.")
+      "MulticopterVelocityControl's comLinkName is missing or names no link.", clause="refused")
 def controller_com_link_missing(ctx: CheckContext) -> Iterator[Issue]:
     """`<comLinkName>` is the body frame gz-sim measures rotor arms in and reads the
     vehicle state from, almost always the base link. Without it, or when it names no
@@ -216,7 +216,7 @@ def controller_com_link_missing(ctx: CheckContext) -> Iterator[Issue]:
 # --------------------------------------------------------------- per rotor
 
 @rule("C404", "controller-direction-mismatch", "error",
-      "A controller entry's direction disagrees with the motor's turningDirection.")
+      "A controller entry's direction disagrees with the motor's turningDirection.", clause="flight-stack")
 def controller_direction_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     """direction +1 means counter-clockwise seen from above (turningDirection `ccw`), -1
     clockwise; this is the convention of both RotorS (rotor_configuration `direction`)
@@ -259,7 +259,7 @@ def _angle_hint(ctx: CheckContext, entry: "ControllerRotor", model_rad: float,
 
 
 @rule("C405", "controller-angle-mismatch", "error",
-      "A controller entry's rotor angle disagrees with where the rotor is.")
+      "A controller entry's rotor angle disagrees with where the rotor is.", clause="flight-stack")
 def controller_angle_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     """RotorS's rotor_configuration `angle` [rad] is the rotor's bearing in the body
     xy-plane, measured from +x (forward) towards +y (left), i.e. counter-clockwise seen
@@ -283,13 +283,16 @@ def controller_angle_mismatch(ctx: CheckContext) -> Iterator[Issue]:
                     hint=_angle_hint(ctx, entry, model_rad, entry.angle_rad))
 
 
-@rule("C406", "controller-arm-length-mismatch", "error",
-      "A controller entry's arm length disagrees with where the rotor is.")
+@rule("C406", "controller-arm-length-mismatch", "warning",
+      "A controller entry's arm length disagrees with where the rotor is.", clause="suspicious")
 def controller_arm_length_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     """`arm_length` [m] is the rotor's distance from the body frame origin in the body
     xy-plane (the height of the rotor above the frame does not count). The controller
     scales roll and pitch torque with it: a wrong arm gives a wrong attitude gain on that
     axis. Tolerance: 1 mm or 1 %, whichever is larger.
+
+    Severity (warning): the torque keeps its sign, only its gain changes, so the vehicle
+    flies (C405 is the error: a rotor at another angle gets torque of the wrong sign).
     """
     for table in _tables(ctx):
         for entry, rotor in _pairs(ctx, table):
@@ -325,7 +328,7 @@ def _constant_issues(ctx: CheckContext, attr: str, rotor_attr: str, param: str,
 
 
 @rule("C407", "controller-force-constant-mismatch", "warning",
-      "A controller entry's force constant differs from the motor's motorConstant.")
+      "A controller entry's force constant differs from the motor's motorConstant.", clause="suspicious")
 def controller_force_constant_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     """The controller turns wanted thrust into rotor speed with its force constant; the
     motor turns speed into thrust with `motorConstant` [N/(rad/s)²]. If they differ by
@@ -338,7 +341,7 @@ def controller_force_constant_mismatch(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C408", "controller-moment-constant-mismatch", "warning",
-      "A controller entry's moment constant differs from the motor's momentConstant.")
+      "A controller entry's moment constant differs from the motor's momentConstant.", clause="suspicious")
 def controller_moment_constant_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     """The yaw drag torque is momentConstant [m] times thrust. A controller that assumes
     another value gets the wrong yaw authority: sluggish or oscillating heading.
@@ -352,7 +355,7 @@ def controller_moment_constant_mismatch(ctx: CheckContext) -> Iterator[Issue]:
 # --------------------------------------------------------------- vehicle
 
 @rule("C409", "controller-mass-mismatch", "warning",
-      "A controller's vehicle mass differs from the model's total mass.")
+      "A controller's vehicle mass differs from the model's total mass.", clause="suspicious")
 def controller_mass_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     """The controller's feed-forward thrust is mass x g. When its mass differs from the sum
     of the model's link masses by more than 1 %, the vehicle sinks or climbs until an
@@ -371,7 +374,7 @@ def controller_mass_mismatch(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C410", "controller-inertia-mismatch", "warning",
-      "A controller's inertia differs from the model's whole-robot inertia.")
+      "A controller's inertia differs from the model's whole-robot inertia.", clause="suspicious")
 def controller_inertia_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     """The controller's `inertia` is the whole vehicle's tensor about its centre of mass in
     body axes [kg·m²]; attitude control feeds forward with it. Each element is compared

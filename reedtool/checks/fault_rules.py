@@ -49,7 +49,7 @@ def _order(rotors, signs) -> str:
 
 
 @rule("R350", "spin-order-not-fault-tolerant", "info",
-      "No single rotor failure leaves full control, but another spin order would.")
+      "No single rotor failure leaves full control, but another spin order would.", clause="explains")
 def spin_order_not_fault_tolerant(ctx: CheckContext) -> Iterator[Issue]:
     """A multirotor with six or more rotors has spare actuators, yet with the common
     alternating spin order (ccw, cw, ccw, ...) of a hexacopter, losing any one rotor

@@ -125,7 +125,7 @@ def _px4_pairs(ctx: CheckContext, params: "Px4Params"
 # --------------------------------------------------------------- PX4: table shape
 
 @rule("C413", "px4-rotor-count", "error",
-      "CA_ROTOR_COUNT differs from the number of rotors in the model.")
+      "CA_ROTOR_COUNT differs from the number of rotors in the model.", clause="flight-stack")
 def px4_rotor_count(ctx: CheckContext) -> Iterator[Issue]:
     """PX4's control allocation builds one effectiveness column per CA rotor. With fewer
     CA rotors than motors in the model, some motors are never commanded; with more, PX4
@@ -146,7 +146,7 @@ def px4_rotor_count(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C414", "px4-output-mapping", "error",
-      "A CA rotor and the model's motors are not connected one to one through SIM_GZ_EC_FUNC.")
+      "A CA rotor and the model's motors are not connected one to one through SIM_GZ_EC_FUNC.", clause="flight-stack")
 def px4_output_mapping(ctx: CheckContext) -> Iterator[Issue]:
     """For Gazebo SITL, PX4 sends the command of ESC output k to the model's motor with
     actuator number k-1, and output k carries CA rotor i when SIM_GZ_EC_FUNCk is 101 + i
@@ -209,7 +209,7 @@ def _describes_other(ctx: CheckContext, ca: "Px4Rotor", rotor: "Rotor") -> str:
 
 
 @rule("C415", "px4-rotor-position", "error",
-      "A CA rotor sits in another quadrant, or more than 20° of bearing away, than its motor.")
+      "A CA rotor sits in another quadrant, or more than 20° of bearing away, than its motor.", clause="flight-stack")
 def px4_rotor_position(ctx: CheckContext) -> Iterator[Issue]:
     """CA_ROTORi_PX/PY are the rotor's position in FRD (x forward, y right) about the
     centre of gravity. PX4 derives each rotor's roll and pitch effectiveness from them;
@@ -236,7 +236,7 @@ def px4_rotor_position(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C423", "px4-rotor-position-offset", "info",
-      "A CA rotor's position differs from its motor's, without changing allocation signs.")
+      "A CA rotor's position differs from its motor's, without changing allocation signs.", clause="explains")
 def px4_rotor_position_offset(ctx: CheckContext) -> Iterator[Issue]:
     """A CA position in the right quadrant and within 20° of the model rotor's bearing
     allocates roll and pitch with the right signs, only with slightly different gains.
@@ -260,7 +260,7 @@ def px4_rotor_position_offset(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C416", "px4-rotor-spin", "error",
-      "The sign of CA_ROTORi_KM disagrees with its motor's turning direction.")
+      "The sign of CA_ROTORi_KM disagrees with its motor's turning direction.", clause="flight-stack")
 def px4_rotor_spin(ctx: CheckContext) -> Iterator[Issue]:
     """CA_ROTORi_KM is the yaw moment per thrust, positive for a rotor turning
     counter-clockwise seen from above and negative for clockwise (PX4 parameter reference,
@@ -283,7 +283,7 @@ def px4_rotor_spin(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C417", "px4-moment-ratio", "info",
-      "|CA_ROTORi_KM| differs from the motor's momentConstant.")
+      "|CA_ROTORi_KM| differs from the motor's momentConstant.", clause="explains")
 def px4_moment_ratio(ctx: CheckContext) -> Iterator[Issue]:
     """|KM| is PX4's yaw moment per thrust, the same quantity as the motor model's
     momentConstant. A different value scales PX4's yaw effectiveness, which the yaw
@@ -303,7 +303,7 @@ def px4_moment_ratio(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C418", "px4-thrust-axis", "error",
-      "A CA rotor's thrust axis is more than 10° from its motor's.")
+      "A CA rotor's thrust axis is more than 10° from its motor's.", clause="flight-stack")
 def px4_thrust_axis(ctx: CheckContext) -> Iterator[Issue]:
     """CA_ROTORi_AX/AY/AZ is the thrust direction in FRD (default 0, 0, -1: up). The model's
     rotor thrusts along its link's z axis, which in FRD is (x, -y, -z). A tilt PX4 does
@@ -331,7 +331,7 @@ def px4_thrust_axis(ctx: CheckContext) -> Iterator[Issue]:
 # --------------------------------------------------------------- PX4: command range
 
 @rule("C419", "px4-command-above-max", "warning",
-      "SIM_GZ_EC_MAX is above the motor's maxRotVelocity: the top of the range does nothing.")
+      "SIM_GZ_EC_MAX is above the motor's maxRotVelocity: the top of the range does nothing.", clause="suspicious")
 def px4_command_above_max(ctx: CheckContext) -> Iterator[Issue]:
     """The gz bridge scales PX4's motor output 0..1 to SIM_GZ_EC_MINk..SIM_GZ_EC_MAXk rad/s
     and the motor model clamps the command at maxRotVelocity. With MAX above that limit,
@@ -356,7 +356,7 @@ def px4_command_above_max(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C424", "px4-command-below-max", "warning",
-      "SIM_GZ_EC_MAX is below the motor's maxRotVelocity: full thrust is never reached.")
+      "SIM_GZ_EC_MAX is below the motor's maxRotVelocity: full thrust is never reached.", clause="suspicious")
 def px4_command_below_max(ctx: CheckContext) -> Iterator[Issue]:
     """With SIM_GZ_EC_MAXk below maxRotVelocity, PX4's full output commands less than the
     motor's top speed; thrust grows with speed squared, so the vehicle has
@@ -393,7 +393,7 @@ def _hover_speeds(ctx: CheckContext) -> dict[int, float] | None:
 
 
 @rule("C420", "px4-idle-command", "error",
-      "SIM_GZ_EC_MIN is not below the motor's hover speed (or not below SIM_GZ_EC_MAX).")
+      "SIM_GZ_EC_MIN is not below the motor's hover speed (or not below SIM_GZ_EC_MAX).", clause="flight-stack")
 def px4_idle_command(ctx: CheckContext) -> Iterator[Issue]:
     """SIM_GZ_EC_MINk is the rotor speed at PX4's zero output once armed. At or above the
     speed the rotor needs to hover the vehicle climbs at zero throttle and cannot
@@ -448,7 +448,7 @@ def _hover_message(params: "Px4Params", needed: float, setting: float) -> str:
 
 
 @rule("C421", "px4-hover-throttle", "info",
-      "MPC_THR_HOVER and the throttle the model needs at hover, side by side.")
+      "MPC_THR_HOVER and the throttle the model needs at hover, side by side.", clause="explains")
 def px4_hover_throttle(ctx: CheckContext) -> Iterator[Issue]:
     """MPC_THR_HOVER is the collective thrust PX4 starts from in position control
     (it learns the real value in flight when MPC_USE_HTE is on). reedtool computes what
@@ -465,7 +465,7 @@ def px4_hover_throttle(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C422", "px4-hover-throttle-mismatch", "warning",
-      "MPC_THR_HOVER is more than 0.15 from the throttle the model needs at hover.")
+      "MPC_THR_HOVER is more than 0.15 from the throttle the model needs at hover.", clause="suspicious")
 def px4_hover_throttle_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     """As C421, with the two values more than 0.15 apart: PX4 takes off with the wrong
     feed-forward, sinks or balloons after take-off until the hover thrust estimator
@@ -480,7 +480,7 @@ def px4_hover_throttle_mismatch(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C425", "px4-param-out-of-range", "warning",
-      "A PX4 parameter is outside the range PX4 documents for it.")
+      "A PX4 parameter is outside the range PX4 documents for it.", clause="suspicious")
 def px4_param_out_of_range(ctx: CheckContext) -> Iterator[Issue]:
     """reedtool knows the documented ranges of the parameters it reads (the PARAM_RANGES
     table in reedtool.flightstack.px4, with its sources): CA_ROTOR_COUNT 0..12,
@@ -550,7 +550,7 @@ def _output_text(output: int, line) -> str:
 
 
 @rule("C430", "ardupilot-frame-unknown", "warning",
-      "FRAME_CLASS/FRAME_TYPE is not set or names a frame reedtool has no motor table for.")
+      "FRAME_CLASS/FRAME_TYPE is not set or names a frame reedtool has no motor table for.", clause="suspicious")
 def ardupilot_frame_unknown(ctx: CheckContext) -> Iterator[Issue]:
     """ArduCopter's FRAME_CLASS defaults to 0 (undefined: the motors do not start).
     reedtool knows the motor tables of quad (plus, X, V, H, V-tail, A-tail, plus-rev,
@@ -570,7 +570,7 @@ def ardupilot_frame_unknown(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C431", "ardupilot-motor-count", "error",
-      "The ArduPilot frame has a different number of motors than the model has lift rotors.")
+      "The ArduPilot frame has a different number of motors than the model has lift rotors.", clause="flight-stack")
 def ardupilot_motor_count(ctx: CheckContext) -> Iterator[Issue]:
     """FRAME_CLASS fixes the number of motors ArduCopter mixes for (quad 4, hexa 6, octa
     and octaquad 8, Y6 6). A model with a different number of lift rotors cannot be flown
@@ -588,7 +588,7 @@ def ardupilot_motor_count(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C432", "ardupilot-motor-position", "error",
-      "An ArduPilot motor is driven on a rotor in another place than its frame puts it.")
+      "An ArduPilot motor is driven on a rotor in another place than its frame puts it.", clause="flight-stack")
 def ardupilot_motor_position(ctx: CheckContext) -> Iterator[Issue]:
     """Each ArduPilot frame puts motor m at a bearing from the nose (AP_MotorsMatrix); the
     mixer gives it roll and pitch factors from that bearing. The model rotor that output
@@ -620,7 +620,7 @@ def ardupilot_motor_position(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C433", "ardupilot-motor-spin", "error",
-      "An ArduPilot motor's spin disagrees with the turning direction of the rotor it drives.")
+      "An ArduPilot motor's spin disagrees with the turning direction of the rotor it drives.", clause="flight-stack")
 def ardupilot_motor_spin(ctx: CheckContext) -> Iterator[Issue]:
     """AP_MotorsMatrix gives every motor a yaw factor: +1 counter-clockwise, -1 clockwise
     seen from above. The rotor the motor's output drives must turn that way (the model's
@@ -644,7 +644,7 @@ def ardupilot_motor_spin(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C434", "ardupilot-motor-unassigned", "error",
-      "An ArduPilot motor reaches no rotor of the model, or a rotor gets no motor.")
+      "An ArduPilot motor reaches no rotor of the model, or a rotor gets no motor.", clause="flight-stack")
 def ardupilot_motor_unassigned(ctx: CheckContext) -> Iterator[Issue]:
     """Motor m goes out on the servo output whose SERVOn_FUNCTION is 32 + m (default:
     output m). When that output drives no rotor of the model, or a model rotor's output

@@ -92,7 +92,7 @@ def _with_geometry(ctx: CheckContext, link: Link, text: str) -> str:
     return f"{text}; {described} gives {_inertia_xml(I)}"
 
 
-@rule("I201", "mass-not-positive", "error", "A link's mass is negative, or zero on a moving link.")
+@rule("I201", "mass-not-positive", "error", "A link's mass is negative, or zero on a moving link.", clause="cannot-fly")
 def mass_not_positive(ctx: CheckContext) -> Iterator[Issue]:
     """A negative mass is never valid. A zero mass is fine on a link merged into its parent
     by a fixed joint (a frame marker), but a link that moves on its own joint needs mass:
@@ -113,7 +113,7 @@ def mass_not_positive(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("I202", "inertia-not-positive-definite", "error",
-      "A link's inertia tensor is not symmetric positive definite.")
+      "A link's inertia tensor is not symmetric positive definite.", clause="refused")
 def inertia_not_positive_definite(ctx: CheckContext) -> Iterator[Issue]:
     """The inertia tensor of a body with mass has three positive principal moments. A zero
     or negative moment (often a zero `ixx`/`iyy`/`izz`, or products of inertia larger than
@@ -135,7 +135,7 @@ def inertia_not_positive_definite(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("I203", "inertia-triangle-inequality", "error",
-      "A link's principal moments break the triangle inequality.")
+      "A link's principal moments break the triangle inequality.", clause="refused")
 def inertia_triangle_inequality(ctx: CheckContext) -> Iterator[Issue]:
     """For any real mass distribution each principal moment is at most the sum of the
     other two (A + B >= C; equality for a flat plate). Gazebo (gz-math) rejects a tensor
@@ -180,21 +180,36 @@ def _trace_findings(ctx: CheckContext, verdict: str) -> Iterator[Issue]:
         r_geom = math.sqrt(expected / (2 * link.inertial.mass_kg))
         way = "larger" if ratio > 1 else "smaller"
         factor = ratio if ratio > 1 else 1 / ratio
+        # The robot-level judgement (physics.inertia.judge_in_robot) says why a tensor
+        # 100x off is only a warning, or why it is an error.
+        why = comparison.message.split("; ", 1)[1] if "; " in comparison.message else ""
         yield Issue(f"link '{link.name}': inertia is {factor:,.3g}x {way} than "
-                    f"{described} (radius of gyration {_fmt(r_decl)} m vs {_fmt(r_geom)} m)",
+                    f"{described} (radius of gyration {_fmt(r_decl)} m vs {_fmt(r_geom)} m)"
+                    + (f"; {why}" if why else ""),
                     link.inertial.inertia_loc or link.inertial.loc, link.name,
                     hint=f"{described} gives {_inertia_xml(I_geom)}")
 
 
 @rule("I204", "inertia-implausible-for-geometry", "warning",
-      "A link's inertia is 10x to 100x from what its own geometry and mass give.")
+      "A link's inertia is 10x or more from what its own geometry and mass give, without "
+      "changing how the robot flies.", clause="ambiguous")
 def inertia_implausible_for_geometry(ctx: CheckContext) -> Iterator[Issue]:
     """Compares the declared tensor with that of the link's geometry (first collision,
     else first visual) filled uniformly with the declared mass, through the trace (twice
-    the mass times the squared radius of gyration). Between 10x and 100x off either way is
-    no real mass distribution (all mass in the corners of a box gives only 3x the solid
-    box's inertia), but a body built of a light shell and heavy parts far out may come
-    close, so it is a warning; 100x and beyond is I209, an error.
+    the mass times the squared radius of gyration). 10x off either way is no real mass
+    distribution (all mass in the corners of a box gives only 3x the solid box's inertia).
+
+    Severity (warning: suspicious, but the model loads and flies): reedtool cannot tell
+    which of the two is wrong, the tensor or a placeholder geometry (RotorS omav's
+    0.28 kg tilt units on 5 mm boxes), and the robot flies the same either way: swapping
+    the tensor for the geometry's changes none of the whole robot's principal moments by
+    2x. A tensor 100x off that does change them 2x or more is I209, an error.
+
+    Placeholder links are not compared: a link whose mass and whose inertia about the
+    robot's centre of mass are both under 0.1 % of the robot's (control surfaces of
+    1e-8 kg, a 1e-15 kg sonar frame) changes hover thrust and attitude response by less
+    than any flight stack resolves (physics.inertia.PLACEHOLDER_FRACTION has the
+    derivation).
 
     A rotor link driven by a motor plugin with `rotorVelocitySlowdownSim` s (RotorS, PX4
     classic, gz MulticopterMotorModel) may declare s times its geometry's inertia: RotorS
@@ -208,20 +223,26 @@ def inertia_implausible_for_geometry(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("I209", "inertia-orders-off-geometry", "error",
-      "A link's inertia is 100x or more from what its own geometry and mass give.")
+      "A link's inertia is 100x or more from its geometry's and decides how the robot flies.", clause="cannot-fly")
 def inertia_orders_off_geometry(ctx: CheckContext) -> Iterator[Issue]:
     """The declared tensor's trace is at least 100x larger or smaller than that of the
-    link's geometry filled uniformly with the declared mass. No mass distribution comes
-    within an order of magnitude of that: it is a placeholder (`1.0` copied into every
-    link: 43,000x for a 0.1 kg wheel of 6 cm radius) or a unit mistake (g·mm² or kg·mm²
-    for kg·m²), and the body spins up like a flywheel a thousand times its size (or,
-    too small, the solver becomes stiff and explodes). The RotorS slowdown convention is
-    recognised as for I204. `reedtool inertia` calls such a link "way-off" and exits 1.
+    link's geometry filled uniformly with the declared mass, and it matters: swapping
+    every such tensor of the robot for its geometry's changes a principal moment of the
+    whole robot by 2x or more, and this link's share of that change is a tenth or more.
+    It is a placeholder value (`1.0` copied into every link: 43,000x for a 0.1 kg wheel
+    of 6 cm radius) or a unit mistake (g·mm² or kg·mm² for kg·m²).
+
+    Severity (error: the model as written cannot do what it is for): the robot's attitude
+    dynamics are those of another body, beyond the 2x gain margin a controller tuned on
+    the real vehicle keeps. Where the robot flies the same with either tensor it is I204
+    (warning); placeholder links are not compared (see I204). The RotorS slowdown
+    convention is recognised as for I204. `reedtool inertia` calls such a link "way-off"
+    and exits 1.
     """
     yield from _trace_findings(ctx, "way-off")
 
 
-@rule("I207", "robot-mass-not-positive", "error", "The whole robot's mass is zero or negative.")
+@rule("I207", "robot-mass-not-positive", "error", "The whole robot's mass is zero or negative.", clause="cannot-fly")
 def robot_mass_not_positive(ctx: CheckContext) -> Iterator[Issue]:
     """The links' declared masses add up to zero or less (one link with `mass 0` or
     `-0.0`, or negative masses cancelling positive ones). Gazebo cannot integrate a body
@@ -236,7 +257,7 @@ def robot_mass_not_positive(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("I208", "massless-link-with-inertia", "error",
-      "A link has zero mass but a non-zero inertia.")
+      "A link has zero mass but a non-zero inertia.", clause="refused")
 def massless_link_with_inertia(ctx: CheckContext) -> Iterator[Issue]:
     """Inertia is mass times squared distance: a body with no mass has none. A zero mass
     with a non-zero tensor is a mass that was forgotten (or set to 0 to "switch the link
@@ -287,7 +308,7 @@ def link_geometry_bounds(ctx: CheckContext, link: Link) -> np.ndarray | None:
 
 
 @rule("I205", "com-outside-geometry", "warning",
-      "A link's centre of mass lies outside its geometry.")
+      "A link's centre of mass lies outside its geometry.", clause="suspicious")
 def com_outside_geometry(ctx: CheckContext) -> Iterator[Issue]:
     """The `<inertial><origin>` is the centre of mass in the link frame; it lies inside
     the link's visual and collision shapes (their bounding box, plus 10 %). Outside it,
@@ -390,7 +411,7 @@ def _mesh_scale_findings(ctx: CheckContext, certain: bool) -> Iterator[Issue]:
 
 
 @rule("I206", "mesh-scale-implausible", "warning",
-      "A mesh is implausibly large or small: perhaps the wrong unit.")
+      "A mesh is implausibly large or small: perhaps the wrong unit.", clause="ambiguous")
 def mesh_scale_implausible(ctx: CheckContext) -> Iterator[Issue]:
     """CAD tools export STL in millimetres by default, URDF reads metres: a 470 mm frame
     becomes 470 m. The size is the mesh as Gazebo loads it: its coordinates times the
@@ -406,7 +427,7 @@ def mesh_scale_implausible(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("I210", "mesh-unit-wrong", "error",
-      "A mesh is about 1000x too large or too small: certainly the wrong unit.")
+      "A mesh is about 1000x too large or too small: certainly the wrong unit.", clause="cannot-fly")
 def mesh_unit_wrong(ctx: CheckContext) -> Iterator[Issue]:
     """The mesh, sized as Gazebo loads it (see I206), is outside 1 mm - 20 m and the unit
     is certainly wrong, which is the case when any of these holds:

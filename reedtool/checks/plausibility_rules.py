@@ -50,7 +50,7 @@ def _span_m(ctx: CheckContext) -> float:
 
 
 @rule("R340", "thrust-to-weight-high", "warning",
-      "Thrust-to-weight is above 25: the motor constants or speeds belong to another vehicle.")
+      "Thrust-to-weight is above 25: the motor constants or speeds belong to another vehicle.", clause="suspicious")
 def thrust_to_weight_high(ctx: CheckContext) -> Iterator[Issue]:
     """Camera and transport multirotors fly with a thrust-to-weight ratio of 2-3, 5-inch
     racing quads with 8-15, the lightest freestyle builds approach 20, and omnidirectional
@@ -79,7 +79,7 @@ def thrust_to_weight_high(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("I220", "mass-implausible-for-size", "warning",
-      "The whole-robot mass or inertia does not fit the rotor span.")
+      "The whole-robot mass or inertia does not fit the rotor span.", clause="suspicious")
 def mass_implausible_for_size(ctx: CheckContext) -> Iterator[Issue]:
     """Two ratios that real multirotors keep whatever their size. Mass over the cube of
     the rotor span (twice the farthest rotor's distance from the COM) stays within about
@@ -117,7 +117,7 @@ def mass_implausible_for_size(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R341", "rotor-joint-axis-not-thrust-axis", "warning",
-      "A rotor's joint turns about another axis than the rotor's thrust axis.")
+      "A rotor's joint turns about another axis than the rotor's thrust axis.", clause="suspicious")
 def rotor_joint_axis(ctx: CheckContext) -> Iterator[Issue]:
     """The motor plugin pushes along the rotor link's z axis and spins the rotor about
     its joint axis. When the two differ by more than 5°, the propeller visibly wobbles,
@@ -148,7 +148,7 @@ def rotor_joint_axis(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R342", "uneven-hover-trim", "warning",
-      "At hover the rotor thrusts differ by more than 15 %: the COM is off the rotor centroid.")
+      "At hover the rotor thrusts differ by more than 15 %: the COM is off the rotor centroid.", clause="suspicious")
 def uneven_hover_trim(ctx: CheckContext) -> Iterator[Issue]:
     """With every lift rotor parallel, equal thrusts hold the vehicle level only when the
     centre of mass sits over the rotors' centroid. Otherwise some rotors hover harder than

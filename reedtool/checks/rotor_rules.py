@@ -107,7 +107,7 @@ def _number_loc(rotor: "Rotor"):
     return rotor.param_loc(rotor.number_tag)
 
 
-@rule("R301", "motor-number-duplicate", "error", "Two rotors have the same motor number.")
+@rule("R301", "motor-number-duplicate", "error", "Two rotors have the same motor number.", clause="cannot-fly")
 def motor_number_duplicate(ctx: CheckContext) -> Iterator[Issue]:
     """The motor number (`<motorNumber>`; gz-sim `<actuator_number>`; ArduPilot the
     `<control channel>`) is the rotor's index in the command the flight stack sends. Two
@@ -128,7 +128,7 @@ def motor_number_duplicate(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R302", "motor-numbers-not-contiguous", "error",
-      "Motor numbers are missing or not 0..n-1.")
+      "Motor numbers are missing or not 0..n-1.", clause="cannot-fly")
 def motor_numbers_not_contiguous(ctx: CheckContext) -> Iterator[Issue]:
     """With n rotors the motor numbers must be exactly 0, 1, ..., n-1: the command vector
     has n entries and a rotor numbered n or above never receives one. A missing or
@@ -159,7 +159,7 @@ def motor_numbers_not_contiguous(ctx: CheckContext) -> Iterator[Issue]:
                         if missing else None)
 
 
-@rule("R303", "rotor-direction-invalid", "error", "A rotor's turning direction is not cw or ccw.")
+@rule("R303", "rotor-direction-invalid", "error", "A rotor's turning direction is not cw or ccw.", clause="refused")
 def rotor_direction_invalid(ctx: CheckContext) -> Iterator[Issue]:
     """`<turningDirection>` must be exactly `ccw` or `cw` (lower case: the motor plugins
     compare the string). Anything else makes the plugin refuse to load or spin the
@@ -181,7 +181,7 @@ def rotor_direction_invalid(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R304", "yaw-moment-imbalance", "error",
-      "At equal rotor speed the rotors' yaw moments do not cancel.")
+      "At equal rotor speed the rotors' yaw moments do not cancel.", clause="cannot-fly")
 def yaw_moment_imbalance(ctx: CheckContext) -> Iterator[Issue]:
     """Each rotor's drag pushes the body the other way round (a ccw rotor pushes it cw),
     by momentConstant x thrust. When every rotor spins at the same speed these moments
@@ -276,7 +276,7 @@ _AXES = ("thrust", "roll", "pitch", "yaw")
 
 
 @rule("R305", "allocation-rank-deficient", "error",
-      "The rotors cannot set thrust, roll, pitch and yaw independently.")
+      "The rotors cannot set thrust, roll, pitch and yaw independently.", clause="cannot-fly")
 def allocation_rank_deficient(ctx: CheckContext) -> Iterator[Issue]:
     """The allocation matrix maps rotor thrusts to collective thrust and roll, pitch and
     yaw torque about the centre of mass; it is built from the rotors' positions, axes,
@@ -329,7 +329,7 @@ def _wrench_rank_deficient(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R306", "allocation-ill-conditioned", "warning",
-      "The allocation matrix is nearly singular.")
+      "The allocation matrix is nearly singular.", clause="suspicious")
 def allocation_ill_conditioned(ctx: CheckContext) -> Iterator[Issue]:
     """With each row scaled to unit norm, the allocation matrix of a symmetric frame has
     condition number 1. Above 25 one axis is controlled only by large, opposing thrust
@@ -347,7 +347,7 @@ def allocation_ill_conditioned(ctx: CheckContext) -> Iterator[Issue]:
 # ----------------------------------------------------------------------- trim
 
 @rule("R307", "trim-infeasible", "error",
-      "No rotor thrusts within [0, k·ω_max²] hold the robot level in hover.")
+      "No rotor thrusts within [0, k·ω_max²] hold the robot level in hover.", clause="cannot-fly")
 def trim_infeasible(ctx: CheckContext) -> Iterator[Issue]:
     """Hover needs thrusts that give collective thrust m·g and no torque about the
     centre of mass, each between 0 and the rotor's maximum k·ω_max². When the least-
@@ -396,7 +396,7 @@ def _max_loc(rotor: "Rotor"):
 
 
 @rule("R308", "thrust-to-weight-below-one", "error",
-      "At full speed the rotors cannot lift the robot.")
+      "At full speed the rotors cannot lift the robot.", clause="cannot-fly")
 def thrust_to_weight_below_one(ctx: CheckContext) -> Iterator[Issue]:
     """Thrust-to-weight is the rotors' combined upward thrust at maxRotVelocity,
     sum(k·ω_max²·axis_z), over the robot's weight m·g. Below 1 the model cannot leave
@@ -416,7 +416,7 @@ def thrust_to_weight_below_one(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R309", "thrust-to-weight-low", "warning",
-      "Thrust-to-weight is below 1.5: little margin to climb and control.")
+      "Thrust-to-weight is below 1.5: little margin to climb and control.", clause="suspicious")
 def thrust_to_weight_low(ctx: CheckContext) -> Iterator[Issue]:
     """A multirotor that can lift itself but with thrust-to-weight below 1.5 hovers near
     full throttle, with little left for attitude control or climbing; real vehicles are
@@ -434,7 +434,7 @@ def thrust_to_weight_low(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R310", "hover-throttle-high", "warning",
-      "A rotor needs more than 80 % of its maximum speed to hover.")
+      "A rotor needs more than 80 % of its maximum speed to hover.", clause="suspicious")
 def hover_throttle_high(ctx: CheckContext) -> Iterator[Issue]:
     """Hover throttle is the trim speed over maxRotVelocity. Above 0.8 for any rotor,
     that rotor has almost no speed left to correct attitude and the controller
@@ -456,7 +456,7 @@ def hover_throttle_high(ctx: CheckContext) -> Iterator[Issue]:
 
 # ------------------------------------------------------------------- geometry
 
-@rule("R311", "rotor-axis-tilted", "warning", "A rotor's thrust axis is not along body z.")
+@rule("R311", "rotor-axis-tilted", "warning", "A rotor's thrust axis is not along body z.", clause="suspicious")
 def rotor_axis_tilted(ctx: CheckContext) -> Iterator[Issue]:
     """Motor plugins push along the rotor link's z axis. For a conventional multirotor
     that axis is the base link's z; a tilt usually comes from an `rpy` on the rotor joint
@@ -486,7 +486,7 @@ def rotor_axis_tilted(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R312", "rotor-count-mismatch", "error",
-      "The MAVLink/PX4 interface declares a different number of rotors than exist.")
+      "The MAVLink/PX4 interface declares a different number of rotors than exist.", clause="flight-stack")
 def rotor_count_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     """The autopilot interface plugin forwards one motor command per declared rotor
     (`rotor_count`, or its control channels). More than there are motor plugins and the
@@ -510,7 +510,7 @@ def rotor_count_mismatch(ctx: CheckContext) -> Iterator[Issue]:
                         hint=f"set rotor_count to {found}")
 
 
-@rule("R313", "rotor-joint-not-continuous", "error", "A rotor turns on a joint that is not continuous.")
+@rule("R313", "rotor-joint-not-continuous", "error", "A rotor turns on a joint that is not continuous.", clause="cannot-fly")
 def rotor_joint_not_continuous(ctx: CheckContext) -> Iterator[Issue]:
     """A motor plugin spins its joint without end: the joint must be `continuous`. A
     revolute joint stops at its limits, a fixed one is merged away by Gazebo and the
@@ -524,7 +524,7 @@ def rotor_joint_not_continuous(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R314", "rotor-plugin-target-missing", "error",
-      "A motor plugin names a joint or link that does not exist.")
+      "A motor plugin names a joint or link that does not exist.", clause="refused")
 def rotor_plugin_target_missing(ctx: CheckContext) -> Iterator[Issue]:
     """`<jointName>` and `<linkName>` of a motor plugin must name the rotor's joint and
     link exactly (namespace prefix included); the plugin fails to load otherwise and the
@@ -551,7 +551,7 @@ def rotor_plugin_target_missing(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R315", "rotor-link-not-joint-child", "error",
-      "A motor plugin's link is not the child of its joint.")
+      "A motor plugin's link is not the child of its joint.", clause="cannot-fly")
 def rotor_link_not_joint_child(ctx: CheckContext) -> Iterator[Issue]:
     """The plugin spins `<jointName>` and applies thrust to `<linkName>`; they must be the
     same rotor: the link is the joint's child. Otherwise thrust is applied to a link that
@@ -569,7 +569,7 @@ def rotor_link_not_joint_child(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R316", "rotor-constant-invalid", "error",
-      "A rotor's motor constant, moment constant or maximum speed is missing or not positive.")
+      "A rotor's motor constant, moment constant or maximum speed is missing or not positive.", clause="cannot-fly")
 def rotor_constant_invalid(ctx: CheckContext) -> Iterator[Issue]:
     """`motorConstant` (thrust = k·ω², N/(rad/s)²) and `maxRotVelocity` (rad/s) must be
     positive and `momentConstant` (yaw drag torque per newton of thrust, m) must not be
@@ -619,7 +619,7 @@ def balanced_tilt(ctx: CheckContext):
 
 
 @rule("R317", "rotor-constants-estimated", "info",
-      "An ArduPilot rotor's thrust constants are estimated from its LiftDrag blades.")
+      "An ArduPilot rotor's thrust constants are estimated from its LiftDrag blades.", clause="explains")
 def rotor_constants_estimated(ctx: CheckContext) -> Iterator[Issue]:
     """ArduPilotPlugin models write no motor constant: thrust comes from LiftDrag plugins
     on the blades. reedtool estimates k_f = sum(0.5·rho·r²·area·cla·a0) over the blades
@@ -645,7 +645,7 @@ def rotor_constants_estimated(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R318", "ardupilot-spin-against-blades", "error",
-      "An ArduPilot channel spins its rotor against the way its blades make lift.")
+      "An ArduPilot channel spins its rotor against the way its blades make lift.", clause="cannot-fly")
 def ardupilot_spin_against_blades(ctx: CheckContext) -> Iterator[Issue]:
     """The ArduPilotPlugin turns the joint at `multiplier` × command about the joint axis,
     so the multiplier's sign is the spin direction. Each LiftDrag blade makes lift only
@@ -667,7 +667,7 @@ def ardupilot_spin_against_blades(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R319", "rotor-role", "info",
-      "Rotors that are not lift rotors, or an omnidirectional frame.")
+      "Rotors that are not lift rotors, or an omnidirectional frame.", clause="explains")
 def rotor_role(ctx: CheckContext) -> Iterator[Issue]:
     """A rotor whose thrust axis is 60-120° from body z on a vehicle that also has lift
     rotors (or a wing), pointing along body ±x or on a vehicle with a wing, is
@@ -690,7 +690,7 @@ def rotor_role(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R320", "rotor-tilt-pattern", "info",
-      "The rotors are tilted in a balanced pattern.")
+      "The rotors are tilted in a balanced pattern.", clause="explains")
 def rotor_tilt_pattern(ctx: CheckContext) -> Iterator[Issue]:
     """Some frames tilt every rotor on purpose: the AscTec Neo (RotorS neo9/neo11) tilts
     each rotor 5° sideways, alternating, for more yaw authority; tailsitters tilt theirs

@@ -33,7 +33,7 @@ def _fmt_names(names) -> str:
     return ", ".join(f"'{n}'" for n in names)
 
 
-@rule("S101", "urdf-parse-error", "error", "An element or attribute could not be read as URDF.")
+@rule("S101", "urdf-parse-error", "error", "An element or attribute could not be read as URDF.", clause="refused")
 def urdf_parse_error(ctx: CheckContext) -> Iterator[Issue]:
     """The URDF reader could not read an element: a number that is not a number, a missing
     required attribute (a link or joint without name=, a <mass> without value=), a missing
@@ -48,7 +48,7 @@ def urdf_parse_error(ctx: CheckContext) -> Iterator[Issue]:
             yield Issue(issue.message, issue.loc, issue.subject)
 
 
-@rule("S102", "non-finite-number", "error", "A number in the model is NaN or infinite.")
+@rule("S102", "non-finite-number", "error", "A number in the model is NaN or infinite.", clause="cannot-fly")
 def non_finite_number(ctx: CheckContext) -> Iterator[Issue]:
     """Every number in a URDF must be finite. `nan` and `inf` usually come from an xacro
     expression that divided by zero or used an undefined property default.
@@ -62,7 +62,7 @@ def non_finite_number(ctx: CheckContext) -> Iterator[Issue]:
                         hint="check the xacro expression that computes this value")
 
 
-@rule("S103", "legacy-xacro-tag", "error", "An old-style xacro tag was copied into the URDF.")
+@rule("S103", "legacy-xacro-tag", "error", "An old-style xacro tag was copied into the URDF.", clause="cannot-fly")
 def legacy_xacro_tag(ctx: CheckContext) -> Iterator[Issue]:
     """Old tutorials use `<property>`, `<include>`, `<macro>` and macro calls without the
     `xacro:` prefix. xacro 2.x no longer understands them and copies them into the URDF
@@ -79,7 +79,7 @@ def legacy_xacro_tag(ctx: CheckContext) -> Iterator[Issue]:
                         hint="use the xacro: prefix (reedtool expand --fix-legacy rewrites it)")
 
 
-@rule("S104", "single-root", "error", "The model must have exactly one root link.")
+@rule("S104", "single-root", "error", "The model must have exactly one root link.", clause="refused")
 def single_root(ctx: CheckContext) -> Iterator[Issue]:
     """A URDF is a tree: exactly one link is not the child of any joint. Two roots mean a
     joint is missing (or names the wrong child); urdfdom rejects the file with "two root
@@ -99,7 +99,7 @@ def single_root(ctx: CheckContext) -> Iterator[Issue]:
                         hint=f"add a joint with <child link=\"{name}\"/> to attach it")
 
 
-@rule("S105", "joint-link-missing", "error", "A joint's parent or child link does not exist.")
+@rule("S105", "joint-link-missing", "error", "A joint's parent or child link does not exist.", clause="refused")
 def joint_link_missing(ctx: CheckContext) -> Iterator[Issue]:
     """Every joint's `<parent link=>` and `<child link=>` must name a link of the model.
     A typo or a missing namespace prefix here makes urdfdom reject the file.
@@ -119,7 +119,7 @@ def _closest_hint(name: str, candidates) -> str:
     return f"did you mean '{close[0]}'?" if close else "declare the link or fix the name"
 
 
-@rule("S106", "duplicate-link-name", "error", "Two links have the same name.")
+@rule("S106", "duplicate-link-name", "error", "Two links have the same name.", clause="refused")
 def duplicate_link_name(ctx: CheckContext) -> Iterator[Issue]:
     """Link names must be unique. A macro instantiated twice without a distinct prefix or
     suffix is the usual cause; urdfdom rejects the file.
@@ -127,7 +127,7 @@ def duplicate_link_name(ctx: CheckContext) -> Iterator[Issue]:
     yield from _redeclared(ctx.robot.links, ctx.robot.link_map, "link")
 
 
-@rule("S107", "duplicate-joint-name", "error", "Two joints have the same name.")
+@rule("S107", "duplicate-joint-name", "error", "Two joints have the same name.", clause="refused")
 def duplicate_joint_name(ctx: CheckContext) -> Iterator[Issue]:
     """Joint names must be unique; urdfdom rejects the file otherwise, and Gazebo plugins
     that look a joint up by name would find only one of them.
@@ -146,7 +146,7 @@ def _redeclared(elements, first_by_name, kind: str) -> Iterator[Issue]:
         seen.add(element.name)
 
 
-@rule("S108", "link-multiple-parents", "error", "A link is the child of more than one joint.")
+@rule("S108", "link-multiple-parents", "error", "A link is the child of more than one joint.", clause="refused")
 def link_multiple_parents(ctx: CheckContext) -> Iterator[Issue]:
     """In a tree every link has at most one parent joint. A second joint naming the same
     child closes a loop that URDF cannot express.
@@ -159,7 +159,7 @@ def link_multiple_parents(ctx: CheckContext) -> Iterator[Issue]:
                         hint="each link can be the child of one joint only")
 
 
-@rule("S109", "kinematic-cycle", "error", "The joints form a cycle.")
+@rule("S109", "kinematic-cycle", "error", "The joints form a cycle.", clause="refused")
 def kinematic_cycle(ctx: CheckContext) -> Iterator[Issue]:
     """Following parent links from some link leads back to it. urdfdom reports this as
     "no root link found"; the links on the cycle are named here.
@@ -170,7 +170,7 @@ def kinematic_cycle(ctx: CheckContext) -> Iterator[Issue]:
                     joint.name, hint="remove or re-parent one of these joints")
 
 
-@rule("S110", "joint-type-invalid", "error", "A joint has an unknown type.")
+@rule("S110", "joint-type-invalid", "error", "A joint has an unknown type.", clause="refused")
 def joint_type_invalid(ctx: CheckContext) -> Iterator[Issue]:
     """URDF joint types are revolute, continuous, prismatic, fixed, floating and planar."""
     import difflib
@@ -183,7 +183,7 @@ def joint_type_invalid(ctx: CheckContext) -> Iterator[Issue]:
             yield Issue(f"joint '{joint.name}' has {what}", joint.loc, joint.name, hint=hint)
 
 
-@rule("S111", "joint-limit-missing", "error", "A revolute or prismatic joint lacks <limit>.")
+@rule("S111", "joint-limit-missing", "error", "A revolute or prismatic joint lacks <limit>.", clause="refused")
 def joint_limit_missing(ctx: CheckContext) -> Iterator[Issue]:
     """Revolute and prismatic joints need `<limit lower= upper= effort= velocity=/>`;
     urdfdom requires effort and velocity and rejects the joint without them. A spinning
@@ -204,7 +204,7 @@ def joint_limit_missing(ctx: CheckContext) -> Iterator[Issue]:
                         hint="urdfdom requires both effort= and velocity=")
 
 
-@rule("S112", "joint-limit-inverted", "error", "A joint's lower limit is above its upper limit.")
+@rule("S112", "joint-limit-inverted", "error", "A joint's lower limit is above its upper limit.", clause="cannot-fly")
 def joint_limit_inverted(ctx: CheckContext) -> Iterator[Issue]:
     """With lower > upper the allowed range is empty; simulators pin the joint or
     behave erratically.
@@ -217,7 +217,7 @@ def joint_limit_inverted(ctx: CheckContext) -> Iterator[Issue]:
                         f"{limit.upper:g}", limit.loc, joint.name, hint="swap lower and upper")
 
 
-@rule("S113", "joint-axis-zero", "error", "A moving joint's axis is the zero vector.")
+@rule("S113", "joint-axis-zero", "error", "A moving joint's axis is the zero vector.", clause="refused")
 def joint_axis_zero(ctx: CheckContext) -> Iterator[Issue]:
     """Revolute, continuous, prismatic and planar joints move along or about their
     `<axis xyz=>`, which must not be zero (it is normalised by every consumer).
@@ -231,7 +231,7 @@ def joint_axis_zero(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("S114", "gazebo-reference-missing", "warning",
-      "A <gazebo reference=> names no link or joint.")
+      "A <gazebo reference=> names no link or joint.", clause="suspicious")
 def gazebo_reference_missing(ctx: CheckContext) -> Iterator[Issue]:
     """A `<gazebo reference="NAME">` block applies to the link or joint called NAME.
     When there is none, Gazebo ignores the block silently: its material, friction or
@@ -264,7 +264,7 @@ def _refused(ctx: CheckContext, mesh: Mesh) -> bool:
     return bool(uri_problem(mesh.uri, mesh.path) or format_problem(mesh.uri, ctx.simulator))
 
 
-@rule("S115", "mesh-unresolved", "error", "A mesh file cannot be found or read.")
+@rule("S115", "mesh-unresolved", "error", "A mesh file cannot be found or read.", clause="refused")
 def mesh_unresolved(ctx: CheckContext) -> Iterator[Issue]:
     """Every `<mesh filename=>` must resolve to a readable file: `package://PKG/...`
     through the package search path, `file://` and plain paths relative to the model.
@@ -294,7 +294,7 @@ def mesh_unresolved(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("S130", "mesh-format-unsupported", "error",
-      "A mesh file is in a format the simulator cannot load.")
+      "A mesh file is in a format the simulator cannot load.", clause="refused")
 def mesh_format_unsupported(ctx: CheckContext) -> Iterator[Issue]:
     """Gazebo picks its mesh loader by file extension. Gazebo classic loads STL, COLLADA
     (.dae) and Wavefront OBJ; gz-sim (gz-common) also loads glTF (.gltf, .glb) and FBX.
@@ -318,14 +318,17 @@ def mesh_format_unsupported(ctx: CheckContext) -> Iterator[Issue]:
                         hint="export the part as STL or COLLADA (.dae) and reference that file")
 
 
-@rule("S131", "mesh-uri-escapes", "error",
-      "A mesh reference leaves its package or points at system files.")
+@rule("S131", "mesh-uri-escapes", "warning",
+      "A mesh reference leaves its package or points at system files.", clause="suspicious")
 def mesh_uri_escapes(ctx: CheckContext) -> Iterator[Issue]:
     """A `package://PKG/../../..` or `model://` path that climbs out of its package with
     `..`, or a reference into a system directory (`file:///etc/passwd`, `/proc/...`),
     is never a mesh: it makes every machine that loads the model open files outside the
     model (a leak when the model comes from someone else) and works on no other machine.
     reedtool does not open such a file.
+
+    Severity (warning): Gazebo follows the path and loads the model on this machine; the
+    reference is suspicious, not refused.
     """
     from reedtool.io.meshes import uri_problem
 
@@ -349,7 +352,7 @@ def _geometry_sizes(geometry) -> dict[str, float]:
     return {}
 
 
-@rule("S116", "geometry-size-invalid", "error", "A geometry has a zero or negative size.")
+@rule("S116", "geometry-size-invalid", "error", "A geometry has a zero or negative size.", clause="refused")
 def geometry_size_invalid(ctx: CheckContext) -> Iterator[Issue]:
     """Box sizes, cylinder radius and length, sphere radius and mesh scale must be
     positive. A zero size makes a collision shape degenerate (objects fall through it),
@@ -365,7 +368,7 @@ def geometry_size_invalid(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("S117", "link-dropped-by-sdf", "error",
-      "A moving link has no inertial or a mass below 1e-6 kg; Gazebo drops it.")
+      "A moving link has no inertial or a mass below 1e-6 kg; Gazebo drops it.", clause="refused")
 def link_dropped_by_sdf(ctx: CheckContext) -> Iterator[Issue]:
     """When Gazebo converts URDF to SDF it silently drops a link that is attached by a
     non-fixed joint and has no `<inertial>` or a mass below 1e-6 kg, together with its
@@ -412,7 +415,7 @@ def _keeps_fixed_joint(ctx: CheckContext, joint_name: str) -> bool:
 
 
 @rule("S118", "plugin-link-merged", "warning",
-      "A plugin names a link that fixed-joint lumping merges away.")
+      "A plugin names a link that fixed-joint lumping merges away.", clause="suspicious")
 def plugin_link_merged(ctx: CheckContext) -> Iterator[Issue]:
     """Gazebo merges every link attached by a fixed joint into its parent when it converts
     URDF to SDF, so the link's name no longer exists in the simulation. A plugin told to
@@ -446,7 +449,7 @@ def plugin_link_merged(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("S119", "xml-tolerated", "info",
-      "The file uses XML that Gazebo reads but strict XML tools reject.")
+      "The file uses XML that Gazebo reads but strict XML tools reject.", clause="explains")
 def xml_tolerated(ctx: CheckContext) -> Iterator[Issue]:
     """libsdformat parses with TinyXML2, which accepts `--` inside a comment and a
     namespace prefix (such as `gz:`) used without its `xmlns:` declaration. Gazebo loads
@@ -463,7 +466,7 @@ def xml_tolerated(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("S150", "package-name-ambiguous", "warning",
-      "Two ROS packages with the same name are on the search path; one is ignored.")
+      "Two ROS packages with the same name are on the search path; one is ignored.", clause="suspicious")
 def package_name_ambiguous(ctx: CheckContext) -> Iterator[Issue]:
     """`$(find pkg)` and `package://pkg/...` name a package, not a directory. When two
     packages of that name sit under one search root (a copied package, a backup next to

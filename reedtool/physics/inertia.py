@@ -9,7 +9,7 @@ place, `combine`, where parts are summed about their common COM.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from typing import Iterable
 
@@ -581,13 +581,120 @@ def moving_links(robot: Robot) -> set[str]:
 
 
 def compare_links(robot: Robot) -> list[LinkComparison]:
-    """compare_link for every link of the robot, in document order."""
+    """compare_link for every link of the robot, in document order, then judged in the
+    robot (judge_in_robot): a placeholder link, or a tensor whose error does not change
+    how the robot flies, is not an error."""
     moving = moving_links(robot)
     slowdowns = rotor_slowdown_by_link(robot)
     unreadable = unreadable_masses(robot)
-    return [compare_link(link, moving=link.name in moving, slowdown=slowdowns.get(link.name),
-                         mass_unreadable=link.name in unreadable)
-            for link in robot.links]
+    comparisons = [compare_link(link, moving=link.name in moving,
+                                slowdown=slowdowns.get(link.name),
+                                mass_unreadable=link.name in unreadable)
+                   for link in robot.links]
+    return judge_in_robot(robot, comparisons)
+
+
+# A link is a placeholder when its mass and its inertia about the robot's COM are both
+# below this fraction of the robot's. Derivation: hover thrust is proportional to the
+# mass, attitude response to the inverse inertia, so such a link changes either by less
+# than 0.1 %: ten times below the finest figure a flight stack is tuned to (PX4's
+# MPC_THR_HOVER resolution is 0.01 of full thrust; rate gains keep a 2x gain margin) and
+# below what a scale (1 g on 2 kg) or a pendulum test (1-5 %) measures. Control surfaces
+# of 1e-8 kg and sensor frames of 1e-15 kg are this: whatever their tensor, it cannot
+# change how the vehicle flies, so it is not compared.
+PLACEHOLDER_FRACTION = 1e-3
+# A way-off tensor (100x its geometry's) is an error when it changes how the robot flies:
+# swapping it for its geometry's changes a principal moment of the whole robot by this
+# factor or more. Attitude controllers keep about a 2x (6 dB) gain margin, so beyond it
+# the vehicle tuned on the real inertia is at the edge of stability, and a robot
+# dominated by one wrong tensor (a 0.1 kg wheel with 1.0 kg·m²) moves like another body.
+# Below it reedtool cannot tell a wrong tensor from a placeholder geometry (a 5 mm box
+# standing for a 0.28 kg tilt unit): a warning that says so.
+ROBOT_INERTIA_FACTOR = 2.0
+
+
+def _robot_frame(robot: Robot):
+    """(link poses in the base frame, whole-robot MassProperties) or None when the tree or
+    the masses leave them undefined."""
+    from reedtool.physics.kinematics import link_poses
+
+    try:
+        poses = link_poses(robot)
+    except (ReedtoolError, KeyError, ValueError):
+        return None
+    parts = []
+    for name, T_base_link in poses.items():
+        declared = declared_mass_properties(robot.link_map[name])
+        if declared is None:
+            continue
+        if not (np.isfinite(declared.mass_kg) and np.all(np.isfinite(declared.com_m))
+                and np.all(np.isfinite(declared.inertia_kg_m2))) or declared.mass_kg < 0:
+            return None
+        parts.append(declared.transformed(T_base_link))
+    whole = combine(parts)
+    if whole.mass_kg <= 0 or not np.all(np.isfinite(whole.inertia_kg_m2)):
+        return None
+    return poses, whole
+
+
+def _about_robot_com(part: MassProperties, T_base_link, com_m) -> np.ndarray:
+    return part.transformed(T_base_link).inertia_about(com_m)
+
+
+def judge_in_robot(robot: Robot, comparisons: list[LinkComparison]) -> list[LinkComparison]:
+    """Lower way-off and implausible verdicts that cannot matter to the robot; the others
+    are returned unchanged.
+
+    A placeholder (PLACEHOLDER_FRACTION) is not compared. A way-off tensor stays an error
+    when swapping every way-off tensor of the robot for its geometry's changes a principal
+    moment of the whole robot by ROBOT_INERTIA_FACTOR or more (several links may share one
+    copied value: the smartcar's 1.0 everywhere), and this link's own swap is a tenth or
+    more of that change; otherwise it is implausible (a warning saying why).
+    """
+    if not any(c.verdict in ("way-off", "implausible") for c in comparisons):
+        return comparisons
+    frame = _robot_frame(robot)
+    if frame is None:
+        return comparisons
+    poses, whole = frame
+    J_robot = whole.inertia_kg_m2
+    moments = principal_moments(J_robot)
+    if moments[0] <= 0:
+        return comparisons
+
+    judged: dict[str, tuple[str, str]] = {}        # link -> (verdict, message)
+    changes: dict[str, np.ndarray] = {}            # way-off link -> J_geometry - J_declared
+    for c in comparisons:
+        T = poses.get(c.link)
+        if c.verdict not in ("way-off", "implausible") or T is None or c.derived is None:
+            continue
+        J_declared = _about_robot_com(c.declared, T, whole.com_m)
+        mass_share = c.declared.mass_kg / whole.mass_kg
+        inertia_share = float(np.max(principal_moments(J_declared))) / float(moments[0])
+        if mass_share < PLACEHOLDER_FRACTION and inertia_share < PLACEHOLDER_FRACTION:
+            judged[c.link] = ("placeholder", (
+                f"{c.message}; a placeholder: {mass_share:.1e} of the whole-robot mass and "
+                f"{inertia_share:.1e} of its smallest moment cannot change how it flies"))
+        elif c.verdict == "way-off":
+            changes[c.link] = _about_robot_com(c.derived, T, whole.com_m) - J_declared
+    if changes:
+        total = sum(changes.values())
+        swapped = principal_moments(J_robot + total)
+        factor = float(np.max(np.maximum(swapped / moments,
+                                         moments / np.maximum(swapped, 1e-300))))
+        largest = float(np.max(np.abs(np.linalg.eigvalsh(total))))
+        for name, change in changes.items():
+            own = float(np.max(np.abs(np.linalg.eigvalsh(change))))
+            c = next(c for c in comparisons if c.link == name)
+            if factor >= ROBOT_INERTIA_FACTOR and own >= 0.1 * largest:
+                judged[name] = ("way-off", f"{c.message}; it changes the whole-robot inertia "
+                                           f"{factor:.3g}x")
+            else:
+                judged[name] = ("implausible", (
+                    f"{c.message}; the whole-robot inertia changes {factor:.3g}x at most "
+                    "with either: a wrong tensor or a placeholder geometry"))
+    return [replace(c, verdict=judged[c.link][0], message=judged[c.link][1])
+            if c.link in judged else c for c in comparisons]
 
 
 def robot_mass_problem(robot: Robot) -> str | None:
