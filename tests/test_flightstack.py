@@ -198,8 +198,17 @@ def test_out_of_range_value(tmp_path):
 
 
 def test_tilted_thrust_axis(tmp_path):
+    # 45° off the x500's upright rotor: most thrust still goes up, PX4 allocates a wrong
+    # side force (C426, warning); at 73° (AX 1, AZ -0.3: acos(0.3/1.044)) less than half does
+    # (C418, error).
     text = AIRFRAME + "param set-default CA_ROTOR0_AX 0.5\nparam set-default CA_ROTOR0_AZ -0.5\n"
-    assert not_info(px4_findings(tmp_path, text)) == ["C418"]
+    (finding,) = [f for f in px4_findings(tmp_path, text) if f.severity != "info"]
+    assert (finding.code, finding.severity) == ("C426", "warning")
+    assert "45.0°" in finding.message
+    text = AIRFRAME + "param set-default CA_ROTOR0_AX 1\nparam set-default CA_ROTOR0_AZ -0.3\n"
+    (finding,) = [f for f in px4_findings(tmp_path, text) if f.severity != "info"]
+    assert (finding.code, finding.severity) == ("C418", "error")
+    assert f"{math.degrees(math.acos(0.3 / math.hypot(1, 0.3))):.1f}°" in finding.message
 
 
 # --------------------------------------------------------------- ArduPilot tables
@@ -325,8 +334,19 @@ def test_vtol_pusher_is_a_ca_rotor_but_not_in_the_hover(tmp_path):
     findings = px4_findings(tmp_path, text, vtol)
     assert not_info(findings) == []                     # 5 CA rotors = 4 lift + the pusher
     assert "C421" in [f.code for f in findings]
+    # CA_AIRFRAME 2 drops the propeller torque of rotors that are not upward
+    # (enablePropellerTorqueNonUpwards(false)): the pusher's KM sign is not used.
     flipped = text.replace("CA_ROTOR4_KM 0.05", "CA_ROTOR4_KM -0.05")
+    assert not_info(px4_findings(tmp_path, flipped, vtol)) == []
+    # ... but a lift rotor's is.
+    flipped = text.replace("CA_ROTOR0_KM 0.05", "CA_ROTOR0_KM -0.05")
     assert not_info(px4_findings(tmp_path, flipped, vtol)) == ["C416"]
     level = text.replace("CA_ROTOR4_AX 1", "CA_ROTOR4_AX 0").replace("CA_ROTOR4_AZ 0",
                                                                        "CA_ROTOR4_AZ -1")
     assert not_info(px4_findings(tmp_path, level, vtol)) == ["C418"]
+    # CA_AIRFRAME 1 (fixed-wing) fixes every rotor forward whatever AX/AY/AZ say: the
+    # four lift rotors are 90° off, and the finding points at CA_AIRFRAME.
+    fixed_wing = text.replace("set-default CA_AIRFRAME 2", "set-default CA_AIRFRAME 1")
+    findings = [f for f in px4_findings(tmp_path, fixed_wing, vtol) if f.severity == "error"]
+    assert [f.code for f in findings] == ["C418"] * 4
+    assert {f.line for f in findings} == {line_of(fixed_wing, "set-default CA_AIRFRAME 1")}

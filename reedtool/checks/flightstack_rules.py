@@ -41,6 +41,7 @@ if TYPE_CHECKING:
 BEARING_TOL_DEG = 20.0          # allocation signs survive a bearing error up to this
 POSITION_INFO_M = 0.005          # smaller position differences are not worth a line
 AXIS_TOL_DEG = 10.0
+AXIS_ERROR_DEG = 60.0           # beyond: less than half the thrust goes where PX4 expects
 RANGE_REL_TOL = 1e-3
 KM_REL_TOL = 0.01
 HOVER_THROTTLE_TOL = 0.15
@@ -109,9 +110,20 @@ def _ardupilot(ctx: CheckContext) -> list["ArduPilotParams"]:
     return [p for p in ctx.flight_params if p.kind == "ardupilot"] if ctx.tree_ok else []
 
 
+def _px4_kind(params: "Px4Params"):
+    """The effectiveness class CA_AIRFRAME selects, when it reads a rotor table."""
+    from reedtool.flightstack.px4 import effectiveness
+
+    kind = effectiveness(params)
+    return kind if kind is not None and kind.rotor_table else None
+
+
 def _px4_pairs(ctx: CheckContext, params: "Px4Params"
                ) -> list[tuple["Px4Rotor", int, "Rotor"]]:
-    """(CA rotor, gz output k, model rotor on actuator k-1) for every connected pair."""
+    """(CA rotor, gz output k, model rotor on actuator k-1) for every connected pair; none
+    when CA_AIRFRAME selects no rotor table (rovers, helicopters)."""
+    if _px4_kind(params) is None:
+        return []
     by_actuator = {_actuator(r): r for r in _all_rotors(ctx) if _actuator(r) is not None}
     pairs = []
     for ca in params.rotors():
@@ -136,11 +148,10 @@ def px4_rotor_count(ctx: CheckContext) -> Iterator[Issue]:
     rotors = _all_rotors(ctx)
     for params in _px4(ctx):
         count = params.get("CA_ROTOR_COUNT")
-        if not rotors or count.value == len(rotors):
+        if not rotors or count.value == len(rotors) or _px4_kind(params) is None:
             continue
         where = ", ".join(str(r.loc) for r in rotors[:4]) + (", ..." if len(rotors) > 4 else "")
-        written = f"({count.loc})" if count.explicit else "(not set: PX4's default)"
-        yield Issue(f"CA_ROTOR_COUNT {count.value:g} {written}, but the model has "
+        yield Issue(f"{count.describe()}, but the model has "
                     f"{len(rotors)} rotor(s) ({where})", count.loc, "CA_ROTOR_COUNT",
                     hint=f"param set-default CA_ROTOR_COUNT {len(rotors)}")
 
@@ -221,6 +232,22 @@ def px4_rotor_position(ctx: CheckContext) -> Iterator[Issue]:
     for params in _px4(ctx):
         for ca, k, rotor in _px4_pairs(ctx, params):
             model = _frd_about_com(ctx, rotor)
+            axis = _ca_axis(params, ca)
+            if axis is None:
+                continue
+            if not _upward(axis):
+                conflict = _moment_conflict(ca, axis.axis_frd, model, rotor)
+                if conflict:
+                    yield Issue(f"{ca.where('PX', 'PY', 'PZ')} with thrust axis "
+                                f"({_vec(axis.axis_frd)}) ({axis.text}) gives a {conflict} "
+                                f"torque of the other sign than {_rotor_label(rotor)} on "
+                                f"output {k}, at ({_vec(model)}) m thrusting along "
+                                f"({_vec(_model_axis(rotor))}) (FRD about the COM)",
+                                ca.loc_of("PX"), f"CA_ROTOR{ca.index}",
+                                hint=f"param set-default CA_ROTOR{ca.index}_PX {model[0]:.4g}; "
+                                     f"CA_ROTOR{ca.index}_PY {model[1]:.4g}; "
+                                     f"CA_ROTOR{ca.index}_PZ {model[2]:.4g}")
+                continue
             ca_bearing, model_bearing = _bearing(ca.position_frd_m), _bearing(model)
             gap = _gap(ca_bearing, model_bearing)
             if gap <= BEARING_TOL_DEG and _same_quadrant(ca.position_frd_m, model):
@@ -246,6 +273,9 @@ def px4_rotor_position_offset(ctx: CheckContext) -> Iterator[Issue]:
     """
     for params in _px4(ctx):
         for ca, k, rotor in _px4_pairs(ctx, params):
+            axis = _ca_axis(params, ca)
+            if axis is None or not _upward(axis):
+                continue
             model = _frd_about_com(ctx, rotor)
             gap = _gap(_bearing(ca.position_frd_m), _bearing(model))
             if gap > BEARING_TOL_DEG or not _same_quadrant(ca.position_frd_m, model):
@@ -266,11 +296,19 @@ def px4_rotor_spin(ctx: CheckContext) -> Iterator[Issue]:
     counter-clockwise seen from above and negative for clockwise (PX4 parameter reference,
     control_allocator module.yaml). A sign that disagrees with the model's
     turningDirection makes PX4 yaw the wrong way with that rotor: on take-off the vehicle
-    spins up in yaw.
+    spins up in yaw. An unset KM is PX4's default 0.05 (counter-clockwise).
+
+    Only where PX4 uses KM: not on a fixed-wing (CA_AIRFRAME 1 disables propeller torque),
+    not for a standard VTOL's pusher (CA_AIRFRAME 2 drops the
+    propeller torque of rotors that are not upward), a tailsitter with 3 rotors or fewer, or
+    a tiltrotor whose tilt servos control yaw (CA_SV_TLk_CT 1 or 3).
+
+    Severity (error, flight-stack): PX4 yaws with the motor the other way.
     """
     for params in _px4(ctx):
         for ca, k, rotor in _px4_pairs(ctx, params):
-            if rotor.turning_sign == 0 or ca.km == 0 or not math.isfinite(ca.km):
+            if rotor.turning_sign == 0 or ca.km == 0 or not math.isfinite(ca.km) \
+                    or not _uses_km(params, ca):
                 continue
             if int(np.sign(ca.km)) != rotor.turning_sign:
                 yield Issue(f"{ca.where('KM')} says {SPIN_NAME[int(np.sign(ca.km))]}, but "
@@ -293,7 +331,8 @@ def px4_moment_ratio(ctx: CheckContext) -> Iterator[Issue]:
     for params in _px4(ctx):
         for ca, k, rotor in _px4_pairs(ctx, params):
             model = rotor.moment_constant
-            if not (math.isfinite(model) and model > 0 and math.isfinite(ca.km)):
+            if not (math.isfinite(model) and model > 0 and math.isfinite(ca.km)) \
+                    or not _uses_km(params, ca):
                 continue
             if abs(abs(ca.km) - model) > KM_REL_TOL * model:
                 yield Issue(f"{ca.where('KM')} vs momentConstant {model:g} of "
@@ -302,30 +341,150 @@ def px4_moment_ratio(ctx: CheckContext) -> Iterator[Issue]:
                             ca.loc_of("KM"), f"CA_ROTOR{ca.index}")
 
 
-@rule("C418", "px4-thrust-axis", "error",
-      "A CA rotor's thrust axis is more than 10° from its motor's.", clause="flight-stack")
-def px4_thrust_axis(ctx: CheckContext) -> Iterator[Issue]:
-    """CA_ROTORi_AX/AY/AZ is the thrust direction in FRD (default 0, 0, -1: up). The model's
-    rotor thrusts along its link's z axis, which in FRD is (x, -y, -z). A tilt PX4 does
-    not know about (or a tilt PX4 assumes that the model does not have) puts a force and
-    a torque into the allocation that the vehicle does not produce.
-    """
+def _ca_axis(params: "Px4Params", ca: "Px4Rotor"):
+    """PX4's hover thrust axis for CA rotor i (reedtool.flightstack.px4.rotor_axis)."""
+    from reedtool.flightstack.px4 import rotor_axis
+
+    kind = _px4_kind(params)
+    return rotor_axis(params, ca, kind) if kind is not None else None
+
+
+def _upward(axis) -> bool:
+    from reedtool.flightstack.px4 import is_upward
+
+    return is_upward(axis.axis_frd)
+
+
+def _uses_km(params: "Px4Params", ca: "Px4Rotor") -> bool:
+    from reedtool.flightstack.px4 import uses_yaw_moment
+
+    axis, kind = _ca_axis(params, ca), _px4_kind(params)
+    return axis is not None and uses_yaw_moment(params, kind, axis)
+
+
+def _model_axis(rotor: "Rotor") -> np.ndarray:
     from reedtool.flightstack.px4 import frd_from_flu
 
+    axis = frd_from_flu(rotor.axis)
+    norm = float(np.linalg.norm(axis))
+    return axis / norm if norm > 0 and math.isfinite(norm) else axis
+
+
+def _vec(v) -> str:
+    return ", ".join(f"{x:.3g}" for x in np.asarray(v, dtype=float) + 0.0)
+
+
+def _moment_conflict(ca: "Px4Rotor", ca_axis: np.ndarray, model_p: np.ndarray,
+                     rotor: "Rotor") -> str:
+    """'roll', 'pitch' or 'yaw' when PX4's torque per thrust (position x axis) and the
+    model's have a component of opposite sign, both beyond 20 % of the longer arm."""
+    ours = np.cross(ca.position_frd_m, ca_axis)
+    theirs = np.cross(model_p, _model_axis(rotor))
+    scale = 0.2 * max(float(np.linalg.norm(ca.position_frd_m)), float(np.linalg.norm(model_p)))
+    for i, name in enumerate(("roll", "pitch", "yaw")):
+        if abs(ours[i]) > scale and abs(theirs[i]) > scale and ours[i] * theirs[i] < 0:
+            return name
+    return ""
+
+
+def _axis_angles(ctx: CheckContext):
+    """(params, CA rotor, output, model rotor, PX4 axis, angle in degrees) per pair."""
     for params in _px4(ctx):
         for ca, k, rotor in _px4_pairs(ctx, params):
-            norm = float(np.linalg.norm(ca.axis_frd))
-            model = frd_from_flu(rotor.axis)
-            if norm == 0 or not np.all(np.isfinite(model)):
+            axis = _ca_axis(params, ca)
+            model = _model_axis(rotor)
+            if axis is None or not np.all(np.isfinite(model)) or np.linalg.norm(model) == 0:
                 continue
-            cos = float(np.dot(ca.axis_frd / norm, model / np.linalg.norm(model)))
-            angle = math.degrees(math.acos(max(-1.0, min(1.0, cos))))
-            if angle > AXIS_TOL_DEG:
-                yield Issue(f"{ca.where('AX', 'AY', 'AZ')}: thrust axis {angle:.1f}° from "
-                            f"{_rotor_label(rotor)}'s ({model[0]:.3g}, {model[1]:.3g}, "
-                            f"{model[2]:.3g} in FRD)", ca.loc_of("AZ"), f"CA_ROTOR{ca.index}",
-                            hint=f"CA_ROTOR{ca.index}_AX {model[0]:.3g}, _AY {model[1]:.3g}, "
-                                 f"_AZ {model[2]:.3g}")
+            cos = float(np.dot(axis.axis_frd, model))
+            yield params, ca, k, rotor, axis, math.degrees(math.acos(max(-1.0, min(1.0, cos))))
+
+
+def _axis_message(ca: "Px4Rotor", rotor: "Rotor", axis, angle: float) -> str:
+    return (f"PX4 allocates CA rotor {ca.index} along ({_vec(axis.axis_frd)}) in FRD "
+            f"({axis.text}): {angle:.1f}° from {_rotor_label(rotor)}'s thrust axis "
+            f"({_vec(_model_axis(rotor))})")
+
+
+def _axis_hint(ca: "Px4Rotor", rotor: "Rotor", axis) -> str | None:
+    model = _model_axis(rotor)
+    if axis.source != "parameters":
+        return "CA_AIRFRAME fixes this axis: choose the CA_AIRFRAME of the vehicle, or turn " \
+               "the rotor in the model"
+    return (f"CA_ROTOR{ca.index}_AX {model[0]:.3g}, _AY {model[1]:.3g}, _AZ {model[2]:.3g}")
+
+
+@rule("C418", "px4-thrust-axis", "error",
+      "PX4 allocates a rotor along an axis more than 60° from the model's.",
+      clause="flight-stack")
+def px4_thrust_axis(ctx: CheckContext) -> Iterator[Issue]:
+    """The thrust axis PX4 allocates CA rotor i with depends on CA_AIRFRAME
+    (ActuatorEffectivenessRotors' axis configuration): multirotor, standard VTOL,
+    tailsitter and custom airframes read CA_ROTORi_AX/AY/AZ (default 0, 0, -1: up);
+    fixed-wing fixes every rotor forward (1, 0, 0) and ignores the parameters; a tiltrotor's
+    rotor with CA_ROTORi_TILT follows its tilt servo (hover: the servo's minimum angle
+    CA_SV_TLk_MINA in direction CA_SV_TLk_TD). The model's rotor thrusts along its link's z
+    axis, in FRD (x, -y, -z).
+
+    Severity (error, flight-stack): more than 60° apart, less than half of the thrust PX4
+    counts on goes where it expects (cos 60° = 0.5): PX4 uses the rotor for an axis it
+    does not serve (a pusher for lift, a lift rotor for forward thrust) and the vehicle
+    cannot hover or fly as commanded. 10°-60° is C426 (warning) or C427 (information).
+    """
+    for params, ca, k, rotor, axis, angle in _axis_angles(ctx):
+        if angle > AXIS_ERROR_DEG:
+            yield Issue(_axis_message(ca, rotor, axis, angle), _axis_loc(params, ca, axis),
+                        f"CA_ROTOR{ca.index}", hint=_axis_hint(ca, rotor, axis))
+
+
+def _axis_loc(params: "Px4Params", ca: "Px4Rotor", axis):
+    if axis.source == "parameters":
+        return ca.loc_of("AZ")
+    return params.get("CA_AIRFRAME").loc
+
+
+def _axis_ignored(ctx: CheckContext, axis) -> bool:
+    """PX4 cannot be told the tilt (a fixed axis), or the model's tilt is a balanced
+    pattern (R320) whose side forces cancel: leaving it out of PX4's table is the
+    convention (PX4's quadtailsitter)."""
+    from reedtool.checks.rotor_rules import balanced_tilt
+
+    return axis.source != "parameters" or balanced_tilt(ctx) is not None
+
+
+@rule("C426", "px4-thrust-axis-offset", "warning",
+      "A CA rotor's configured thrust axis is 10°-60° from its motor's.", clause="suspicious")
+def px4_thrust_axis_offset(ctx: CheckContext) -> Iterator[Issue]:
+    """As C418, for an axis PX4 reads from CA_ROTORi_AX/AY/AZ that is 10°-60° from the
+    model rotor's, where the model's tilt is not a balanced pattern: PX4 puts a force and a
+    torque into its allocation that the vehicle does not produce, so attitude and position
+    control fight a steady error.
+
+    Severity (warning: suspicious, but the vehicle loads and flies): most of the thrust
+    still goes where PX4 expects it. The hint gives the axis to write.
+    """
+    for params, ca, k, rotor, axis, angle in _axis_angles(ctx):
+        if AXIS_TOL_DEG < angle <= AXIS_ERROR_DEG and not _axis_ignored(ctx, axis):
+            yield Issue(_axis_message(ca, rotor, axis, angle), _axis_loc(params, ca, axis),
+                        f"CA_ROTOR{ca.index}", hint=_axis_hint(ca, rotor, axis))
+
+
+@rule("C427", "px4-thrust-axis-fixed", "info",
+      "A rotor is tilted 10°-60° from the axis PX4 fixes or assumes for it, by convention.",
+      clause="ambiguous")
+def px4_thrust_axis_fixed(ctx: CheckContext) -> Iterator[Issue]:
+    """As C426, where the difference is the convention rather than a mistake: CA_AIRFRAME
+    fixes the axis (fixed-wing: forward), so there is no parameter to set, or the model's
+    rotors are tilted in a balanced pattern (R320: side forces and tilt torques cancel at
+    equal thrust, as on PX4's own quadtailsitter with its 0.17 rad tilts) that PX4's table
+    leaves out on purpose.
+
+    Severity (information): reedtool cannot tell the convention from a mistake here, so it
+    says what it sees.
+    """
+    for params, ca, k, rotor, axis, angle in _axis_angles(ctx):
+        if AXIS_TOL_DEG < angle <= AXIS_ERROR_DEG and _axis_ignored(ctx, axis):
+            yield Issue(_axis_message(ca, rotor, axis, angle), _axis_loc(params, ca, axis),
+                        f"CA_ROTOR{ca.index}")
 
 
 # --------------------------------------------------------------- PX4: command range
@@ -397,19 +556,22 @@ def _hover_speeds(ctx: CheckContext) -> dict[int, float] | None:
 def px4_idle_command(ctx: CheckContext) -> Iterator[Issue]:
     """SIM_GZ_EC_MINk is the rotor speed at PX4's zero output once armed. At or above the
     speed the rotor needs to hover the vehicle climbs at zero throttle and cannot
-    descend; at or above SIM_GZ_EC_MAXk the command range is empty.
+    descend; at or above SIM_GZ_EC_MAXk the command range is empty. A reversible rotor
+    (PX4's omnicopter) is commanded both ways and has no idle speed to compare.
+
+    Severity (error, flight-stack): PX4 cannot command the motor below what it needs.
     """
     hover = _hover_speeds(ctx)
     for params in _px4(ctx):
         for ca, k, rotor in _px4_pairs(ctx, params):
             low, high = params.get(f"SIM_GZ_EC_MIN{k}"), params.get(f"SIM_GZ_EC_MAX{k}")
             if low.value >= high.value:
-                yield Issue(f"SIM_GZ_EC_MIN{k} {low.value:g} ({low.loc}) is not below "
-                            f"SIM_GZ_EC_MAX{k} {high.value:g} ({high.loc}): output {k} "
+                yield Issue(f"{low.describe()} is not below {high.describe()}: output {k} "
                             f"({_rotor_label(rotor)}) has no command range", low.loc,
                             f"SIM_GZ_EC_MIN{k}", hint="idle is usually 10-20 % of the maximum")
-            elif hover and id(rotor) in hover and low.value >= hover[id(rotor)]:
-                yield Issue(f"SIM_GZ_EC_MIN{k} {low.value:g} rad/s ({low.loc}) is at or above "
+            elif hover and id(rotor) in hover and not rotor.reversible \
+                    and low.value >= hover[id(rotor)]:
+                yield Issue(f"{low.describe()} rad/s is at or above "
                             f"the {hover[id(rotor)]:.0f} rad/s {_rotor_label(rotor)} needs to "
                             "hover: at zero throttle the vehicle still climbs", low.loc,
                             f"SIM_GZ_EC_MIN{k}",
@@ -422,8 +584,8 @@ def _hover_throttle(ctx: CheckContext, params: "Px4Params") -> tuple[float, floa
 
     hover = _hover_speeds(ctx)
     pairs = _px4_pairs(ctx, params)
-    if not hover or not pairs:
-        return None
+    if not hover or not pairs or ctx.omnidirectional:
+        return None     # 6-DoF hover (reversible rotors): no single collective throttle
     factor = params.get("THR_MDL_FAC").value
     needed = []
     for ca, k, rotor in pairs:
