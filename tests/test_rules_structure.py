@@ -46,6 +46,8 @@ CASES = [
     ("S118_good_body_name_lumped.urdf", []),
     ("S119_bad_tinyxml_only.sdf", ["S119"]),
     ("S119_good_strict.sdf", []),
+    # URDF is read through sdformat's URDF parser, TinyXML2 as well.
+    ("S119_bad_tinyxml_only.urdf", ["S119"]),
     # Good fixtures: the arm has a zero-mass fixed tool frame (fine), a plugin on a fixed
     # link kept by preserveFixedJoint, a limited revolute joint; the car a mesh in metres.
     ("clean_arm.urdf", []),

@@ -53,3 +53,51 @@ def test_colons_in_text_and_values_are_not_prefixes():
             '<uri a="x:y=1">model://m</uri>\n<note>see: a:b = c</note>\n</model>\n</sdf>\n')
     _root, tolerated = parse_tolerant(text, "f.sdf")
     assert [t.what for t in tolerated] == ["'--' inside a comment"]
+
+
+# --------------------------------------------------- every format Gazebo reads with it
+
+def test_collada_with_double_hyphen_comment_is_read(tmp_path):
+    """assimp reads COLLADA leniently: a '--' comment (a CAD exporter's command line) is a
+    mesh Gazebo shows, so reedtool reads its triangles too."""
+    from reedtool.io.dae import parse_dae
+
+    dae = ('<?xml version="1.0"?>\n<!-- exported -- with --units mm -->\n'
+           '<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">\n'
+           '<asset><unit meter="1"/><up_axis>Z_UP</up_axis></asset>\n'
+           '<library_geometries><geometry id="g"><mesh>\n'
+           '<source id="p"><float_array id="pa" count="9">0 0 0 1 0 0 0 1 0</float_array>\n'
+           '<technique_common><accessor source="#pa" count="3" stride="3">'
+           '<param name="X" type="float"/><param name="Y" type="float"/>'
+           '<param name="Z" type="float"/></accessor></technique_common></source>\n'
+           '<vertices id="v"><input semantic="POSITION" source="#p"/></vertices>\n'
+           '<triangles count="1"><input semantic="VERTEX" source="#v" offset="0"/>'
+           '<p>0 1 2</p></triangles>\n</mesh></geometry></library_geometries>\n'
+           '<library_visual_scenes><visual_scene id="s"><node id="n">'
+           '<instance_geometry url="#g"/></node></visual_scene></library_visual_scenes>\n'
+           '<scene><instance_visual_scene url="#s"/></scene>\n</COLLADA>\n')
+    with pytest.raises(etree.XMLSyntaxError):
+        etree.fromstring(dae.encode())
+    mesh = parse_dae(dae.encode(), tmp_path / "part.dae")
+    assert mesh.triangles.shape == (1, 3, 3)
+
+
+def test_launch_file_with_double_hyphen_comment_is_read(tmp_path):
+    from reedtool.io.launch import read_launch
+
+    (tmp_path / "quad.urdf").write_text('<robot name="q"><link name="b"/></robot>')
+    launch = tmp_path / "spawn.launch"
+    launch.write_text('<launch>\n<!-- run with --screen -- or not -->\n'
+                      '<arg name="model" default="$(dirname)/quad.urdf"/>\n'
+                      '<param name="robot_description" command="$(find xacro)/xacro '
+                      '$(arg model) mav_name:=q"/>\n</launch>\n')
+    call = read_launch(launch)
+    assert call.mappings.get("mav_name") == "q" and call.model.name == "quad.urdf"
+
+
+def test_urdf_still_refuses_what_tinyxml2_refuses():
+    from reedtool.io.urdf import parse_urdf
+
+    with pytest.raises(ReedtoolError) as exc:
+        parse_urdf('<robot name="r">\n<link name="a">\n</robot>\n', "r.urdf")
+    assert exc.value.line is not None and "malformed XML" in exc.value.message

@@ -63,7 +63,7 @@ from reedtool.errors import ReedtoolError
 from reedtool.frames import make_T, matrix_to_rpy, rpy_to_matrix
 from reedtool.io.resources import resolve_model_file_uri
 from reedtool.io.sdf_include import SourceFile, SourceMap, expand_includes
-from reedtool.io.tolerant_xml import local_tag, parse_tolerant
+from reedtool.io.tolerant_xml import local_tag, parse_tolerant, tolerated_message
 from reedtool.model import (
     INERTIA_KEYS,
     Box,
@@ -437,11 +437,8 @@ class _ModelReader:
             by_file.setdefault(source.path, []).append(tolerated)
         for path, items in by_file.items():
             items = sorted(set(items), key=lambda t: t.line)   # a file included twice
-            what = "; ".join(f"line {t.line}: {t.what}" for t in items)
-            self.issues.append(ParseIssue(
-                "xml-tolerated", f"Gazebo (TinyXML2) reads this file, but strict XML tools "
-                f"(xmllint, lxml, XML editors) reject it: {what}",
-                SourceLoc(str(path), items[0].line), path.name))
+            self.issues.append(ParseIssue("xml-tolerated", tolerated_message(items),
+                                          SourceLoc(str(path), items[0].line), path.name))
 
     def _T_link_X(self, link_scoped: str, scope: str, pose_el: etree._Element | None,
                   subject: str) -> np.ndarray:

@@ -1,7 +1,10 @@
-"""Parse SDF text the way libsdformat (TinyXML2) does: what TinyXML2 reads, reedtool reads.
+"""Parse model XML the way Gazebo's loaders do: what TinyXML2 reads, reedtool reads.
 
-TinyXML2 is not a validating XML parser. Gazebo therefore loads files that libxml2 (lxml,
-xmllint) refuses; two kinds occur in files people fly today:
+Every XML format reedtool reads for Gazebo goes through here: SDF (libsdformat parses it
+with TinyXML2), URDF (Gazebo converts it through sdformat's URDF parser, TinyXML2 again),
+COLLADA meshes and launch files. TinyXML2 is not a validating XML parser. Gazebo
+therefore loads files that libxml2 (lxml, xmllint) refuses; two kinds occur in files
+people fly today:
 
 * `--` inside a comment (gz-sim's own `examples/worlds/quadcopter.sdf`), which XML 1.0
   forbids;
@@ -46,9 +49,9 @@ class Tolerated:
     what: str          # what the construct is, for the message
 
 
-def _parser() -> etree.XMLParser:
+def _parser(remove_comments: bool = False) -> etree.XMLParser:
     return etree.XMLParser(remove_blank_text=False, resolve_entities=False, huge_tree=True,
-                           encoding="utf-8")
+                           encoding="utf-8", no_network=True, remove_comments=remove_comments)
 
 
 def _line_of(text: str, offset: int) -> int:
@@ -97,26 +100,42 @@ def _declare(text: str, prefixes: dict[str, int]) -> str:
     return text[:root.end()] + declarations + text[root.end():]
 
 
-def parse_tolerant(text: str, file: Path | str) -> tuple[etree._Element, list[Tolerated]]:
-    """(root element, what was tolerated) of XML text, or a one-line ReedtoolError."""
+def parse_tolerant(text: str, file: Path | str, *, remove_comments: bool = False,
+                   error: str = "malformed XML", line_known: bool = True,
+                   hint: str = "fix the XML syntax at that position",
+                   ) -> tuple[etree._Element, list[Tolerated]]:
+    """(root element, what was tolerated) of XML text, or a one-line ReedtoolError.
+
+    `error` starts the error message ("not a COLLADA file", "not a launch file");
+    `line_known` False when the text's lines are not the file's (an expansion's output).
+    """
     data = text.encode("utf-8")
+    parser = _parser(remove_comments)
     try:
-        return etree.fromstring(data, _parser()), []
+        return etree.fromstring(data, parser), []
     except etree.XMLSyntaxError as strict_error:
         cleaned, tolerated = _clean_comments(text)
         prefixes = _undeclared_prefixes(cleaned)
         tolerated += [Tolerated(line, f"namespace prefix '{p}:' used without an xmlns:{p} "
                                       "declaration") for p, line in sorted(prefixes.items())]
         if not tolerated:
-            raise ReedtoolError(f"malformed XML: {strict_error.msg}", file=file,
-                                line=strict_error.lineno,
-                                hint="fix the XML syntax at that position") from None
+            raise ReedtoolError(f"{error}: {strict_error.msg}", file=file,
+                                line=strict_error.lineno if line_known else None,
+                                hint=hint) from None
         try:
-            root = etree.fromstring(_declare(cleaned, prefixes).encode("utf-8"), _parser())
+            root = etree.fromstring(_declare(cleaned, prefixes).encode("utf-8"),
+                                    _parser(remove_comments))
         except etree.XMLSyntaxError as exc:
-            raise ReedtoolError(f"malformed XML: {exc.msg}", file=file, line=exc.lineno,
-                                hint="fix the XML syntax at that position") from None
+            raise ReedtoolError(f"{error}: {exc.msg}", file=file,
+                                line=exc.lineno if line_known else None, hint=hint) from None
         return root, sorted(tolerated, key=lambda t: t.line)
+
+
+def tolerated_message(items: list[Tolerated]) -> str:
+    """The one information message per file (S119) for what was tolerated in it."""
+    what = "; ".join(f"line {t.line}: {t.what}" for t in sorted(set(items), key=lambda t: t.line))
+    return (f"Gazebo (TinyXML2) reads this file, but strict XML tools (xmllint, lxml, XML "
+            f"editors) reject it: {what}")
 
 
 def local_tag(el: etree._Element) -> str:
