@@ -48,6 +48,8 @@ CASES = [
     ("S119_good_strict.sdf", []),
     # URDF is read through sdformat's URDF parser, TinyXML2 as well.
     ("S119_bad_tinyxml_only.urdf", ["S119"]),
+    # SDF models are held to SDFormat's joint types (ball, screw, universal, ...).
+    ("S110_good_sdf_ball_joint.sdf", []),
     # Good fixtures: the arm has a zero-mass fixed tool frame (fine), a plugin on a fixed
     # link kept by preserveFixedJoint, a limited revolute joint; the car a mesh in metres.
     ("clean_arm.urdf", []),

@@ -128,16 +128,29 @@ def motor_number_duplicate(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R302", "motor-numbers-not-contiguous", "error",
-      "Motor numbers are missing or not 0..n-1.", clause="cannot-fly")
+      "A motor has no number, or one its autopilot interface never commands.",
+      clause="cannot-fly")
 def motor_numbers_not_contiguous(ctx: CheckContext) -> Iterator[Issue]:
-    """With n rotors the motor numbers must be exactly 0, 1, ..., n-1: the command vector
-    has n entries and a rotor numbered n or above never receives one. A missing or
-    unreadable `<motorNumber>` is reported here as well.
+    """A motor plugin spins at the entry of the command vector its number names. The
+    vector is what the autopilot interface sends: RotorS's MAVLink interface sends
+    `rotor_count` entries (0..count-1), PX4 classic's fills entry `input_index` of each
+    control channel (a plane's puller is motor 4 because its channel's input_index is 4).
+    A motor whose number the interface never fills never spins. A missing or unreadable
+    `<motorNumber>` / `<actuator_number>` is reported as well.
+
+    Without such an interface (gz-sim, where PX4's gz bridge or another node sends the
+    commands) the numbers are the flight stack's outputs and a gap is no mistake by itself:
+    `--airframe` compares them with PX4's outputs (C414).
+
+    Severity (error, cannot-fly): the motor never receives a command.
     """
+    from reedtool.physics.rotors import command_vector
+
     # ArduPilot channels are servo outputs mapped by SERVOn_FUNCTION: any channel is fine.
     rotors = [r for r in _rotors(ctx) if r.kind != "ardupilot"]
     if not rotors:
         return
+    vector = command_vector(ctx.robot)
     for rotor in rotors:
         if rotor.motor_number is None:
             tag = rotor.number_tag
@@ -146,17 +159,21 @@ def motor_numbers_not_contiguous(ctx: CheckContext) -> Iterator[Issue]:
             yield Issue(f"rotor '{rotor.name}': {what}", _number_loc(rotor),
                         rotor.name, hint=f"add <{tag}>N</{tag}>, N from 0 to "
                                          f"{len(rotors) - 1}")
-    numbers = {r.motor_number for r in rotors if r.motor_number is not None}
-    expected = set(range(len(rotors)))
-    outside = sorted(numbers - expected)
-    missing = sorted(expected - numbers)
+    if vector is None:
+        return
+    used = {r.motor_number for r in rotors if r.motor_number is not None}
+    free = sorted(vector.indices - used)
     for rotor in rotors:
-        if rotor.motor_number in outside:
-            yield Issue(f"rotor '{rotor.name}' has {_number_what(rotor)} {rotor.motor_number}; "
-                        f"with {len(rotors)} rotors the numbers are 0..{len(rotors) - 1}",
+        if rotor.motor_number is not None and rotor.motor_number not in vector.indices:
+            indices = sorted(vector.indices)
+            shown = (f"{indices[0]}..{indices[-1]}" if indices == list(range(indices[0],
+                                                                              indices[-1] + 1))
+                     else ", ".join(map(str, indices)))
+            yield Issue(f"rotor '{rotor.name}' has {_number_what(rotor)} {rotor.motor_number}, "
+                        f"but the autopilot interface fills entries {shown} ({vector.what}, "
+                        f"{vector.loc}): this motor never receives a command",
                         _number_loc(rotor), rotor.name,
-                        hint=f"unused numbers: {', '.join(map(str, missing))}"
-                        if missing else None)
+                        hint=f"unused numbers: {', '.join(map(str, free))}" if free else None)
 
 
 @rule("R303", "rotor-direction-invalid", "error", "A rotor's turning direction is not cw or ccw.", clause="refused")
@@ -592,6 +609,29 @@ def rotor_constant_invalid(ctx: CheckContext) -> Iterator[Issue]:
                                  f" number in {unit}")
 
 
+# Beyond this angle between a rotor's joint axis and its thrust axis, "the way it spins
+# about its thrust axis" is not defined (the two are closer to perpendicular than parallel).
+SPIN_AXIS_UNDEFINED_DEG = 45.0
+
+
+def joint_axis_angle_deg(ctx: CheckContext, rotor: "Rotor") -> float | None:
+    """Angle between the rotor's joint axis (in the base frame) and its thrust axis, folded
+    to 0-90° (a joint axis either way spins the same rotor); None when undefined."""
+    if not ctx.tree_ok:
+        return None
+    poses = ctx.link_poses
+    joint = ctx.robot.joint_map.get(rotor.joint or "")
+    if joint is None or joint.child not in poses or not np.all(np.isfinite(rotor.axis)) \
+            or np.linalg.norm(rotor.axis) == 0:
+        return None
+    axis = np.asarray(joint.axis, dtype=float)
+    if not np.all(np.isfinite(axis)) or np.linalg.norm(axis) == 0:
+        return None
+    axis_base = poses[joint.child][:3, :3] @ (axis / np.linalg.norm(axis))
+    cos = abs(float(np.dot(axis_base, rotor.axis / np.linalg.norm(rotor.axis))))
+    return math.degrees(math.acos(min(1.0, cos)))
+
+
 # ------------------------------------------------- families, roles and patterns
 
 # A tilt pattern is balanced when, at equal thrust, the rotors' side forces and tilt yaw
@@ -653,10 +693,19 @@ def ardupilot_spin_against_blades(ctx: CheckContext) -> Iterator[Issue]:
     it pushes down. A multiplier whose sign disagrees with the blades (copying a cw
     rotor's control block onto a ccw rotor) makes that rotor push the vehicle to the
     ground at take-off.
+
+    A rotor whose joint turns about an axis more than 45° from its thrust axis has no
+    spin direction about that axis to compare (SITL_Models' alti_transition_quad's forward
+    motor turns about the vertical while its blades face forward): R341 reports the axis.
+
+    Severity (error, cannot-fly): the rotor pushes the wrong way.
     """
     for rotor in _rotors(ctx):
         if rotor.kind != "ardupilot" or rotor.blade_turning_sign == 0 or rotor.turning_sign == 0:
             continue
+        angle = joint_axis_angle_deg(ctx, rotor)
+        if angle is not None and angle > SPIN_AXIS_UNDEFINED_DEG:
+            continue    # the joint does not spin it about its thrust axis: R341 says so
         if rotor.blade_turning_sign != rotor.turning_sign:
             want = "ccw" if rotor.blade_turning_sign > 0 else "cw"
             yield Issue(f"rotor '{rotor.name}' (channel {rotor.channel}): multiplier "

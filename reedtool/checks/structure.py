@@ -24,6 +24,9 @@ SDF_MIN_MASS_KG = 1e-6
 _NON_FINITE_KINDS = {"non-finite"}
 _LEGACY_KINDS = {"legacy-xacro"}
 _TOLERATED_KINDS = {"xml-tolerated"}
+# libsdformat's joint types (sdf/1.x/joint.sdf): what an SDF <joint type=> may be.
+SDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "ball", "screw",
+                   "universal", "revolute2", "gearbox")
 _PACKAGE_KINDS = {"package-duplicate"}
 _PER_AXIS_JOINTS = {"revolute", "continuous", "prismatic", "planar"}
 _LIMITED_JOINTS = {"revolute", "prismatic"}
@@ -172,13 +175,18 @@ def kinematic_cycle(ctx: CheckContext) -> Iterator[Issue]:
 
 @rule("S110", "joint-type-invalid", "error", "A joint has an unknown type.", clause="refused")
 def joint_type_invalid(ctx: CheckContext) -> Iterator[Issue]:
-    """URDF joint types are revolute, continuous, prismatic, fixed, floating and planar."""
+    """URDF joint types are revolute, continuous, prismatic, fixed, floating and planar;
+    an SDF model's are SDFormat's: revolute, continuous, prismatic, fixed, ball, screw,
+    universal, revolute2 and gearbox (ardupilot_gazebo's zephyr_with_parachute hangs its
+    parachute on a ball joint). Each file is held to its own format, as its parser does.
+    """
     import difflib
 
+    types = SDF_JOINT_TYPES if ctx.robot.source_format == "sdf" else JOINT_TYPES
     for joint in ctx.robot.joints:
-        if joint.type not in JOINT_TYPES:
-            close = difflib.get_close_matches(joint.type, JOINT_TYPES, n=1)
-            hint = f"did you mean '{close[0]}'?" if close else f"use one of {', '.join(JOINT_TYPES)}"
+        if joint.type not in types:
+            close = difflib.get_close_matches(joint.type, types, n=1)
+            hint = f"did you mean '{close[0]}'?" if close else f"use one of {', '.join(types)}"
             what = f"type '{joint.type}'" if joint.type else "no type="
             yield Issue(f"joint '{joint.name}' has {what}", joint.loc, joint.name, hint=hint)
 
