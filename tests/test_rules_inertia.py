@@ -66,16 +66,24 @@ def test_mm_mesh_hint_suggests_millimetre_scale():
 INERTIA_FIXTURES = Path(__file__).parent / "fixtures" / "inertia"
 
 
-def test_placeholder_links_are_not_compared():
-    """Control surfaces of 1e-8 kg (20,000x their plate) and a 1e-15 kg sonar frame: each
-    is under 0.1 % of the robot's mass and smallest moment, so no inertia finding and the
-    verdict says why. By hand: 1e-6 / Ixx_base 0.0433 = 2.3e-5 < 1e-3."""
+def test_placeholder_links_are_not_compared(tmp_path):
+    """Control surfaces of 1e-8 kg (20,000x their plate, COM beyond it) and a 1e-15 kg sonar
+    frame: each is under 0.1 % of the robot's mass and smallest moment, so no inertia or
+    COM finding and the verdict says why. By hand: 1e-6 / Ixx_base 0.0433 = 2.3e-5 < 1e-3.
+    The same elevon at 0.1 kg is no placeholder: I204/I209 and I205 speak again."""
     from reedtool.physics.inertia import compare_links
 
     robot = load_robot(INERTIA_FIXTURES / "placeholder_surface.urdf")
     assert [f.code for f in run_checks(robot, Selection(select=("I",)))] == []
     verdicts = {c.link: c.verdict for c in compare_links(robot)}
     assert verdicts["left_elevon"] == verdicts["sonar_link"] == "placeholder"
+    heavy = (INERTIA_FIXTURES / "placeholder_surface.urdf").read_text().replace(
+        '<mass value="0.00000001"/>', '<mass value="0.1"/>')
+    path = tmp_path / "heavy.urdf"
+    path.write_text(heavy)
+    found = {f.code for f in run_checks(load_robot(path), Selection(select=("I",)))
+             if f.subject == "left_elevon"}
+    assert "I205" in found and found & {"I204", "I209"}
 
 
 def test_placeholder_geometry_is_a_warning_not_an_error():

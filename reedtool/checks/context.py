@@ -197,6 +197,13 @@ class CheckContext:
 
         return compare_links(self.robot)
 
+    @cached_property
+    def placeholder_links(self) -> set[str]:
+        """Links too light to change how the robot flies (physics.inertia.placeholder_links)."""
+        from reedtool.physics.inertia import placeholder_links
+
+        return placeholder_links(self.robot) if self.tree_ok else set()
+
     def geometry_mass_properties(self, link: Link):
         """Mass properties of the link's own geometry at its declared mass, in the link frame.
 

@@ -314,9 +314,14 @@ def com_outside_geometry(ctx: CheckContext) -> Iterator[Issue]:
     the link's visual and collision shapes (their bounding box, plus 10 %). Outside it,
     the usual cause is an origin given in the parent's frame, or the joint offset applied
     twice.
+
+    Severity (warning): the model loads and flies; where the mass sits may be a mistake.
+    Placeholder links (under 0.1 % of the robot's mass and inertia, see I204: PX4's
+    1e-8 kg control surfaces with their COM at the hinge's far end) are not judged.
     """
     for link in ctx.robot.links:
-        if not _massive(link) or _mesh_extent_implausible(ctx, link):
+        if not _massive(link) or link.name in ctx.placeholder_links \
+                or _mesh_extent_implausible(ctx, link):
             continue
         bounds = link_geometry_bounds(ctx, link)
         com = np.asarray(link.inertial.com_m, dtype=float)

@@ -641,6 +641,35 @@ def _about_robot_com(part: MassProperties, T_base_link, com_m) -> np.ndarray:
     return part.transformed(T_base_link).inertia_about(com_m)
 
 
+def _placeholder_shares(declared: MassProperties, T_base_link, whole: MassProperties,
+                        smallest_moment: float) -> tuple[float, float]:
+    """(mass share, inertia share) of a link in the robot; see PLACEHOLDER_FRACTION."""
+    J = _about_robot_com(declared, T_base_link, whole.com_m)
+    return (declared.mass_kg / whole.mass_kg,
+            float(np.max(principal_moments(J))) / smallest_moment)
+
+
+def placeholder_links(robot: Robot) -> set[str]:
+    """Links whose mass and inertia about the robot's COM are both under
+    PLACEHOLDER_FRACTION of the robot's: nothing about them can change how it flies."""
+    frame = _robot_frame(robot)
+    if frame is None:
+        return set()
+    poses, whole = frame
+    smallest = float(principal_moments(whole.inertia_kg_m2)[0])
+    if smallest <= 0:
+        return set()
+    out = set()
+    for name, T in poses.items():
+        declared = declared_mass_properties(robot.link_map[name])
+        if declared is None or not declared.mass_kg > 0:
+            continue
+        mass_share, inertia_share = _placeholder_shares(declared, T, whole, smallest)
+        if mass_share < PLACEHOLDER_FRACTION and inertia_share < PLACEHOLDER_FRACTION:
+            out.add(name)
+    return out
+
+
 def judge_in_robot(robot: Robot, comparisons: list[LinkComparison]) -> list[LinkComparison]:
     """Lower way-off and implausible verdicts that cannot matter to the robot; the others
     are returned unchanged.
@@ -669,8 +698,7 @@ def judge_in_robot(robot: Robot, comparisons: list[LinkComparison]) -> list[Link
         if c.verdict not in ("way-off", "implausible") or T is None or c.derived is None:
             continue
         J_declared = _about_robot_com(c.declared, T, whole.com_m)
-        mass_share = c.declared.mass_kg / whole.mass_kg
-        inertia_share = float(np.max(principal_moments(J_declared))) / float(moments[0])
+        mass_share, inertia_share = _placeholder_shares(c.declared, T, whole, float(moments[0]))
         if mass_share < PLACEHOLDER_FRACTION and inertia_share < PLACEHOLDER_FRACTION:
             judged[c.link] = ("placeholder", (
                 f"{c.message}; a placeholder: {mass_share:.1e} of the whole-robot mass and "
