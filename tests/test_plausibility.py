@@ -91,3 +91,15 @@ def test_racing_thrust_to_weight_is_not_suspicious(tmp_path, ratio):
     text = SDF.replace("<maxRotVelocity>1000.0",
                        f"<maxRotVelocity>{1000.0 * math.sqrt(26.0 / base):.3f}")
     assert codes(findings_of(tmp_path, text)) == ["R340"]
+
+
+def test_coaxial_rotors_have_no_span_to_judge(tmp_path):
+    """Every rotor within 5 mm of the body's vertical (a coaxial helicopter, the Sikorsky
+    X2's shape): 2.06 kg over a 10 mm span cube would be 2e6 kg/m³; I220 stays quiet."""
+    text = SDF
+    for x, y in (("0.174", "-0.174"), ("-0.174", "0.174"), ("0.174", "0.174"),
+                 ("-0.174", "-0.174")):
+        sx, sy = ("" if x[0] != "-" else "-"), ("" if y[0] != "-" else "-")
+        text = text.replace(f"{x} {y} 0.06", f"{sx}0.0035 {sy}0.0035 0.06")
+    assert text.count("0.0035") == 8
+    assert "I220" not in codes(findings_of(tmp_path, text))

@@ -94,3 +94,18 @@ def test_placeholder_geometry_is_a_warning_not_an_error():
     findings = run_checks(robot, Selection(select=("I",)))
     assert [(f.code, f.severity) for f in findings] == [("I204", "warning")]
     assert "343x" in findings[0].message and "placeholder geometry" in findings[0].message
+
+
+@pytest.mark.parametrize("factor, expected", [(1 / 20, []), (20, ["I204"])])
+def test_a_lighter_core_is_plausible_a_heavier_rim_is_not(tmp_path, factor, expected):
+    """The arm's 0.5 kg cylinder (r 0.05 m, 0.3 m) with its tensor scaled: 20x larger fits
+    no mass distribution inside it (all mass in the corners gives 3x at most), 1/20 does
+    (mass gathered at the axis), so only the larger one is a finding."""
+    m, r, h = 0.5, 0.05, 0.3
+    ixx, izz = m * (3 * r * r + h * h) / 12 * factor, m * r * r / 2 * factor
+    text = (FIXTURES / "I209_bad_placeholder.urdf").read_text().replace(
+        'ixx="1.0" ixy="0" ixz="0" iyy="1.0" iyz="0" izz="1.0"',
+        f'ixx="{ixx:.9g}" ixy="0" ixz="0" iyy="{ixx:.9g}" iyz="0" izz="{izz:.9g}"')
+    path = tmp_path / "arm.urdf"
+    path.write_text(text)
+    assert [f.code for f in run_checks(load_robot(path), Selection(select=("I",)))] == expected

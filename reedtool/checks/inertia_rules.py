@@ -191,13 +191,15 @@ def _trace_findings(ctx: CheckContext, verdict: str) -> Iterator[Issue]:
 
 
 @rule("I204", "inertia-implausible-for-geometry", "warning",
-      "A link's inertia is 10x or more from what its own geometry and mass give, without "
-      "changing how the robot flies.", clause="ambiguous")
+      "A link's inertia is 10x above (or 100x below) what its geometry and mass give, "
+      "without changing how the robot flies.", clause="ambiguous")
 def inertia_implausible_for_geometry(ctx: CheckContext) -> Iterator[Issue]:
     """Compares the declared tensor with that of the link's geometry (first collision,
     else first visual) filled uniformly with the declared mass, through the trace (twice
-    the mass times the squared radius of gyration). 10x off either way is no real mass
-    distribution (all mass in the corners of a box gives only 3x the solid box's inertia).
+    the mass times the squared radius of gyration). 10x larger is no real mass
+    distribution (all mass in the corners of a box gives only 3x the solid box's inertia);
+    smaller is, down to any share (a hub inside a large collision cylinder), so the
+    smaller side is reported from 100x (a radius of gyration a tenth of the solid's).
 
     Severity (warning: suspicious, but the model loads and flies): reedtool cannot tell
     which of the two is wrong, the tensor or a placeholder geometry (RotorS omav's

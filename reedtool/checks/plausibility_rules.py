@@ -35,6 +35,9 @@ SPAN_DENSITY_MAX_KG_M3 = 1000.0
 # Yaw radius of gyration sqrt(Izz/m) over the farthest rotor's distance from the COM: the
 # mass of a multirotor lies inside its rotor circle, so above this the inertia does not fit.
 GYRATION_RATIO_MAX = 1.5
+# Lift rotors all within this horizontal distance of the COM: a coaxial or single-rotor
+# helicopter (the Sikorsky X2 shape), whose size the rotor positions do not tell.
+SINGLE_AXIS_SPAN_M = 0.01
 JOINT_AXIS_TOL_DEG = 5.0
 TRIM_SPREAD_MAX = 0.15
 PARALLEL_TOL_DEG = 1.0
@@ -87,13 +90,17 @@ def mass_implausible_for_size(ctx: CheckContext) -> Iterator[Issue]:
     bounding cube. The yaw radius of gyration sqrt(Izz/m) stays inside the rotor circle:
     above 1.5 times the rotor distance the inertia puts the mass outside the rotors. Both
     catch a mass and inertia copied from a larger vehicle (1.5 kg on a 65 mm frame).
+    A coaxial or single-rotor helicopter (every lift rotor within 1 cm of the COM's
+    vertical) has no rotor span to compare with and is not judged.
+
+    Severity (warning): the model flies, like a vehicle of another size.
     """
     if not _physics_ready(ctx) or not _lift(ctx):
         return
     whole = ctx.whole_robot
     span = _span_m(ctx)
-    if span <= 0:
-        return
+    if span < SINGLE_AXIS_SPAN_M:
+        return      # coaxial or single-rotor: no rotor span to size the vehicle by
     rotor = _lift(ctx)[0]
     density = whole.mass_kg / (2.0 * span) ** 3
     if density > SPAN_DENSITY_MAX_KG_M3:

@@ -385,7 +385,8 @@ def inertial_xml(props: MassProperties, indent: str = "  ", rpy: str = "0 0 0") 
 # A real part is not a uniform solid of its collision shape, so only a large difference
 # means a wrong tensor: within 50 % is "ok". The trace (twice the mass times the squared
 # radius of gyration) decides plausibility: all mass in the corners of a box gives only 3x
-# the solid box's inertia, so beyond 10x (or 1/10) no real mass distribution fits
+# the solid box's inertia, so beyond 10x (below, only at 1/100: see _plausible) no real
+# mass distribution fits
 # (implausible, warning), and beyond 100x the tensor is a placeholder or a unit mistake
 # (1.0 everywhere, mm^2 for m^2) that certainly changes how the body flies (way-off, error).
 OK_REL_DIFF = 0.5
@@ -564,7 +565,14 @@ def compare_link(link: Link, *, moving: bool = False, slowdown: float | None = N
 
 
 def _plausible(ratio: float, factor: float = PLAUSIBLE_TRACE_RATIO) -> bool:
-    return 1.0 / factor < ratio < factor
+    """Within `factor` of the geometry's trace: above it, or below by ORDERS_OFF at least.
+
+    Asymmetric on purpose: a body inside its geometry has at most ~3x the uniform solid's
+    trace (all mass in the corners), so 10x more is no mass distribution; but any share
+    down to zero is one (a motor or a hub inside a large collision cylinder, a contact
+    sensor box around a light frame: PX4's bumper at 1/84), so smaller is judged only at
+    the orders-off bound, 1/100 (radius of gyration a tenth of the uniform body's)."""
+    return 1.0 / max(factor, ORDERS_OFF_TRACE_RATIO) < ratio < factor
 
 
 def _times(ratio: float) -> str:
