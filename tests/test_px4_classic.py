@@ -25,7 +25,7 @@ def codes(name: str, severities=("error", "warning")) -> list[str]:
     ("iris_template_channels.sdf", []),
     ("plane_puller_motor_4.sdf", []),
     ("R302_bad_unfilled_number.sdf", ["R302"]),
-    ("R312_bad_six_motor_channels.sdf", ["R312"]),
+    ("eight_channels_four_motors.sdf", []),
 ])
 def test_classic_interface_codes(name, expected):
     assert codes(name) == expected

@@ -50,6 +50,12 @@ CASES = [
     ("S119_bad_tinyxml_only.urdf", ["S119"]),
     # SDF models are held to SDFormat's joint types (ball, screw, universal, ...).
     ("S110_good_sdf_ball_joint.sdf", []),
+    # An SDF link without <inertial> is 1 kg to sdformat: a warning, not a parse error.
+    ("S120_bad_no_inertial.sdf", ["S120"]),
+    # A negative mesh scale mirrors: the convention for a visual (information), a warning
+    # on a collision (faces inside out); only a zero scale is S116.
+    ("S121_bad_mirrored_visual.urdf", ["S121"]),
+    ("S122_bad_mirrored_collision.urdf", ["S122"]),
     # Good fixtures: the arm has a zero-mass fixed tool frame (fine), a plugin on a fixed
     # link kept by preserveFixedJoint, a limited revolute joint; the car a mesh in metres.
     ("clean_arm.urdf", []),

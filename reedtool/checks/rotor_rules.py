@@ -505,10 +505,14 @@ def rotor_axis_tilted(ctx: CheckContext) -> Iterator[Issue]:
 @rule("R312", "rotor-count-mismatch", "error",
       "The MAVLink/PX4 interface declares a different number of rotors than exist.", clause="flight-stack")
 def rotor_count_mismatch(ctx: CheckContext) -> Iterator[Issue]:
-    """The autopilot interface plugin forwards one motor command per declared rotor
-    (`rotor_count`, or its control channels). More than there are motor plugins and the
-    autopilot mixes for a frame that does not exist; fewer and some rotors never spin. A
-    count that is not a whole number is reported too: the plugin cannot use it either.
+    """RotorS's autopilot interface plugin forwards one motor command per declared rotor
+    (`rotor_count`). More than there are motor plugins and the autopilot mixes for a frame
+    that does not exist; fewer and some rotors never spin. A count that is not a whole
+    number is reported too: the plugin cannot use it either. PX4 classic's control
+    channels declare no count (unused channels are unused outputs; a motor no channel
+    fills is R302).
+
+    Severity (error, flight-stack): the autopilot commands motors the model does not have.
     """
     if not ctx.tree_ok:
         return

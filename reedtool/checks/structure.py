@@ -24,6 +24,7 @@ SDF_MIN_MASS_KG = 1e-6
 _NON_FINITE_KINDS = {"non-finite"}
 _LEGACY_KINDS = {"legacy-xacro"}
 _TOLERATED_KINDS = {"xml-tolerated"}
+_DEFAULT_INERTIAL_KINDS = {"sdf-default-inertial"}
 # libsdformat's joint types (sdf/1.x/joint.sdf): what an SDF <joint type=> may be.
 SDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "ball", "screw",
                    "universal", "revolute2", "gearbox")
@@ -47,7 +48,8 @@ def urdf_parse_error(ctx: CheckContext) -> Iterator[Issue]:
     Fix the element at the reported line.
     """
     for issue in ctx.robot.parse_issues:
-        if issue.kind not in _NON_FINITE_KINDS | _LEGACY_KINDS | _TOLERATED_KINDS | _PACKAGE_KINDS:
+        if issue.kind not in _NON_FINITE_KINDS | _LEGACY_KINDS | _TOLERATED_KINDS \
+                | _PACKAGE_KINDS | _DEFAULT_INERTIAL_KINDS:
             yield Issue(issue.message, issue.loc, issue.subject)
 
 
@@ -301,6 +303,23 @@ def mesh_unresolved(ctx: CheckContext) -> Iterator[Issue]:
                         hint=f"export the part again as {mesh.path.suffix.lstrip('.').upper()}")
 
 
+@rule("S120", "sdf-link-default-inertial", "warning",
+      "An SDF link has no <inertial>: sdformat gives it 1 kg and a 1 kg·m² inertia.",
+      clause="suspicious")
+def sdf_link_default_inertial(ctx: CheckContext) -> Iterator[Issue]:
+    """libsdformat reads a `<link>` without `<inertial>` as 1 kg with a unit inertia
+    tensor, and Gazebo simulates it so: a visual-only link (a trail, a marker) adds a
+    kilogram to the vehicle. reedtool counts it the same way in every mass figure.
+
+    Severity (warning: suspicious, but the model loads and flies): the element is valid
+    SDF; whether the kilogram is meant cannot be told.
+    """
+    for issue in ctx.robot.parse_issues:
+        if issue.kind in _DEFAULT_INERTIAL_KINDS:
+            yield Issue(issue.message, issue.loc, issue.subject,
+                        hint="give the link its <inertial> (mass and inertia), even a small one")
+
+
 @rule("S130", "mesh-format-unsupported", "error",
       "A mesh file is in a format the simulator cannot load.", clause="refused")
 def mesh_format_unsupported(ctx: CheckContext) -> Iterator[Issue]:
@@ -360,19 +379,63 @@ def _geometry_sizes(geometry) -> dict[str, float]:
     return {}
 
 
-@rule("S116", "geometry-size-invalid", "error", "A geometry has a zero or negative size.", clause="refused")
+@rule("S116", "geometry-size-invalid", "error",
+      "A geometry has a zero or negative size (a mesh: a zero scale).", clause="refused")
 def geometry_size_invalid(ctx: CheckContext) -> Iterator[Issue]:
-    """Box sizes, cylinder radius and length, sphere radius and mesh scale must be
-    positive. A zero size makes a collision shape degenerate (objects fall through it),
-    a negative mesh scale mirrors the mesh and turns its normals inside out.
+    """Box sizes, cylinder radius and length and sphere radius must be positive, and a
+    mesh scale non-zero. A zero size makes a collision shape degenerate (objects fall
+    through it); libsdformat refuses a non-positive box size or radius. A negative mesh
+    scale is a mirror, which Gazebo draws (S121, S122).
     """
     for link in ctx.robot.links:
         for shape in [*link.visuals, *link.collisions]:
+            mesh = isinstance(shape.geometry, Mesh)
             for name, value in _geometry_sizes(shape.geometry).items():
-                if value is not None and math.isfinite(value) and value <= 0:
+                if value is not None and math.isfinite(value) and value <= 0 \
+                        and not (mesh and value < 0):
                     kind = type(shape.geometry).__name__.lower()
                     yield Issue(f"link '{link.name}': {kind} {name} is {value:g}", shape.loc,
                                 link.name, hint="sizes must be positive (metres)")
+
+
+def _mirrored_meshes(ctx: CheckContext, collisions: bool):
+    for link in ctx.robot.links:
+        for shape in (link.collisions if collisions else link.visuals):
+            if not isinstance(shape.geometry, Mesh):
+                continue
+            scale = np.broadcast_to(np.asarray(shape.geometry.scale, dtype=float), (3,))
+            axes = [f"{'xyz'[i]} {scale[i]:g}" for i in range(3)
+                    if math.isfinite(scale[i]) and scale[i] < 0]
+            if axes:
+                yield link, shape, axes
+
+
+@rule("S121", "visual-mesh-mirrored", "info",
+      "A visual mesh is mirrored by a negative scale.", clause="explains")
+def visual_mesh_mirrored(ctx: CheckContext) -> Iterator[Issue]:
+    """A negative `<mesh scale>` component mirrors the mesh. For a visual that is a
+    convention: the MRS UAV models draw their clockwise propellers as the counter-clockwise
+    mesh with scale -1. Gazebo draws it mirrored.
+    """
+    for link, shape, axes in _mirrored_meshes(ctx, collisions=False):
+        yield Issue(f"link '{link.name}': visual mesh '{shape.geometry.uri}' is mirrored "
+                    f"({', '.join(axes)})", shape.loc, link.name)
+
+
+@rule("S122", "collision-mesh-mirrored", "warning",
+      "A collision mesh is mirrored by a negative scale: its faces point inwards.",
+      clause="suspicious")
+def collision_mesh_mirrored(ctx: CheckContext) -> Iterator[Issue]:
+    """A negative `<mesh scale>` on a collision mirrors the mesh and with an odd number of
+    negative components turns its faces inside out: the physics engine's contacts may push
+    objects into the shape rather than out of it.
+
+    Severity (warning: the model loads and can fly): contacts only matter on the ground.
+    """
+    for link, shape, axes in _mirrored_meshes(ctx, collisions=True):
+        yield Issue(f"link '{link.name}': collision mesh '{shape.geometry.uri}' is mirrored "
+                    f"({', '.join(axes)})", shape.loc, link.name,
+                    hint="mirror the file itself, or use a primitive shape for the collision")
 
 
 @rule("S117", "link-dropped-by-sdf", "error",

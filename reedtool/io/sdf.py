@@ -456,8 +456,8 @@ class _ModelReader:
             self._issue("missing-attribute", "<link> has no name= attribute", el, None)
         inertial_el = el.find("inertial")
         if inertial_el is None:
-            self._issue("missing-element", f"link '{scoped}' has no <inertial>: sdformat gives it "
-                        "a mass of 1 kg and an inertia of 1 kg*m^2", el, scoped)
+            self._issue("sdf-default-inertial", f"link '{scoped}' has no <inertial>: sdformat "
+                        "gives it a mass of 1 kg and an inertia of 1 kg*m^2", el, scoped)
             link.inertial = Inertial(SDF_DEFAULT_MASS_KG, np.eye(4), np.eye(3), self.loc(el))
         else:
             link.inertial = self._inertial(scoped, scope, inertial_el)

@@ -595,9 +595,17 @@ def compare_links(robot: Robot) -> list[LinkComparison]:
     moving = moving_links(robot)
     slowdowns = rotor_slowdown_by_link(robot)
     unreadable = unreadable_masses(robot)
+    # An SDF link without <inertial> carries sdformat's 1 kg and unit tensor (S120 says so):
+    # nothing the author wrote to compare with its geometry.
+    defaulted = {issue.subject for issue in robot.parse_issues
+                 if issue.kind == "sdf-default-inertial"}
     comparisons = [compare_link(link, moving=link.name in moving,
                                 slowdown=slowdowns.get(link.name),
                                 mass_unreadable=link.name in unreadable)
+                   if link.name not in defaulted else
+                   LinkComparison(link.name, link.loc, declared_mass_properties(link), None,
+                                  None, None, None, None, "no-inertial",
+                                  "no <inertial>: sdformat's default 1 kg and unit inertia")
                    for link in robot.links]
     return judge_in_robot(robot, comparisons)
 

@@ -452,10 +452,12 @@ def rotor_table(rotors: list[Rotor]) -> list[dict]:
 
 
 def declared_rotor_counts(robot: Robot) -> list[RotorCountDeclaration]:
-    """Rotor counts declared by MAVLink/PX4 interface plugins.
+    """Rotor counts declared by MAVLink/PX4 interface plugins: an explicit
+    <rotorCount>/<rotor_count> (RotorS's interface sends that many motor commands).
 
-    Read from an explicit <rotorCount>/<rotor_count> element, else from the number of
-    rotor channels in <control_channels> (PX4's mavlink interface names them rotorN).
+    PX4 classic's control channels declare no count: a channel no motor reads is an unused
+    output (the MRS models list eight for every frame, PX4's iris template channels for
+    another model's joints), and a motor that no channel fills is R302's finding.
     """
     out = []
     for _block, plugin in robot.plugins():
@@ -468,18 +470,6 @@ def declared_rotor_counts(robot: Robot) -> list[RotorCountDeclaration]:
                 count = int(text) if text.isdigit() else None
                 out.append(RotorCountDeclaration(count, plugin, node.loc, text))
                 break
-        else:
-            channels = plugin.node.find("control_channels")
-            if channels is not None:
-                # A channel with a <joint_name> drives that joint itself (a servo, or a
-                # puller spun by the interface, PX4 classic's plane); PX4's shared iris
-                # template also lists channels for joints of other models, which the
-                # plugin skips. Only the channels the motor plugins read are rotors.
-                rotor_channels = [c for c in channels.findall("channel")
-                                  if c.attrib.get("name", "").lower().startswith("rotor")
-                                  and c.find("joint_name") is None]
-                if rotor_channels:
-                    out.append(RotorCountDeclaration(len(rotor_channels), plugin, channels.loc))
     return out
 
 
