@@ -126,6 +126,28 @@ class CheckContext:
         return [r for r in self.rotors if r.role == "lift"]
 
     @cached_property
+    def articulated_rotors(self) -> dict[str, str]:
+        """Lift rotor name -> the first moving joint between it and the base other than its
+        own spin joint (a tilt servo, a folding arm, a leg). Such a rotor's flight pose is
+        set by that joint; the zero pose the hover rules would judge is not the vehicle's."""
+        out: dict[str, str] = {}
+        for rotor in self.lift_rotors:
+            spin = self.robot.joint_map.get(rotor.joint or "")
+            link = spin.parent if spin is not None else None
+            seen = set()
+            while link is not None and link not in seen:
+                seen.add(link)
+                joint = self.parent_joint(link)
+                if joint is None:
+                    break
+                if joint.moves and joint.limit is not None \
+                        and joint.limit.upper - joint.limit.lower > 1e-9:
+                    out[rotor.name] = joint.name
+                    break
+                link = joint.parent
+        return out
+
+    @cached_property
     def omnidirectional(self) -> bool:
         """Reversible or every-direction rotors: hover uses the 6-DoF allocation."""
         from reedtool.physics.rotors import is_omnidirectional

@@ -68,9 +68,10 @@ def _constants_ok(rotor: "Rotor") -> bool:
 
 
 def _physics_ready(ctx: CheckContext) -> bool:
-    """Every rotor placed, turning a known way, with usable constants; the robot has mass."""
+    """Every rotor placed, turning a known way, with usable constants; the robot has mass;
+    no rotor carried by an actuated joint (its zero pose is not the flight pose: R319)."""
     rotors = _lift(ctx)
-    if not rotors:
+    if not rotors or ctx.articulated_rotors:
         return False
     for rotor in rotors:
         if not (np.all(np.isfinite(rotor.position_m)) and np.all(np.isfinite(rotor.axis))
@@ -482,9 +483,10 @@ def rotor_axis_tilted(ctx: CheckContext) -> Iterator[Issue]:
 
     A balanced pattern (R320: several rotors tilted so that their side forces and tilt
     yaw torques cancel, as on the AscTec Neo) is information, not this warning. Propulsion
-    rotors (R319) and omnidirectional frames are not judged by tilt.
+    rotors (R319) and omnidirectional frames are not judged by tilt, nor rotors carried by
+    an actuated joint (R319: the servo sets their tilt in flight).
     """
-    if ctx.omnidirectional or balanced_tilt(ctx) is not None:
+    if ctx.omnidirectional or ctx.articulated_rotors or balanced_tilt(ctx) is not None:
         return
     for rotor in _lift(ctx):
         axis = np.asarray(rotor.axis, dtype=float)
@@ -727,7 +729,10 @@ def rotor_role(ctx: CheckContext) -> Iterator[Issue]:
     propulsion: a fixed-wing puller or a VTOL pusher. It is
     left out of the hover allocation, the trim and the lift-rotor rules (R304-R311). A
     frame with reversible motors or rotors pointing in every direction is
-    omnidirectional: it is judged by the full 6-DoF force-and-torque allocation.
+    omnidirectional: it is judged by the full 6-DoF force-and-torque allocation. Rotors
+    carried by an actuated joint (a tilt servo, an arm, a leg: SITL_Models' hexapod_copter
+    flies with its rotors where its leg servos put them) have no fixed flight pose: the
+    hover rules do not judge them at the model's zero pose.
     """
     for rotor in _rotors(ctx):
         if rotor.role == "propulsion":
@@ -735,6 +740,13 @@ def rotor_role(ctx: CheckContext) -> Iterator[Issue]:
             yield Issue(f"rotor '{rotor.name}' is propulsion (thrust axis "
                         f"{', '.join(f'{v:.3f}' for v in axis)}, {rotor.tilt_deg:.0f}° from "
                         "body z): not used for hover", rotor.loc, rotor.name)
+    if ctx.articulated_rotors:
+        name, joint = next(iter(ctx.articulated_rotors.items()))
+        more = len(ctx.articulated_rotors) - 1
+        yield Issue(f"rotor '{name}'{f' and {more} more' if more else ''} ride on actuated "
+                    f"joint '{joint}': their flight pose is set by it, so hover, trim, "
+                    "allocation and tilt are not judged at the zero pose (R304-R311, R340-R342, "
+                    "I220)", _lift(ctx)[0].loc, "rotors")
     if _lift(ctx) and ctx.omnidirectional:
         reversible = sum(r.reversible for r in _lift(ctx))
         yield Issue(f"omnidirectional frame: {len(_lift(ctx))} rotors ({reversible} "
