@@ -109,3 +109,53 @@ def test_a_lighter_core_is_plausible_a_heavier_rim_is_not(tmp_path, factor, expe
     path = tmp_path / "arm.urdf"
     path.write_text(text)
     assert [f.code for f in run_checks(load_robot(path), Selection(select=("I",)))] == expected
+
+
+SENSOR_INERTIA = 'ixx="4.16666667e-07" ixy="0" ixz="0" iyy="4.16666667e-07" iyz="0" izz="6.66666667e-07"'
+
+
+def _arm_with_sensor(tmp_path, sensor_inertia: str, joint: str = "fixed") -> list[str]:
+    """The clean arm's 0.01 kg sensor link with another tensor, on a fixed (or moving) joint."""
+    text = (FIXTURES / "I209_bad_placeholder.urdf").read_text()
+    text = text.replace('ixx="1.0" ixy="0" ixz="0" iyy="1.0" iyz="0" izz="1.0"',
+                        'ixx="0.00385416667" ixy="0" ixz="0" iyy="0.00385416667" iyz="0" '
+                        'izz="0.000625"')          # link1: its own cylinder, so it is quiet
+    text = text.replace(SENSOR_INERTIA, sensor_inertia)
+    if joint != "fixed":
+        text = text.replace('<joint name="sensor_joint" type="fixed">',
+                            f'<joint name="sensor_joint" type="{joint}">').replace(
+            '<child link="sensor_link"/>\n    <origin xyz="0 0 0.06" rpy="0 0 0"/><axis xyz="0 0 1"/>',
+            '<child link="sensor_link"/>\n    <origin xyz="0 0 0.06" rpy="0 0 0"/><axis xyz="0 0 1"/>'
+            '<limit lower="-1" upper="1" effort="1" velocity="1"/>')
+    path = tmp_path / "arm.urdf"
+    path.write_text(text)
+    return [f.code for f in run_checks(load_robot(path), Selection(select=("I20",)))
+            if f.subject == "sensor_link"]
+
+
+ZERO = 'ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"'
+
+
+def test_point_mass_on_a_fixed_joint_is_accepted(tmp_path):
+    """aerial_gym's motor links: 0.01 kg with a zero tensor on a fixed joint is a point mass
+    (gz-math calls zero moments valid; Gazebo merges the URDF link into its parent). On a
+    joint that moves, the body has no inertia to turn with: I202."""
+    assert _arm_with_sensor(tmp_path, ZERO) == []
+    assert _arm_with_sensor(tmp_path, ZERO, joint="revolute") == ["I202"]
+    # A negative moment is wrong wherever it is.
+    assert _arm_with_sensor(tmp_path, ZERO.replace('izz="0"', 'izz="-1e-6"')) == ["I202"]
+
+
+def test_merged_link_triangle_is_judged_in_its_parents_body(tmp_path):
+    """A 0.01 kg sensor's (1e-7, 1e-7, 1e-6) breaks A + B >= C. The fixture keeps its joint
+    (preserveFixedJoint): its own body in Gazebo, I203. Without that Gazebo merges it into
+    the 2 kg base, whose sum keeps the inequality: nothing to report."""
+    bad = 'ixx="1e-07" ixy="0" ixz="0" iyy="1e-07" iyz="0" izz="1e-06"'
+    assert _arm_with_sensor(tmp_path, bad) == ["I203"]
+    path = tmp_path / "arm.urdf"
+    text = path.read_text()
+    line = '<gazebo reference="sensor_joint"><preserveFixedJoint>true</preserveFixedJoint></gazebo>'
+    assert line in text
+    path.write_text(text.replace(line, ""))
+    assert [f.code for f in run_checks(load_robot(path), Selection(select=("I20",)))
+            if f.subject == "sensor_link"] == []

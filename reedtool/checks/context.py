@@ -220,6 +220,37 @@ class CheckContext:
         return compare_links(self.robot)
 
     @cached_property
+    def lumped_links(self) -> set[str]:
+        """URDF links Gazebo merges into their parent (physics.inertia.lumped_urdf_links)."""
+        from reedtool.physics.inertia import lumped_urdf_links
+
+        return lumped_urdf_links(self.robot)
+
+    def lumped_tensor(self, link_name: str):
+        """Inertia tensor (about its COM) of the body Gazebo makes of `link_name` and the
+        links merged with it (fixed joints lumped into their parent); None without poses."""
+        from reedtool.physics.inertia import combine, declared_mass_properties
+
+        poses = self.link_poses
+        if link_name not in poses:
+            return None
+
+        def group_root(name: str) -> str:
+            while name in self.lumped_links:
+                name = self.parent_joint(name).parent
+            return name
+
+        root = group_root(link_name)
+        T_root_base = np.linalg.inv(poses[root])
+        parts = []
+        for link in self.robot.links:
+            declared = declared_mass_properties(link)
+            if declared is None or link.name not in poses or group_root(link.name) != root:
+                continue
+            parts.append(declared.transformed(T_root_base @ poses[link.name]))
+        return combine(parts).inertia_kg_m2 if parts else None
+
+    @cached_property
     def placeholder_links(self) -> set[str]:
         """Links too light to change how the robot flies (physics.inertia.placeholder_links)."""
         from reedtool.physics.inertia import placeholder_links

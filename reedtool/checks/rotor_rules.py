@@ -535,12 +535,30 @@ def rotor_count_mismatch(ctx: CheckContext) -> Iterator[Issue]:
 
 @rule("R313", "rotor-joint-not-continuous", "error", "A rotor turns on a joint that is not continuous.", clause="cannot-fly")
 def rotor_joint_not_continuous(ctx: CheckContext) -> Iterator[Issue]:
-    """A motor plugin spins its joint without end: the joint must be `continuous`. A
-    revolute joint stops at its limits, a fixed one is merged away by Gazebo and the
-    plugin finds no joint.
+    """A motor plugin spins its joint without end: the joint must be `continuous`, or a
+    revolute one whose limit in the way it turns is open. A revolute joint stops at its
+    limits, a fixed one is merged away by Gazebo and the plugin finds no joint.
+
+    sdformat writes "no limit" as ±1e16, and a rotor turns one way only, so a revolute
+    joint whose limit on that side is 1e15 or beyond spins like a continuous one
+    (SITL_Models' mini_talon_vtail: -1e-16..1e16, turned positive by its multiplier). The
+    way is the sign of the joint velocity the plugin commands: the ArduPilotPlugin's
+    multiplier, or the motor model's turningDirection (ccw +1, cw -1).
+
+    Severity (error, cannot-fly): the rotor stops at the limit.
     """
+    from reedtool.io.sdf import UNBOUNDED_LIMIT
+
     for rotor in _rotors(ctx):
         joint = ctx.robot.joint_map.get(rotor.joint or "")
+        if joint is not None and joint.type == "revolute" and joint.limit is not None:
+            if rotor.kind == "ardupilot":
+                way = np.sign(_number_or_nan(rotor.param("multiplier") or "1"))
+            else:
+                way = rotor.turning_sign
+            if (way > 0 and joint.limit.upper >= UNBOUNDED_LIMIT) \
+                    or (way < 0 and joint.limit.lower <= -UNBOUNDED_LIMIT):
+                continue
         if joint is not None and joint.type != "continuous":
             yield Issue(f"rotor '{rotor.name}' spins joint '{joint.name}', which is {joint.type}",
                         joint.loc, joint.name, hint='use type="continuous"')

@@ -323,6 +323,25 @@ def tensor_problem(inertia_kg_m2) -> str | None:
     return None
 
 
+# Eigenvalues of a tensor with zero moments come out as +-1e-25 of its largest moment:
+# below this fraction of the largest, a moment is zero, not negative.
+MOMENT_NOISE_REL = 1e-9
+
+
+def degenerate_but_accepted(inertia_kg_m2, *, moving: bool, lumped: bool) -> bool:
+    """A tensor with zero (not negative) principal moments that the simulator accepts: a
+    point mass (all zero) on a fixed joint, which gz-math calls valid, or any such tensor
+    of a URDF link merged into its parent, where it only adds to the parent's sum."""
+    I = np.asarray(inertia_kg_m2, dtype=float)
+    if moving or not np.all(np.isfinite(I)):
+        return False
+    moments = np.linalg.eigvalsh((I + I.T) / 2.0)
+    largest = float(np.max(np.abs(moments)))
+    if moments[0] < -MOMENT_NOISE_REL * max(largest, 1e-300):
+        return False
+    return lumped or largest == 0.0
+
+
 def physically_valid(inertia_kg_m2) -> bool:
     """Positive principal moments obeying the triangle inequality (A + B >= C)."""
     return tensor_problem(inertia_kg_m2) is None
@@ -607,7 +626,27 @@ def compare_links(robot: Robot) -> list[LinkComparison]:
                                   None, None, None, None, "no-inertial",
                                   "no <inertial>: sdformat's default 1 kg and unit inertia")
                    for link in robot.links]
+    lumped = lumped_urdf_links(robot)
+    comparisons = [replace(c, verdict="point-mass", message="zero moments: a point mass on a "
+                           "fixed joint (or merged into its parent), which Gazebo accepts")
+                   if c.verdict == "invalid" and c.tensor_problem == "not-positive-definite"
+                   and degenerate_but_accepted(c.declared.inertia_kg_m2,
+                                               moving=c.link in moving,
+                                               lumped=c.link in lumped) else c
+                   for c in comparisons]
     return judge_in_robot(robot, comparisons)
+
+
+def lumped_urdf_links(robot: Robot) -> set[str]:
+    """URDF links that Gazebo's URDF->SDF conversion merges into their parent: children of
+    fixed joints without preserveFixedJoint/disableFixedJointLumping (parser_urdf.cc)."""
+    if robot.source_format != "urdf":
+        return set()
+    kept = {block.reference for block in robot.gazebo for node in block.elements
+            if node.tag in ("disableFixedJointLumping", "preserveFixedJoint")
+            and (node.text or "").strip().lower() == "true"}
+    return {joint.child for joint in robot.joints
+            if joint.type == "fixed" and joint.name not in kept}
 
 
 # A link is a placeholder when its mass and its inertia about the robot's COM are both
