@@ -101,3 +101,33 @@ def test_urdf_still_refuses_what_tinyxml2_refuses():
     with pytest.raises(ReedtoolError) as exc:
         parse_urdf('<robot name="r">\n<link name="a">\n</robot>\n', "r.urdf")
     assert exc.value.line is not None and "malformed XML" in exc.value.message
+
+
+@pytest.mark.parametrize("text, what, line", [
+    # PX4 classic's generated depth_camera.sdf: a comment line, then the declaration.
+    ('<!-- generated -->\n<?xml version="1.0"?>\n<sdf version="1.6"><model name="m"/></sdf>\n',
+     "XML declaration not at the start", 2),
+    # PX4 classic's cloudship.sdf: blank lines before the declaration.
+    ('\n\n\n<?xml version="1.0"?>\n<sdf version="1.6"><model name="m"/></sdf>\n',
+     "XML declaration not at the start", 4),
+])
+def test_misplaced_xml_declaration_is_read(text, what, line):
+    with pytest.raises(etree.XMLSyntaxError):
+        etree.fromstring(text.encode())
+    root, tolerated = parse_tolerant(text, "f.sdf")
+    assert root.find("model").get("name") == "m"
+    assert [(t.line, t.what) for t in tolerated] == [(line, what)]
+
+
+def test_angle_bracket_in_attribute_and_bare_ampersand_are_read_as_text():
+    """An STL converter's `<node id="<STL_BINARY>">` and the MRS meshes' `Motor&Proplr`:
+    TinyXML2 reads both characters as they are; so does reedtool, lines kept."""
+    text = ('<COLLADA>\n<node id="<STL_BINARY>"/>\n<node name="MOTOR Motor&Proplr">a &amp; b</node>'
+            '\n<!-- a & b < c -->\n<x/>\n</COLLADA>\n')
+    root, tolerated = parse_tolerant(text, "part.dae")
+    nodes = root.findall("node")
+    assert nodes[0].get("id") == "<STL_BINARY>" and nodes[0].sourceline == 2
+    assert nodes[1].get("name") == "MOTOR Motor&Proplr" and nodes[1].text == "a & b"
+    assert root.find("x").sourceline == 5
+    assert sorted((t.line, t.what) for t in tolerated) == [
+        (2, "'<' inside an attribute value"), (3, "'&' that starts no entity")]

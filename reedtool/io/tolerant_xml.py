@@ -11,10 +11,14 @@ people fly today:
 * a namespace prefix used without its `xmlns:` declaration (PX4's optical-flow sensor
   writes `gz:` attributes), which the Namespaces in XML spec forbids.
 
-The strict parse is tried first. Only when it fails are these two patterns cleaned in a
-copy of the text that keeps every character offset and line number (a `-` becomes a
-space; the missing declarations go inside the root start tag, on its own line), and the
-copy is parsed. Anything else that is malformed stays a one-line error, as it is in
+Three more occur in meshes and generated files: a `<` inside an attribute value (an STL
+converter's `<node id="<STL_BINARY>">`), a `&` that starts no entity (`name="Motor&Prop"`),
+and an XML declaration after a comment or blank lines (a generated file's header).
+
+The strict parse is tried first. Only when it fails are these patterns cleaned in a copy
+of the text that keeps every line number (a `-` becomes a space, a misplaced declaration
+blanks, `<` and a bare `&` are escaped; the missing namespace declarations go inside the
+root start tag, on its own line), and the copy is parsed. Anything else that is malformed stays a one-line error, as it is in
 Gazebo. The caller turns the returned notes into one information finding per file.
 """
 
@@ -74,6 +78,84 @@ def _clean_comments(text: str) -> tuple[str, list[Tolerated]]:
     return _COMMENT.sub(fix, text), found
 
 
+_XML_DECL = re.compile(r"<\?xml\s[^>]*\?>")
+_ENTITY = re.compile(r"&(#\d+|#x[0-9A-Fa-f]+|[A-Za-z_][\w.-]*);")
+
+
+def _clean_declaration(text: str) -> tuple[str, list[Tolerated]]:
+    """An XML declaration after blank lines or a comment (a generated file's header line):
+    TinyXML2 reads it as an ordinary node; blanked here, newlines kept."""
+    match = _XML_DECL.search(text)
+    if match is None or match.start() == 0:
+        return text, []
+    blank = re.sub(r"[^\n]", " ", match.group(0))
+    return (text[:match.start()] + blank + text[match.end():],
+            [Tolerated(_line_of(text, match.start()), "XML declaration not at the start")])
+
+
+def _escape_markup(text: str) -> tuple[str, list[Tolerated]]:
+    """A '<' inside an attribute value and a '&' that starts no entity, which TinyXML2 (and
+    the COLLADA loaders of gz-common and Gazebo classic) read as plain characters, escaped.
+    Comments, CDATA, processing instructions and DOCTYPE are copied as they are; no
+    newline is added or removed, so line numbers stay."""
+    out: list[str] = []
+    found: dict[str, int] = {}
+    i, n = 0, len(text)
+
+    def note(what: str, at: int) -> None:
+        found.setdefault(what, _line_of(text, at))
+
+    def amp(at: int) -> str:
+        if _ENTITY.match(text, at):
+            return "&"
+        note("'&' that starts no entity", at)
+        return "&amp;"
+
+    while i < n:
+        ch = text[i]
+        if ch == "<":
+            for opener, closer in (("<!--", "-->"), ("<![CDATA[", "]]>"), ("<?", "?>"),
+                                   ("<!", ">")):
+                if text.startswith(opener, i):
+                    end = text.find(closer, i + len(opener))
+                    end = n if end < 0 else end + len(closer)
+                    out.append(text[i:end])
+                    i = end
+                    break
+            else:
+                # a tag: copy to its closing '>' outside quotes, escaping inside quotes
+                out.append("<")
+                i += 1
+                quote = None
+                while i < n:
+                    c = text[i]
+                    if quote:
+                        if c == quote:
+                            quote = None
+                            out.append(c)
+                        elif c == "<":
+                            note("'<' inside an attribute value", i)
+                            out.append("&lt;")
+                        elif c == "&":
+                            out.append(amp(i))
+                        else:
+                            out.append(c)
+                    elif c in "\"'":
+                        quote = c
+                        out.append(c)
+                    elif c == ">":
+                        out.append(c)
+                        i += 1
+                        break
+                    else:
+                        out.append(c)
+                    i += 1
+            continue
+        out.append(amp(i) if ch == "&" else ch)
+        i += 1
+    return "".join(out), [Tolerated(line, what) for what, line in found.items()]
+
+
 def _undeclared_prefixes(text: str) -> dict[str, int]:
     """Prefix -> first line it is used on, for prefixes no xmlns: declares."""
     no_comments = _COMMENT.sub(lambda m: " " * len(m.group(0)), text)
@@ -115,6 +197,9 @@ def parse_tolerant(text: str, file: Path | str, *, remove_comments: bool = False
         return etree.fromstring(data, parser), []
     except etree.XMLSyntaxError as strict_error:
         cleaned, tolerated = _clean_comments(text)
+        cleaned, misplaced = _clean_declaration(cleaned)
+        cleaned, escaped = _escape_markup(cleaned)
+        tolerated += misplaced + escaped
         prefixes = _undeclared_prefixes(cleaned)
         tolerated += [Tolerated(line, f"namespace prefix '{p}:' used without an xmlns:{p} "
                                       "declaration") for p, line in sorted(prefixes.items())]
