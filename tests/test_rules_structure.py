@@ -56,6 +56,8 @@ CASES = [
     # on a collision (faces inside out); only a zero scale is S116.
     ("S121_bad_mirrored_visual.urdf", ["S121"]),
     ("S122_bad_mirrored_collision.urdf", ["S122"]),
+    # 1.6's <use_parent_model_frame> in a 1.7 file: ignored, as libsdformat does.
+    ("S123_bad_parent_frame_in_1_7.sdf", ["S123"]),
     # Good fixtures: the arm has a zero-mass fixed tool frame (fine), a plugin on a fixed
     # link kept by preserveFixedJoint, a limited revolute joint; the car a mesh in metres.
     ("clean_arm.urdf", []),

@@ -22,6 +22,7 @@ from reedtool.physics.kinematics import link_poses
 from reedtool.physics.rotors import discover_rotors
 
 GZ = Path(__file__).parent / "fixtures" / "gz"
+FIXTURES_VALIDATE = Path(__file__).parent / "fixtures" / "validate"
 S45 = math.sin(math.radians(45))
 S10, C10 = math.sin(math.radians(10)), math.cos(math.radians(10))
 
@@ -241,3 +242,19 @@ def test_hover_test_and_inertia_work_on_gz_models_unchanged(model):
     assert len(omegas) == 4 and np.allclose(omegas, omega, rtol=1e-9)
     inertia = CliRunner().invoke(cli, ["inertia", path, "--format", "json"])
     assert inertia.exit_code == 0, inertia.output
+
+
+@pytest.mark.parametrize("version, axis_in_base", [("1.7", [-1, 0, 0]), ("1.6", [0, 0, 1])])
+def test_use_parent_model_frame_counts_only_where_the_version_defines_it(version, axis_in_base):
+    """In 1.6 it puts the axis in the model frame (body z); a 1.7 file's is ignored, so the
+    axis stays in the joint frame: the wheel link's z, pitched -90° onto body -x."""
+    from reedtool.physics.kinematics import link_poses
+
+    text = (FIXTURES_VALIDATE / "S123_bad_parent_frame_in_1_7.sdf").read_text().replace(
+        '<sdf version="1.7">', f'<sdf version="{version}">')
+    robot = parse_sdf(text, "m.sdf")
+    joint = robot.joint_map["wheel_joint"]
+    axis = link_poses(robot)["wheel"][:3, :3] @ joint.axis
+    np.testing.assert_allclose(axis, axis_in_base, atol=1e-9)
+    kinds = [i.kind for i in robot.parse_issues]
+    assert kinds == (["sdf-undefined-element"] if version == "1.7" else [])

@@ -25,6 +25,7 @@ _NON_FINITE_KINDS = {"non-finite"}
 _LEGACY_KINDS = {"legacy-xacro"}
 _TOLERATED_KINDS = {"xml-tolerated"}
 _DEFAULT_INERTIAL_KINDS = {"sdf-default-inertial"}
+_UNDEFINED_KINDS = {"sdf-undefined-element"}
 # libsdformat's joint types (sdf/1.x/joint.sdf): what an SDF <joint type=> may be.
 SDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "ball", "screw",
                    "universal", "revolute2", "gearbox")
@@ -49,7 +50,7 @@ def urdf_parse_error(ctx: CheckContext) -> Iterator[Issue]:
     """
     for issue in ctx.robot.parse_issues:
         if issue.kind not in _NON_FINITE_KINDS | _LEGACY_KINDS | _TOLERATED_KINDS \
-                | _PACKAGE_KINDS | _DEFAULT_INERTIAL_KINDS:
+                | _PACKAGE_KINDS | _DEFAULT_INERTIAL_KINDS | _UNDEFINED_KINDS:
             yield Issue(issue.message, issue.loc, issue.subject)
 
 
@@ -318,6 +319,22 @@ def sdf_link_default_inertial(ctx: CheckContext) -> Iterator[Issue]:
         if issue.kind in _DEFAULT_INERTIAL_KINDS:
             yield Issue(issue.message, issue.loc, issue.subject,
                         hint="give the link its <inertial> (mass and inertia), even a small one")
+
+
+@rule("S123", "sdf-element-not-in-version", "info",
+      "An element the file's declared SDF version does not define is ignored.",
+      clause="explains")
+def sdf_element_not_in_version(ctx: CheckContext) -> Iterator[Issue]:
+    """libsdformat reads a file by the spec of the version it declares (converting older
+    versions up): an element that version does not define is ignored with a warning. A
+    1.7+ file's `<use_parent_model_frame>` (removed in 1.7; only a 1.6 file's is converted
+    to `expressed_in="__model__"`) therefore leaves the joint axis in the joint frame, and
+    reedtool reads it so too (SITL_Models' alti_transition_quad and skywalker_x8 declare
+    1.7 and keep it).
+    """
+    for issue in ctx.robot.parse_issues:
+        if issue.kind in _UNDEFINED_KINDS:
+            yield Issue(issue.message, issue.loc, issue.subject)
 
 
 @rule("S130", "mesh-format-unsupported", "error",

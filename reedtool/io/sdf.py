@@ -52,6 +52,7 @@ joints) so URDF-only consumers such as the Pinocchio cross-check see the same mo
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
@@ -92,6 +93,7 @@ _SCOPED_PLUGIN_PARAMS = {"jointName", "linkName", "joint_name", "link_name", "bo
                          "body_name"}
 # sdformat writes "no limit" as +-1e16; anything beyond this is unbounded.
 UNBOUNDED_LIMIT = 1e15
+_SDF_VERSION = re.compile(r"<sdf\b[^>]*\bversion\s*=\s*[\"']([\d.]+)[\"']")
 SDF_DEFAULT_MASS_KG = 1.0
 
 
@@ -218,6 +220,7 @@ class _ModelReader:
         self.sources = sources
         self.resolver = resolver
         self.issues: list[ParseIssue] = []
+        self._versions: dict[Path, str] = {}
         self.frames: dict[str, _FrameEntry] = {}
         self._resolved: dict[str, np.ndarray] = {MODEL_FRAME: np.eye(4)}
         self.link_els: list[tuple[str, str, etree._Element]] = []   # (scoped name, scope, el)
@@ -233,6 +236,21 @@ class _ModelReader:
 
     def file_of(self, el: etree._Element) -> Path:
         return self.sources.file_of(el).path
+
+    def _version_text(self, el: etree._Element) -> str:
+        """The SDF version declared by the file the element was read from."""
+        source = self.sources.file_of(el)
+        cached = self._versions.get(source.path)
+        if cached is None:
+            match = _SDF_VERSION.search("\n".join(source.lines[:200]))
+            cached = self._versions[source.path] = match.group(1) if match else "1.6"
+        return cached
+
+    def _version(self, el: etree._Element) -> tuple[int, ...]:
+        try:
+            return tuple(int(part) for part in self._version_text(el).split("."))
+        except ValueError:
+            return (1, 6)
 
     def _issue(self, kind: str, message: str, el: etree._Element, subject: str | None) -> None:
         self.issues.append(ParseIssue(kind, message, self.loc(el), subject))
@@ -552,8 +570,16 @@ class _ModelReader:
         axis = self._numbers(xyz_el, (3,), [0.0, 0.0, 1.0], scoped)
         if xyz_el is not None and child in self.frames:
             expressed_in = xyz_el.get("expressed_in")
-            if expressed_in is None and (axis_el.findtext("use_parent_model_frame") or "") \
-                    .strip().lower() in ("true", "1"):
+            parent_frame_el = axis_el.find("use_parent_model_frame")
+            if parent_frame_el is not None and self._version(parent_frame_el) >= (1, 7):
+                # SDF 1.7 dropped the element (1_6.convert rewrites it only when a 1.6 file
+                # is upgraded): in a 1.7+ file libsdformat ignores it with a warning.
+                self._issue("sdf-undefined-element", f"<use_parent_model_frame> of joint "
+                            f"'{scoped}' is not part of SDF {self._version_text(parent_frame_el)}"
+                            ": ignored, as libsdformat does (the axis is in the joint frame)",
+                            parent_frame_el, scoped)
+            elif expressed_in is None and (parent_frame_el is not None) \
+                    and (parent_frame_el.text or "").strip().lower() in ("true", "1"):
                 expressed_in = MODEL_FRAME
             frame = self._scoped(scope, expressed_in) if expressed_in else scoped
             R_child_frame = (np.linalg.inv(self.T_model(child, el, scoped))
