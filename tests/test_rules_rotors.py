@@ -114,6 +114,7 @@ def test_every_sir_rule_has_a_bad_and_a_good_fixture():
     ("-1e-16", "1e+16", False),    # mini_talon_vtail's typo: open on the side it turns
     ("-1e+16", "1e-16", True),     # open only the other way: it stops at once
     ("-1", "1", True),             # a limited revolute joint
+    ("-1e+12", "1e+12", False),    # SwiftGust's Sikorsky X2 blades: never reached
 ])
 def test_revolute_rotor_joint_open_in_its_direction(tmp_path, lower, upper, fires):
     """x500's rotor 0 turns ccw: the motor model drives its joint at +omega, so only the

@@ -540,15 +540,15 @@ def rotor_joint_not_continuous(ctx: CheckContext) -> Iterator[Issue]:
     limits, a fixed one is merged away by Gazebo and the plugin finds no joint.
 
     sdformat writes "no limit" as ±1e16, and a rotor turns one way only, so a revolute
-    joint whose limit on that side is 1e15 or beyond spins like a continuous one
-    (SITL_Models' mini_talon_vtail: -1e-16..1e16, turned positive by its multiplier). The
+    joint whose limit on that side is 1e9 rad or beyond spins like a continuous one: at
+    3000 rad/s it would take 92 hours of simulated time to reach it (SITL_Models'
+    mini_talon_vtail: -1e-16..1e16, turned positive by its multiplier; SwiftGust's
+    Sikorsky X2 blades: ±1e12). The
     way is the sign of the joint velocity the plugin commands: the ArduPilotPlugin's
     multiplier, or the motor model's turningDirection (ccw +1, cw -1).
 
     Severity (error, cannot-fly): the rotor stops at the limit.
     """
-    from reedtool.io.sdf import UNBOUNDED_LIMIT
-
     for rotor in _rotors(ctx):
         joint = ctx.robot.joint_map.get(rotor.joint or "")
         if joint is not None and joint.type == "revolute" and joint.limit is not None:
@@ -556,8 +556,8 @@ def rotor_joint_not_continuous(ctx: CheckContext) -> Iterator[Issue]:
                 way = np.sign(_number_or_nan(rotor.param("multiplier") or "1"))
             else:
                 way = rotor.turning_sign
-            if (way > 0 and joint.limit.upper >= UNBOUNDED_LIMIT) \
-                    or (way < 0 and joint.limit.lower <= -UNBOUNDED_LIMIT):
+            if (way > 0 and joint.limit.upper >= ROTOR_LIMIT_OPEN_RAD) \
+                    or (way < 0 and joint.limit.lower <= -ROTOR_LIMIT_OPEN_RAD):
                 continue
         if joint is not None and joint.type != "continuous":
             yield Issue(f"rotor '{rotor.name}' spins joint '{joint.name}', which is {joint.type}",
@@ -633,6 +633,8 @@ def rotor_constant_invalid(ctx: CheckContext) -> Iterator[Issue]:
                                  f" number in {unit}")
 
 
+# A revolute rotor joint's limit this far out is never reached (3000 rad/s: 92 h).
+ROTOR_LIMIT_OPEN_RAD = 1e9
 # Beyond this angle between a rotor's joint axis and its thrust axis, "the way it spins
 # about its thrust axis" is not defined (the two are closer to perpendicular than parallel).
 SPIN_AXIS_UNDEFINED_DEG = 45.0
