@@ -270,7 +270,9 @@ def test_h_frame_on_x_model_reverses_every_spin(tmp_path):
 def test_wrong_class_and_missing_class(tmp_path):
     assert not_info(ap_findings(tmp_path, PARM.replace("FRAME_CLASS 1", "FRAME_CLASS 2"))) \
         == ["C431"]
-    assert not_info(ap_findings(tmp_path, PARM.replace("FRAME_CLASS 1\n", ""))) == ["C430"]
+    # Without FRAME_CLASS the file may be one of several SITL loads: information only.
+    missing = ap_findings(tmp_path, PARM.replace("FRAME_CLASS 1\n", ""))
+    assert [(f.code, f.severity) for f in missing] == [("C430", "info")]
 
 
 def _iris_has_channels() -> bool:

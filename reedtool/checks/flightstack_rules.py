@@ -711,14 +711,18 @@ def _output_text(output: int, line) -> str:
     return f"SERVO{output}" + (f" ({line.loc})" if line is not None else " (default)")
 
 
-@rule("C430", "ardupilot-frame-unknown", "warning",
-      "FRAME_CLASS/FRAME_TYPE is not set or names a frame reedtool has no motor table for.", clause="suspicious")
+@rule("C430", "ardupilot-frame-unknown", "info",
+      "FRAME_CLASS/FRAME_TYPE is not set or names a frame reedtool has no motor table for.",
+      clause="ambiguous")
 def ardupilot_frame_unknown(ctx: CheckContext) -> Iterator[Issue]:
-    """ArduCopter's FRAME_CLASS defaults to 0 (undefined: the motors do not start).
-    reedtool knows the motor tables of quad (plus, X, V, H, V-tail, A-tail, plus-rev,
-    BetaFlight X and reversed, DJI X, clockwise X, no-yaw plus and X), hexa (plus, X),
-    octa (plus, X), octaquad (plus, X, H) and Y6 (default, Y6B, Y6F); for other frames
-    nothing is compared.
+    """ArduCopter's FRAME_CLASS defaults to 0 (undefined: the motors do not start), but a
+    parameter file is often one of several (SITL loads its frame's defaults first, then
+    the user's file), so a file without it cannot be judged alone. reedtool knows the
+    motor tables of quad (plus, X, V, H, V-tail, A-tail, plus-rev, BetaFlight X and
+    reversed, DJI X, clockwise X, no-yaw plus and X), hexa (plus, X), octa (plus, X),
+    octaquad (plus, X, H) and Y6 (default, Y6B, Y6F); for other frames nothing is compared.
+
+    Severity (information): it says what reedtool could not compare.
     """
     for params in _ardupilot(ctx):
         frame_class, frame_type = params.frame()
