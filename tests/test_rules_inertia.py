@@ -159,3 +159,19 @@ def test_merged_link_triangle_is_judged_in_its_parents_body(tmp_path):
     path.write_text(text.replace(line, ""))
     assert [f.code for f in run_checks(load_robot(path), Selection(select=("I20",)))
             if f.subject == "sensor_link"] == []
+
+
+def test_a_small_tensor_is_never_an_error(tmp_path):
+    """gz-sim's plane_propeller shape: the body's tensor 1/200 of its box's, on the link that
+    is most of the robot. Mass gathered inside a shape is real down to any share, so this
+    is I204 (warning) even though it decides the robot's inertia; 200x larger is I209."""
+    text = (INERTIA_FIXTURES / "placeholder_surface.urdf").read_text()
+    base = 'ixx="0.0433333333" ixy="0" ixz="0" iyy="0.0433333333" iyz="0" izz="0.0833333333"'
+    for factor, expected in ((1 / 200, "I204"), (200, "I209")):
+        scaled = (f'ixx="{0.0433333333 * factor:.9g}" ixy="0" ixz="0" '
+                  f'iyy="{0.0433333333 * factor:.9g}" iyz="0" izz="{0.0833333333 * factor:.9g}"')
+        path = tmp_path / "body.urdf"
+        path.write_text(text.replace(base, scaled))
+        found = [f.code for f in run_checks(load_robot(path), Selection(select=("I",)))
+                 if f.subject == "base_link"]
+        assert found == [expected], factor

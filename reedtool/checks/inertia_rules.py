@@ -251,14 +251,15 @@ def inertia_implausible_for_geometry(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("I209", "inertia-orders-off-geometry", "error",
-      "A link's inertia is 100x or more from its geometry's and decides how the robot flies.", clause="cannot-fly")
+      "A link's inertia is 100x or more above its geometry's and decides how the robot flies.", clause="cannot-fly")
 def inertia_orders_off_geometry(ctx: CheckContext) -> Iterator[Issue]:
-    """The declared tensor's trace is at least 100x larger or smaller than that of the
-    link's geometry filled uniformly with the declared mass, and it matters: swapping
+    """The declared tensor's trace is at least 100x larger than that of the link's
+    geometry filled uniformly with the declared mass (a smaller one is I204: mass gathered
+    inside a shape is real, down to any share), and it matters: swapping
     every such tensor of the robot for its geometry's changes a principal moment of the
     whole robot by 2x or more, and this link's share of that change is a tenth or more.
     It is a placeholder value (`1.0` copied into every link: 43,000x for a 0.1 kg wheel
-    of 6 cm radius) or a unit mistake (g·mm² or kg·mm² for kg·m²).
+    of 6 cm radius) or a unit mistake (kg·mm² for kg·m² on the heavy side).
 
     Severity (error: the model as written cannot do what it is for): the robot's attitude
     dynamics are those of another body, beyond the 2x gain margin a controller tuned on
