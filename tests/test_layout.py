@@ -22,9 +22,12 @@ RANK = {
     "checks": 4, "sim": 4,
     "scaffold": 5,
     "report": 6, "config": 6,
-    "commands": 7,
-    "cli": 8,
+    "assembly": 7,
+    "commands": 8,
+    "cli": 9,
 }
+# What the commands share that is not itself a command (click option types).
+COMMANDS_SHARED = {"reedtool.commands", "reedtool.commands.params"}
 MAX_LOOSE_MODULES = 8
 
 
@@ -81,6 +84,40 @@ def test_every_import_points_down_the_pipeline():
             if RANK[there] > RANK[here] or (RANK[there] == RANK[here] and there != ""):
                 wrong.append(f"{module} -> {target}")
     assert wrong == []
+
+
+def test_stages_run_in_pipeline_order():
+    """The assembly sits between the output stage and the commands; checks and sim below it."""
+    order = sorted(RANK, key=RANK.get)
+    assert order.index("assembly") > max(order.index(s) for s in ("checks", "sim", "report"))
+    assert order.index("assembly") < order.index("commands") < order.index("cli")
+
+
+def _command_to_command(graph: dict[str, set[str]]) -> list[str]:
+    wrong = []
+    for module, imported in graph.items():
+        if _stage(module) != "commands" or module in COMMANDS_SHARED:
+            continue
+        wrong += [f"{module} -> {target}" for target in sorted(imported)
+                  if _stage(target) == "commands" and target not in COMMANDS_SHARED
+                  and target != module]
+    return wrong
+
+
+def test_no_command_imports_another_command():
+    """Each command is options -> one call -> report -> exit code; what two commands share
+    lives below them (assembly/, report/), never in one of them."""
+    assert _command_to_command(_graph()) == []
+
+
+def test_command_to_command_imports_are_found():
+    """The check above can fail: hover-test importing validate (as it once did) is caught,
+    the shared option types are not."""
+    graph = {"reedtool.commands.hover_test": {"reedtool.commands.validate",
+                                              "reedtool.commands.params",
+                                              "reedtool.assembly.flight"}}
+    assert _command_to_command(graph) == ["reedtool.commands.hover_test -> "
+                                          "reedtool.commands.validate"]
 
 
 def test_every_module_belongs_to_a_known_stage():

@@ -17,7 +17,7 @@ import pytest
 from cli_helpers import run_cli
 from lxml import etree
 
-from reedtool.commands.layout import ANCHOR_M
+from reedtool.report.layout_picture import ANCHOR_M
 from reedtool.io.loader import load_robot
 from reedtool.physics.rotors import discover_rotors
 from reedtool.scaffold.airframes import FRAMES, MULTIROTOR_FRAMES

@@ -1,5 +1,6 @@
 """The pre-commit hook, run as pre-commit runs it: `pre-commit try-repo` on a sample
-repository holding two broken models. pre-commit installs reedtool from this repository
+repository holding three broken models, one a RotorS-style `.gazebo` top file whose mass
+comes from the xacro arguments of the repository's pyproject.toml. pre-commit installs reedtool from this repository
 into its own environment, which needs the package index (CI has it; offline, skip)."""
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ def _git(cwd: Path, *args: str) -> None:
 
 
 @pytest.mark.slow
-def test_pre_commit_try_repo_reports_both_models_and_fails(tmp_path):
+def test_pre_commit_try_repo_reports_every_model_and_fails(tmp_path):
     pre_commit = _pre_commit()
     if pre_commit is None:
         pytest.skip("pre-commit is not installed")
@@ -53,6 +54,15 @@ def test_pre_commit_try_repo_reports_both_models_and_fails(tmp_path):
     (sample / "urdf").mkdir(parents=True)
     shutil.copy(FIXTURES / "S105_bad_child_missing.urdf", sample / "urdf" / "arm.urdf")
     shutil.copy(FIXTURES / "I203_bad_triangle.urdf", sample / "urdf" / "quad.urdf")
+    # A .gazebo top file (issue 19: the hook matched only .urdf/.xacro/.sdf and printed
+    # "(no files to check) Skipped"); its mass -1 arrives through the config's arguments,
+    # so the run also shows the hook passing pyproject.toml without reading it as a model.
+    (sample / "urdf" / "vehicle.gazebo").write_text(
+        '<?xml version="1.0"?>\n<robot name="vehicle" xmlns:xacro="http://ros.org/wiki/xacro">\n'
+        '  <link name="base_link">\n    <inertial>\n      <mass value="$(arg body_mass)"/>\n'
+        '      <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.02"/>\n'
+        '    </inertial>\n  </link>\n</robot>\n')
+    (sample / "pyproject.toml").write_text('[tool.reedtool]\nargs = {body_mass = "-1"}\n')
     (sample / "README.md").write_text("not a model: the hook's files pattern skips it\n")
     _git(sample, "init", "-q")
     _git(sample, "add", "-A")
@@ -65,7 +75,9 @@ def test_pre_commit_try_repo_reports_both_models_and_fails(tmp_path):
     out = result.stdout + result.stderr
     assert result.returncode == 1, out
     assert "reedtool validate" in out and "Failed" in out
-    # Both models reported, each with its own rule codes, in one run.
+    # Every model reported, each with its own rule codes, in one run.
     assert "urdf/arm.urdf: 2 errors" in out and "urdf/quad.urdf: 1 error" in out
     assert "S105" in out and "S104" in out and "I203" in out
-    assert "2 models: 3 errors" in out
+    assert "urdf/vehicle.gazebo: 2 errors" in out and "has mass -1 kg" in out
+    assert "pyproject.toml" not in out   # passed to the hook, never read as a model
+    assert "3 models: 5 errors" in out

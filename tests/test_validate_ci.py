@@ -115,16 +115,18 @@ def test_ros_package_means_its_top_level_models_with_config_args(capsys, tmp_pat
     assert code == 2
 
 
-def test_a_changed_xacro_part_is_checked_through_the_model_that_includes_it(capsys, tmp_path):
-    """pre-commit passes the changed part alone; alone it has no robot to build (its
-    arguments come from the top file), so it is checked as part of the model beside it."""
+def test_a_xacro_part_given_arguments_is_validated_as_itself(capsys, tmp_path):
+    """Arguments mean "this model" (issue 18): the mechanics file given the launch
+    arguments expands alone into the vehicle, so it is checked as itself, its own I203 on
+    its own line, and never skipped for the .gazebo file beside it."""
     package = Path(shutil.copytree(SEED, tmp_path / "reed_gazebo"))
     part = package / "urdf" / "reed_quad_x.xacro"
     code, doc = run_json([part, "--package-path", tmp_path,
                           *(f"{k}:={v}" for k, v in SEED_ARGS.items())], capsys)
-    by_name = {Path(m["model"]).name: m for m in doc["models"]}
-    assert "part of" in by_name["reed_quad_x.xacro"]["skipped"]
-    assert model_codes(doc)["mav_generic_odometry_sensor.gazebo"] == ["I203", "R312", "S115"]
+    assert [Path(m["model"]).name for m in doc["models"]] == ["reed_quad_x.xacro"]
+    assert doc["models"][0]["skipped"] is None
+    i203 = [f for f in doc["findings"] if f["code"] == "I203"]
+    assert [(Path(f["file"]).name, f["line"]) for f in i203] == [("reed_quad_x.xacro", 30)]
     assert code == 1
 
 

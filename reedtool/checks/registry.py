@@ -130,3 +130,25 @@ def get_rule(code_or_slug: str) -> Rule | None:
     if found is not None:
         return found
     return next((r for r in _RULES.values() if r.slug == key.lower()), None)
+
+
+def suggest_selector(word: str) -> str | None:
+    """The rule code, code prefix or rule name closest to a selector that matches none
+    (`R3O4` -> `R304`: a letter O typed for a zero), for a did-you-mean."""
+    import difflib
+
+    rules = all_rules()
+    key = word.strip()
+    # A code typed with O for 0 or I/l for 1 is the commonest slip; try it first.
+    digits = key[:1].upper() + key[1:].upper().replace("O", "0").replace("I", "1") \
+        .replace("L", "1")
+    codes = {r.code for r in rules}
+    if any(code.startswith(digits) for code in codes) and len(digits) > 1:
+        return digits
+    # Otherwise the nearest code prefix of the same length, or the nearest rule name.
+    prefixes = sorted({r.code[:len(key)] for r in rules if 1 < len(key) <= len(r.code)})
+    close = difflib.get_close_matches(key.upper(), prefixes, n=1, cutoff=0.6)
+    if close:
+        return close[0]
+    close = difflib.get_close_matches(key.lower(), [r.slug for r in rules], n=1, cutoff=0.6)
+    return close[0] if close else None

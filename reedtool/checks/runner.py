@@ -16,7 +16,7 @@ from typing import Iterable, Mapping, Sequence
 
 from reedtool.checks.context import CheckContext
 from reedtool.checks.finding import SEVERITIES, Finding
-from reedtool.checks.registry import Rule, all_rules
+from reedtool.checks.registry import Rule, all_rules, suggest_selector
 from reedtool.errors import ReedtoolError, shorten, shorten_names
 from reedtool.model import Robot
 
@@ -64,10 +64,12 @@ def parse_selectors(values: Iterable[str], *, origin: str) -> tuple[str, ...]:
             elif selector == "ALL":
                 selector = ""
             elif not _SELECTOR.match(selector) or not any(c.startswith(selector) for c in codes):
+                guess = suggest_selector(part)
                 raise ReedtoolError(f"unknown rule selector '{part.strip()}' in {origin}",
-                                    hint="use a code, code prefix or rule name such as S1, I203, R or "
-                                         "inertia-triangle-inequality; "
-                                         "`reedtool rules` lists them")
+                                    hint=(f"did you mean '{guess}'? " if guess else "")
+                                    + "use a code, code prefix or rule name such as S1, I203, "
+                                      "R or inertia-triangle-inequality; "
+                                      "`reedtool rules` lists them")
             out.append(selector)
     return tuple(out)
 

@@ -48,79 +48,22 @@ def _efficiency(items: tuple[str, ...], names: list[str]) -> list[float]:
     return eta
 
 
-def _finite(value: float) -> float | None:
-    return float(value) if math.isfinite(value) else None
-
-
-def analyse(rotors, mass_kg: float, com_m, efficiency=None, degrade: float = 0.0) -> dict:
-    """The JSON-ready report: the intact case and one entry per single-rotor failure (or,
-    with `degrade` > 0, per rotor left with that fraction of its thrust)."""
+def _plot(robot, chosen, params, config, plot_path: Path, force: bool) -> None:
+    """The chosen failure flight as a picture, the failure time marked."""
     import numpy as np
 
-    from reedtool.physics.allocation import allocation_matrix
-    from reedtool.physics.authority import failure_cases
-    from reedtool.physics.trim import STANDARD_GRAVITY_M_S2
+    from reedtool.io.fileio import atomic_write_bytes
+    from reedtool.sim.plot import render
 
-    B = allocation_matrix(rotors, np.asarray(com_m, dtype=float))
-    K = np.array([r.max_thrust_N for r in rotors], dtype=float)
-    eta = np.ones(len(rotors)) if efficiency is None else np.asarray(efficiency, dtype=float)
-    weight_N = mass_kg * STANDARD_GRAVITY_M_S2
-    # The designer's thrust-to-weight: every rotor healthy, at full speed, along body z.
-    thrust_to_weight = float(B[0] @ K) / weight_N
-
-    def entry(a) -> dict:
-        return {"acai": float(a.acai), "rank": a.rank, "controllable": a.controllable,
-                "acai_without_yaw": float(a.acai_without_yaw),
-                "controllable_without_yaw": a.controllable_without_yaw,
-                "min_thrust_to_weight": _finite(a.min_thrust_scale * thrust_to_weight),
-                "min_thrust_to_weight_without_yaw":
-                    _finite(a.min_thrust_scale_without_yaw * thrust_to_weight)}
-
-    intact, failed = failure_cases(B, K, weight_N, eta, failed_efficiency=degrade)
-    failures = []
-    for i, (rotor, a) in enumerate(zip(rotors, failed)):
-        failures.append({"rotor": rotor.name, "index": i, "motor_number": rotor.motor_number,
-                         "direction": rotor.direction, **entry(a)})
-    return {"mass_kg": mass_kg, "weight_N": weight_N, "thrust_to_weight": thrust_to_weight,
-            "efficiency": {r.name: float(e) for r, e in zip(rotors, eta)},
-            "failed_rotor_efficiency": degrade,
-            "intact": entry(intact), "failures": failures}
-
-
-def _fly(robot, rotors, props, report: dict, plot_path: Path | None, force: bool,
-         fail_at_s: float = 1.0, duration_s: float = 6.0) -> None:
-    """Fly every single failure; the controller keeps yaw only where the analysis says it can."""
-    from reedtool.sim import HoverConfig
-    from reedtool.sim.failure import FailureSchedule, simulate_rotor_failure
-    from reedtool.sim.params import VehicleParams, check_rotor_dynamics
-
-    check_rotor_dynamics(rotors)
-    params = VehicleParams.from_rotors(props.mass_kg, props.com_m, props.inertia_kg_m2, rotors)
-    config = HoverConfig(duration_s=duration_s)
-    chosen = None
-    for f in report["failures"]:
-        yaw = f["controllable"] or not f["controllable_without_yaw"]
-        run = simulate_rotor_failure(params, FailureSchedule(f["index"], fail_at_s), config,
-                                     yaw_controlled=yaw, record=plot_path is not None)
-        f["flight"] = {"status": run.status.value, "passed": run.passed,
-                       "yaw_controlled": yaw, "message": run.message}
-        if chosen is None or (chosen.passed and not run.passed):
-            chosen = run
-    if plot_path is not None and chosen is not None:
-        import numpy as np
-
-        from reedtool.io.fileio import atomic_write_bytes
-        from reedtool.sim.plot import render
-
-        keep = [i for i in range(params.n_rotors) if i != chosen.schedule.rotor_index]
-        figure = render(chosen.series(), np.asarray(params.omega_max_rad_s)[keep],
-                        chosen.after.initial_omega_rad_s,
-                        f"{robot.name}: {chosen.status.value}",
-                        fmt=plot_path.suffix.lower().lstrip(".") or "png",
-                        position_tol_m=config.position_tol_m,
-                        attitude_tol_deg=config.attitude_tol_deg,
-                        failures=((chosen.schedule.time_s, f"{chosen.rotor_name} fails"),))
-        atomic_write_bytes(plot_path, figure, force=force)
+    keep = [i for i in range(params.n_rotors) if i != chosen.schedule.rotor_index]
+    figure = render(chosen.series(), np.asarray(params.omega_max_rad_s)[keep],
+                    chosen.after.initial_omega_rad_s,
+                    f"{robot.name}: {chosen.status.value}",
+                    fmt=plot_path.suffix.lower().lstrip(".") or "png",
+                    position_tol_m=config.position_tol_m,
+                    attitude_tol_deg=config.attitude_tol_deg,
+                    failures=((chosen.schedule.time_s, f"{chosen.rotor_name} fails"),))
+    atomic_write_bytes(plot_path, figure, force=force)
 
 
 def meets(report: dict, policy: str) -> bool:
@@ -233,17 +176,16 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
         if plot_path.suffix.lower() not in (".png", ".svg"):
             raise ReedtoolError(f"cannot tell the plot format from '{plot_path.name}'",
                                 file=plot_path, hint="name the --plot file .png or .svg")
-    from reedtool.checks.preflight import require_sound_model
-    from reedtool.io.loader import load_robot
+    from reedtool.assembly.assemble import assemble
+    from reedtool.assembly.models import ModelRequest
     from reedtool.io.mappings import parse_mappings
-    from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
-    from reedtool.physics.rotors import discover_rotors, lift_rotors
 
-    robot = load_robot(model, parse_mappings(mappings), list(package_paths),
-                       model_name=model_name)
-    require_sound_model(robot)
+    request = ModelRequest(mappings=parse_mappings(mappings),
+                           package_paths=list(package_paths), model_name=model_name)
+    assembled = assemble(model, request, validate=False)
+    robot, vehicle = assembled.robot, assembled.vehicle
     # A VTOL's pusher or a plane's puller holds no hover: the lift rotors are analysed.
-    rotors = lift_rotors(discover_rotors(robot))
+    rotors = vehicle.rotors
     if len(rotors) < 1:
         raise ReedtoolError("no motor plugins found: nothing to analyse", file=model,
                             hint="authority needs RotorS, PX4 or gz-sim motor plugins")
@@ -255,14 +197,20 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
         raise ReedtoolError(f"rotor(s) {', '.join(bad)} lack a position, a turning direction "
                             f"or usable constants", file=model,
                             hint="`reedtool validate MODEL` names the problem")
-    props = whole_robot_pinocchio(robot)
+    props = vehicle.props
     if not props.mass_kg > 0:
         raise ReedtoolError("the robot has no mass", file=model,
                             hint="run `reedtool inertia` on the model")
+    from reedtool.assembly.failures import analyse, fly_failures
+
     report = analyse(rotors, props.mass_kg, props.com_m,
                      _efficiency(efficiency_items, [r.name for r in rotors]), degrade)
     if fly:
-        _fly(robot, rotors, props, report, plot_path, force, fail_at_s, duration_s)
+        chosen, params, config = fly_failures(rotors, props, report, fail_at_s=fail_at_s,
+                                              duration_s=duration_s,
+                                              record=plot_path is not None)
+        if plot_path is not None and chosen is not None:
+            _plot(robot, chosen, params, config, plot_path, force)
     report = {"model": robot.name, "require": policy, "passed": meets(report, policy), **report}
     if fmt == "json":
         from reedtool.report.json_format import envelope

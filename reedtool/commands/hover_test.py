@@ -17,6 +17,8 @@ from pathlib import Path
 
 import click
 
+from reedtool.assembly.flight import Progress
+from reedtool.assembly.vehicle import DEFAULT_MAX_MEMORY_MB
 from reedtool.commands.params import FiniteFloatRange, model_arguments
 from reedtool.errors import ReedtoolError
 
@@ -33,44 +35,8 @@ def _validation_json(errors, refused: bool) -> dict:
     return {"errors": [f.to_dict() for f in errors], "refused": refused}
 
 
-# The robustness batch flies all vehicles at once as (k, N) float64 arrays: about 200 state,
-# command and bookkeeping values per vehicle plus ~20 per rotor (measured: 10^7 quads took
-# 22 GB). Estimated before allocating, against --max-memory.
-BATCH_BYTES_PER_VEHICLE = 8 * 200
-BATCH_BYTES_PER_VEHICLE_ROTOR = 8 * 20
-DEFAULT_MAX_MEMORY_MB = 2048
-# Real multirotors have 3 to 16 rotors; a model with hundreds is generated wrongly, and its
-# (rotors x rotors) allocation work is what ran out of memory at 2000.
-MAX_ROTORS = 64
 # A run longer than this on a terminal shows that it is still working.
 PROGRESS_AFTER_S = 2.0
-
-
-def batch_memory_bytes(samples: int, n_rotors: int) -> int:
-    """Estimated peak memory of flying `samples` perturbed vehicles together."""
-    return samples * (BATCH_BYTES_PER_VEHICLE + n_rotors * BATCH_BYTES_PER_VEHICLE_ROTOR)
-
-
-def check_batch_resources(every_rotor, samples: int | None, max_memory_bytes: int) -> None:
-    """Refuse, before anything is allocated, a model or batch this machine cannot fly."""
-    from reedtool.physics.rotors import lift_rotors
-
-    if len(every_rotor) > MAX_ROTORS:
-        source = every_rotor[0].loc.file if every_rotor else None
-        raise ReedtoolError(f"{len(every_rotor)} rotors: more than the {MAX_ROTORS} a multirotor "
-                            "hover test handles", file=source,
-                            hint="is the model generated wrongly? real multirotors have 3 to "
-                                 "16 rotors")
-    n_lift = len(lift_rotors(every_rotor))
-    if samples:
-        need = batch_memory_bytes(samples, n_lift)
-        if need > max_memory_bytes:
-            fit = max_memory_bytes // batch_memory_bytes(1, n_lift)
-            raise ReedtoolError(f"--samples {samples} needs about {need / 2**20:,.0f} MB for "
-                                f"{n_lift} rotors, more than --max-memory "
-                                f"{max_memory_bytes // 2**20} MB",
-                                hint=f"use --samples {fit} or fewer (a few hundred give the "
-                                     "pass rate to a few percent), or raise --max-memory")
 
 
 @click.command(name="hover-test")
@@ -176,20 +142,16 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
         raise ReedtoolError("model file not found", file=model,
                             hint="pass the path of a .urdf or .xacro file")
 
-    from reedtool.checks.preflight import require_sound_model
-    from reedtool.commands.validate import validation_errors
-    from reedtool.io.loader import load_robot
+    from reedtool.assembly.assemble import assemble
+    from reedtool.assembly.models import ModelRequest
     from reedtool.io.mappings import parse_mappings
 
-    robot = load_robot(model, parse_mappings(mappings), list(package_paths),
-                       model_name=model_name)
-    require_sound_model(robot)
-    from reedtool.physics.rotors import discover_rotors
-
+    request = ModelRequest(mappings=parse_mappings(mappings),
+                           package_paths=list(package_paths), model_name=model_name)
     # A model or batch too large for the machine is refused before any rule runs on it.
-    every_rotor = discover_rotors(robot)
-    check_batch_resources(every_rotor, samples, max_memory_mb * 1024 * 1024)
-    errors = validation_errors(model, robot)
+    assembled = assemble(model, request, samples=samples,
+                         max_memory_bytes=max_memory_mb * 1024 * 1024)
+    robot, errors, every_rotor = assembled.robot, assembled.errors, assembled.vehicle.every_rotor
     if errors and not ignore_validation:
         # Bad input (exit 2) comes before what validate finds (exit 1): unreadable rotor
         # parameters.
@@ -217,11 +179,15 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
                                        "passed": False, "status": "refused",
                                        "message": why}, indent=2))
             return 1
+    from reedtool.assembly.flight import hover_test
+
     report = hover_test(robot, config, samples=samples, seed=seed,
                         spreads=(mass_spread, com_spread_m, inertia_spread, motor_spread),
-                        record=bool(plot_path or csv_path), show_progress=fmt == "text",
+                        record=bool(plot_path or csv_path),
+                        progress=TerminalProgress() if fmt == "text" else None,
                         engine=engine, envelope=plot_path is not None,
-                        max_memory_bytes=max_memory_mb * 1024 * 1024)
+                        max_memory_bytes=max_memory_mb * 1024 * 1024,
+                        vehicle=assembled.vehicle)
     batch = report.get("batch")
     if batch is not None:
         batch["min_pass_rate"] = min_pass_rate
@@ -260,134 +226,16 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     return 0 if report["passed"] else 1
 
 
-def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
-               spreads: tuple[float, float, float, float] = (0.1, 0.01, 0.1, 0.05),
-               record: bool = False, show_progress: bool = False,
-               engine: str = "numpy", envelope: bool = False,
-               max_memory_bytes: int = DEFAULT_MAX_MEMORY_MB * 1024 * 1024) -> dict:
-    """Trim, simulate and (optionally) batch one robot; the JSON-ready report.
+class TerminalProgress(Progress):
+    """Progress on stderr: a bar for a batch, elapsed seconds for a long flight."""
 
-    Keys: "model", "trim", "sim" (None when the trim failed), "batch" (None without
-    samples), "passed"; plus "_run" (the HoverRun, for CSV/plot) and "_omega_max".
-    """
-    import numpy as np
+    def flying(self, label: str):
+        return _still_working(label, True)
 
-    from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
-    from reedtool.physics.rotors import (
-        discover_rotors,
-        is_omnidirectional,
-        lift_rotors,
-        rotor_table,
-    )
-    from reedtool.physics.trim import solve_trim, solve_trim_6dof
-    from reedtool.sim import ExitStatus
-    from reedtool.sim.params import VehicleParams, check_rotor_dynamics
-
-    # Hover is held by the lift rotors: a VTOL's pusher or a plane's puller stays off.
-    every_rotor = discover_rotors(robot)
-    rotors = lift_rotors(every_rotor)
-    check_batch_resources(every_rotor, samples, max_memory_bytes)
-    props = whole_robot_pinocchio(robot)
-    # The trim validate judges by (checks.context): the 6-DoF allocation for an
-    # omnidirectional frame, whose reversible rotors may push down.
-    omni = is_omnidirectional(rotors)
-    trim = (solve_trim_6dof if omni else solve_trim)(props.mass_kg, props.com_m, rotors)
-    if every_rotor and not rotors:
-        # A fixed-wing's puller (or a glider with a pusher): motors exist, none lifts.
-        import dataclasses
-
-        roles = ", ".join(f"{r.name} is {r.role}" for r in every_rotor)
-        trim = dataclasses.replace(trim, message=(
-            f"the model has no lift rotors ({roles}: its thrust axis is horizontal); "
-            "a fixed-wing cannot hover"))
-    report: dict = {
-        "model": {"name": robot.name, "file": str(robot.source_file or ""),
-                  "mass_kg": props.mass_kg, "com_m": [float(v) for v in props.com_m],
-                  "inertia_kg_m2": [[float(v) for v in row] for row in props.inertia_kg_m2],
-                  "rotors": len(rotors), "rotor_table": rotor_table(every_rotor)},
-        "trim": trim.to_dict(),
-        "sim": None,
-        "batch": None,
-        "passed": False,
-        "_omega_max": np.array([r.max_rot_velocity_rad_s for r in rotors], dtype=float),
-    }
-    if not trim.feasible:
-        report["status"] = ExitStatus.TRIM_INFEASIBLE.value
-        report["message"] = f"no hover trim: {trim.message}"
-        return report
-
-    if omni:
-        raise ReedtoolError(
-            f"{robot.name}: {trim.message}; hover-test's flight controller cannot fly an "
-            "omnidirectional frame (reversible or many-direction rotors): it commands thrust "
-            "and three torques from rotors that push one way",
-            file=robot.source_file,
-            hint="`reedtool validate` checks this frame's 6-DoF hover trim and allocation")
-    rotors, derived = _ardupilot_motor_response(robot, rotors)
-    report["model"]["derived"] = derived
-    check_rotor_dynamics(rotors)
-    if props.mass_kg <= 0 or not np.all(np.linalg.eigvalsh(props.inertia_kg_m2) > 0):
-        raise ReedtoolError("the whole-robot inertia is not positive definite, nothing can "
-                            "be simulated", file=robot.source_file,
-                            hint="run `reedtool inertia` on the model")
-    params = VehicleParams.from_rotors(props.mass_kg, props.com_m, props.inertia_kg_m2, rotors)
-
-    from reedtool.sim.run import simulate_hover
-
-    with _still_working(f"flying {config.duration_s:g} s at {config.rate_hz:g} Hz",
-                        show_progress):
-        run = simulate_hover(params, config, record=record, engine=engine)
-    sim = run.to_dict()
-    sim["trim_omega_rad_s"] = dict(zip(params.rotor_names,
-                                       (float(w) for w in trim.omega_rad_s)))
-    report["sim"] = sim
-    report["_run"] = run
-    report["status"] = run.status.value
-    report["message"] = run.message
-    report["passed"] = run.passed
-
-    if samples:
-        from reedtool.sim.batch import Spreads, robustness_batch
-
-        mass_rel, com_m, inertia_rel, motor_rel = spreads
-        spread = Spreads(mass_rel=mass_rel, com_m=com_m, inertia_rel=inertia_rel,
-                         motor_constant_rel=motor_rel)
-        if show_progress:
-            with click.progressbar(length=config.n_steps, file=sys.stderr,
-                                   label=f"flying {samples} vehicles") as bar:
-                batch = robustness_batch(params, samples, config, spread, seed,
-                                         progress=bar.update, engine=engine, record=envelope)
-        else:
-            batch = robustness_batch(params, samples, config, spread, seed, engine=engine,
-                                     record=envelope)
-        report["batch"] = batch.to_dict()
-        report["_envelope"] = batch.envelope
-    return report
-
-
-def _ardupilot_motor_response(robot, rotors):
-    """ArduPilotPlugin rotors carry no time constants: derive them from the joint's
-    velocity PID and the rotor's inertia, or refuse with the reason (one line)."""
-    import dataclasses
-
-    from reedtool.physics.rotors import ardupilot_time_constant
-
-    out, derived = [], []
-    for rotor in rotors:
-        if rotor.kind != "ardupilot":
-            out.append(rotor)
-            continue
-        found = ardupilot_time_constant(robot, rotor)
-        if not found.time_constant_s > 0:
-            raise ReedtoolError(
-                f"rotor {rotor.name}: the ArduPilotPlugin gives no motor time constant "
-                f"({found.explanation}), and hover-test simulates the motor response",
-                file=rotor.loc.file, line=rotor.loc.line,
-                hint="`reedtool validate` checks their hover trim from the LiftDrag estimate")
-        out.append(dataclasses.replace(rotor, time_constant_up_s=found.time_constant_s,
-                                       time_constant_down_s=found.time_constant_s))
-        derived.append(f"{rotor.name}: {found.explanation}")
-    return out, derived
+    @contextlib.contextmanager
+    def steps(self, label: str, n_steps: int):
+        with click.progressbar(length=n_steps, file=sys.stderr, label=label) as bar:
+            yield bar.update
 
 
 @contextlib.contextmanager

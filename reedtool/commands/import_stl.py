@@ -150,11 +150,12 @@ def report_lines(outcome: ImportOutcome) -> list[str]:
     imp = outcome.imported
     topo, props = imp.topology, imp.mass
     size = imp.size_m
+    from reedtool.physics.mesh_import import assumption_lines
+
     lines = [
         f"read {imp.source}: {imp.file_format}, {imp.check.triangles} triangles, "
         f"{topo.vertices} vertices",
-        f"units: {imp.units.unit} ({imp.units.reason})",
-        f"frame: {imp.frame.description}",
+        *assumption_lines(imp),
         f"size: {size[0]:.6g} x {size[1]:.6g} x {size[2]:.6g} m (x, y, z in FLU)",
     ]
     if imp.recenter != "none":

@@ -247,14 +247,16 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     inertia error (I201-I203, I207-I210) or a mesh Gazebo cannot load or must not open
     (S130, S131); 0 otherwise, 2 on unreadable input.
     """
+    from reedtool.assembly.assemble import load_robot_for
+    from reedtool.assembly.models import ModelRequest
     from reedtool.checks.preflight import require_sound_model
-    from reedtool.io.loader import load_robot
     from reedtool.io.mappings import parse_mappings
     from reedtool.physics.inertia import compare_links, whole_robot
     from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
 
-    robot = load_robot(model, parse_mappings(mappings), list(package_paths),
-                       model_name=model_name)
+    request = ModelRequest(mappings=parse_mappings(mappings),
+                           package_paths=list(package_paths), model_name=model_name)
+    robot, _ = load_robot_for(model, request, require_sound=False)
     if fix and robot.source_format != "urdf":
         # The blocks --fix writes or prints are URDF <inertial>; SDF spells them differently.
         raise ReedtoolError("--fix edits URDF and xacro models only", file=model,

@@ -16,6 +16,7 @@ class NewPackageResult:
     files: list[PurePosixPath]
     backup: Path | None
     context: dict
+    mesh: object | None = None     # the imported body mesh (physics.mesh_import.ImportedMesh)
 
 
 def template_sets(kind: str, ros: int, sim: str = "classic") -> list[str]:
@@ -37,16 +38,28 @@ def model_path(spec) -> PurePosixPath:
     return PurePosixPath("urdf", f"{spec.name}.urdf.xacro")
 
 
-def _import_body_mesh(spec, units: str, from_frame: str):
-    """Body mesh in metres and FLU, moved so its COM is the body origin, and its inertia."""
+def _import_body_mesh(spec, units: str, from_frame: str | None):
+    """Body mesh in metres and FLU, moved so its COM is the body origin, and its inertia.
+
+    Without --mesh-frame the mesh is read as FLU, unless its extents say another
+    convention fits better (a Y-up or Z-down export): then it is refused, naming them.
+    """
     import numpy as np
 
+    from reedtool.errors import ReedtoolError
     from reedtool.io.stl import stl_bytes
     from reedtool.physics.inertia import MassProperties
-    from reedtool.physics.mesh_import import import_mesh
+    from reedtool.physics.mesh_import import import_mesh, read_axes
 
-    imported = import_mesh(spec.mesh, units=units, from_frame=from_frame,
+    imported = import_mesh(spec.mesh, units=units, from_frame=from_frame or "flu",
                            mass_kg=spec["mass"], recenter="com")
+    reading = read_axes(imported)
+    if from_frame is None and reading.suggested:
+        choices = " or ".join(f"--mesh-frame {name}" for name in reading.suggested)
+        raise ReedtoolError(
+            f"which way is up? {reading.reason}", file=spec.mesh,
+            hint=f"pass {choices} if it was exported so, or --mesh-frame flu to keep its "
+                 "axes (`reedtool import-stl --help` lists every convention)")
     props = MassProperties(imported.mass.mass_kg, np.zeros(3), imported.mass.inertia_kg_m2)
     # The collision box follows the mesh unless the user sized it.
     size_m = imported.size_m
@@ -60,8 +73,20 @@ def _import_body_mesh(spec, units: str, from_frame: str):
     return props, stl_bytes(imported.triangles_m, header=f"reedtool body of {spec.name}"), imported
 
 
+def mesh_lines(imported) -> list[str]:
+    """What new-package assumed about the body mesh, as import-stl says it."""
+    from reedtool.physics.mesh_import import assumption_lines, read_axes
+
+    size = imported.size_m
+    return ([f"body mesh {imported.source}: {imported.file_format}"]
+            + [f"  {line}" for line in assumption_lines(imported)]
+            + [f"  axes: {read_axes(imported).reason}",
+               f"  size: {size[0]:.4g} x {size[1]:.4g} x {size[2]:.4g} m (x, y, z in FLU)"])
+
+
 def new_package(spec, output_dir: Path, *, force: bool = False, mesh_units: str = "auto",
-                mesh_frame: str = "flu", autopilot: str | None = None) -> NewPackageResult:
+                mesh_frame: str | None = None, autopilot: str | None = None
+                ) -> NewPackageResult:
     """Render the package for `spec` into output_dir/spec.name, all or nothing.
 
     `autopilot` ('px4' | 'ardupilot') adds the autopilot's rotor table, written from the
@@ -74,9 +99,9 @@ def new_package(spec, output_dir: Path, *, force: bool = False, mesh_units: str 
 
     target = Path(output_dir) / spec.name
     check_target(target.absolute(), force)   # fail before any expensive work
-    body_props = mesh_data = None
+    body_props = mesh_data = imported = None
     if spec.mesh is not None:
-        body_props, mesh_data, _ = _import_body_mesh(spec, mesh_units, mesh_frame)
+        body_props, mesh_data, imported = _import_body_mesh(spec, mesh_units, mesh_frame)
     from reedtool.scaffold.package_spec import template_context
 
     context = template_context(spec, body_props)
@@ -85,7 +110,7 @@ def new_package(spec, output_dir: Path, *, force: bool = False, mesh_units: str 
         files.append(RenderedFile(PurePosixPath("meshes", context["mesh_file"]), mesh_data, 0o644))
     files += autopilot_files(spec, autopilot)
     backup = write_tree(target, files, force=force)
-    return NewPackageResult(target, sorted(f.path for f in files), backup, context)
+    return NewPackageResult(target, sorted(f.path for f in files), backup, context, imported)
 
 
 def _summary(result: NewPackageResult, spec) -> list[str]:
@@ -95,6 +120,8 @@ def _summary(result: NewPackageResult, spec) -> list[str]:
              f"{spec.frame.title})"]
     if result.backup is not None:
         lines.append(f"previous contents kept in {result.backup}")
+    if result.mesh is not None:
+        lines.extend(mesh_lines(result.mesh))
     if spec.kind == "multirotor":
         lines.append(f"mass {ctx['p']['mass']} kg body, {ctx['total_mass_kg']} kg total; "
                      f"max thrust / weight {ctx['thrust_to_weight']}")
@@ -136,8 +163,9 @@ def _summary(result: NewPackageResult, spec) -> list[str]:
               help="Body mesh; its shape gives the body inertia.")
 @click.option("--mesh-units", default="auto", show_default=True,
               help="Units of the mesh: auto, m, cm, mm, in.")
-@click.option("--mesh-frame", default="flu", show_default=True,
-              help="Axes the mesh was exported in (flu, ned, frd, y-up, ...).")
+@click.option("--mesh-frame", default=None,
+              help="Axes the mesh was exported in (flu, ned, frd, y-up, ...). Default: FLU, "
+                   "unless the mesh's extents say it stands on another axis (then say which).")
 @click.option("-o", "--output-dir", type=click.Path(path_type=Path, file_okay=False),
               default=Path("."), show_default=True,
               help="Directory to create the package directory NAME in.")

@@ -12,15 +12,15 @@ import re
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Sequence
 
 import click
 
+from reedtool.assembly.models import ModelRequest, model_arguments, targets_of
+from reedtool.assembly.validation import selection_for
 from reedtool.commands.params import model_option
 from reedtool.errors import ReedtoolError
 
 FORMATS = ("text", "json", "github", "sarif", "junit")
-_NOT_XACRO = {".urdf", ".sdf", ".world"}
 
 
 def explain(code: str) -> int:
@@ -49,179 +49,73 @@ def _use_color(no_color: bool) -> bool:
 class RunOptions:
     """What the command line says for every model of the run."""
 
-    mappings: dict[str, str] = field(default_factory=dict)
-    package_paths: list[Path] = field(default_factory=list)
-    select: tuple[str, ...] = ()
-    ignore: tuple[str, ...] = ()
-    model_name: str | None = None
-    launch: object | None = None          # reedtool.io.launch.LaunchCall
-    launch_file: Path | None = None
+    request: ModelRequest = field(default_factory=ModelRequest)
     controllers: list = field(default_factory=list)
     flight_params: list = field(default_factory=list)   # --airframe / --autopilot-params
     diagram: Path | None = None           # --diagram: the rotor layout picture
     diagram_per_model: bool = False       # several models: NAME.svg -> NAME-MODEL.svg
     force: bool = False
-
-
-def selection_for(config, select: Sequence[str] = (), ignore: Sequence[str] = ()):
-    """The rule selection of a model: the command line over its configuration."""
-    from reedtool.checks.runner import Selection, parse_selectors, parse_severity_overrides
-
-    origin = str(config.path) if config.path else "config"
-    if select and not parse_selectors(select, origin="--select"):
-        # `--select ""` would run no rule and report a clean model.
-        raise ReedtoolError("--select names no rule", hint="give a code, prefix or rule name "
-                            "such as S, I203 or R; ALL selects every rule")
-    return Selection(
-        select=(parse_selectors(select, origin="--select") if select
-                else parse_selectors(config.select, origin=origin) if config.select is not None
-                else ("",)),
-        ignore=(parse_selectors(config.ignore, origin=origin)
-                + parse_selectors(ignore, origin="--ignore")),
-        severity=parse_severity_overrides(config.severity, origin=origin),
-    )
-
-
-def _config_line(path: Path | None, name: str) -> int | None:
-    """The line of the configuration file that sets argument `name` (best effort)."""
-    if path is None:
-        return None
-    try:
-        lines = path.read_text(encoding="utf-8").splitlines()
-    except OSError:
-        return None
-    pattern = re.compile(r"(^|[{,\s])[\"']?" + re.escape(name) + r"[\"']?\s*=")
-    return next((n for n, line in enumerate(lines, 1) if pattern.search(line)), None)
-
-
-def model_arguments(model: Path, config, options: RunOptions):
-    """The xacro arguments for `model` (configuration, then --launch, then the command
-    line, later ones winning) and their ArgumentUse for the argument rules."""
-    from reedtool.config import relative_to_cwd
-    from reedtool.model import SourceLoc
-
-    mappings: dict[str, str] = {}
-    given: dict[str, SourceLoc | None] = {}
-    origins: dict[str, str] = {}
-    checked: set[str] = set()        # the names rule S140 looks at
-    config_args, _ = config.args_for(model)
-    for name, value in config_args.items():
-        mappings[name] = value
-        line = _config_line(config.path, name)
-        given[name] = SourceLoc(relative_to_cwd(config.path), line) if config.path else None
-        origins[name] = f"config {relative_to_cwd(config.path)}"
-        if name not in config.args:   # per-file-args name this model on purpose
-            checked.add(name)
-    launch = options.launch
-    if launch is not None:
-        for name, value in launch.mappings.items():
-            mappings[name] = value
-            given[name] = launch.locs.get(name, launch.loc)
-            origins[name] = f"--launch {relative_to_cwd(options.launch_file)}"
-            checked.add(name)
-    for name, value in options.mappings.items():
-        mappings[name] = value
-        given[name] = SourceLoc(str(model))     # the model, no line: it was typed
-        origins[name] = "command line"
-        checked.add(name)
-    return mappings, given, origins, checked
-
-
-def _argument_use(model: Path, mappings, given, origins, checked, config, options):
-    from reedtool.io.xacro_args import ArgumentUse, known_arguments
-
-    if model.is_dir() or model.suffix.lower() in _NOT_XACRO or not given:
-        return None
-    declared, complete = known_arguments(model, mappings, options.package_paths)
-    # The config's `args` apply to every model of a repository; they are checked for a
-    # model that reads at least one of them (they are meant for it), so a plain xacro file
-    # next to a RotorS model is not told about arguments it never wanted.
-    if set(config.args) & declared:
-        checked |= set(config.args)
-    return ArgumentUse(declared=declared,
-                       given={n: loc for n, loc in given.items() if n in checked},
-                       origins={n: o for n, o in origins.items() if n in checked},
-                       complete=complete)
-
-
-def load_models(model: Path, mappings, package_paths, model_name):
-    """(display suffix, Robot) pairs of one model path: one, or each model of a world."""
-    from reedtool.io.loader import load_robots
-
-    robots = load_robots(model, mappings, list(package_paths), model_name=model_name)
-    return [("" if len(robots) == 1 else f" [model {r.name}]", r) for r in robots]
+    notes: list[str] = field(default_factory=list)   # one line per clean cross-check
 
 
 def check_model(name: str, model: Path, options: RunOptions) -> list:
     """The ModelResults of one model path (several for a world). Input errors of the
     model itself become a result with `error`; configuration errors raise."""
-    from reedtool.checks.runner import apply_suppressions, parse_selectors, run_checks
-    from reedtool.config import load_config
+    from reedtool.assembly.validation import check_model_path
     from reedtool.report import ModelResult
 
-    config = load_config(model)
-    selection = selection_for(config, options.select, options.ignore)
-    origin = str(config.path) if config.path else "config"
-
-    def ignores_for(file: str | None) -> tuple[str, ...]:
-        return parse_selectors(config.ignores_for(file or model), origin=origin)
-
-    ignores_for(model)   # a bad per-file-ignores selector is a config error, raised now
-    mappings, given, origins, checked = model_arguments(model, config, options)
-    try:
-        arguments = _argument_use(model, mappings, given, origins, checked, config, options)
-        pairs = load_models(model, mappings, options.package_paths, options.model_name)
-    except ReedtoolError as exc:
+    checked = check_model_path(model, options.request, controllers=options.controllers,
+                               flight_params=options.flight_params)
+    if checked.error is not None:
+        exc = checked.error
         return [ModelResult(name, error=exc.one_line(), error_file=exc.file,
                             error_line=exc.line)]
     results = []
-    for suffix, robot in pairs:
-        findings = run_checks(robot, selection, controllers=options.controllers,
-                              flight_params=options.flight_params, arguments=arguments)
-        kept, dropped = apply_suppressions(findings, ignores_for)
-        results.append(ModelResult(name + suffix, kept, suppressed=dropped))
+    for one in checked.models:
+        results.append(ModelResult(name + one.suffix, one.findings, suppressed=one.suppressed))
+        if not one.suppressed:     # a silenced flight-stack finding is no agreement
+            options.notes += _agreement_lines(model, one.robot, one.findings, options,
+                                              name + one.suffix)
         if options.diagram is not None:
-            _write_diagram(robot, kept, options, several=len(pairs) > 1)
+            _write_diagram(one.robot, one.findings, options, several=len(checked.models) > 1)
     return results
 
 
+def _agreement_lines(path: Path, robot, findings, options: RunOptions, model: str
+                     ) -> list[str]:
+    """One line per --airframe/--autopilot-params file the model agrees with: every rule
+    of that flight stack ran and none found anything above information."""
+    if not options.flight_params or any(f.code.startswith("S") and f.severity == "error"
+                                        for f in findings):
+        return []     # a broken tree: the flight-stack rules did not look
+    from reedtool.checks.registry import all_rules
+    from reedtool.config import load_config
+    from reedtool.flightstack.params_files import agreement_line
+    from reedtool.physics.rotors import discover_rotors
+
+    selection = selection_for(load_config(path), options.request.select,
+                              options.request.ignore)
+    rotors = discover_rotors(robot)
+    lines = []
+    for params in options.flight_params:
+        rules = [r for r in all_rules() if r.check.__module__.endswith(".flightstack_rules")
+                 and r.slug.startswith(params.kind)]
+        ran = all(selection.enabled(r.code) for r in rules)
+        quiet = not any(f.code in {r.code for r in rules} and f.severity != "info"
+                        for f in findings)
+        counted = rotors if params.kind == "px4" else [r for r in rotors if r.role == "lift"]
+        if rules and ran and quiet and counted:
+            lines.append(agreement_line(params, len(counted), model))
+    return lines
+
+
 def _write_diagram(robot, findings, options: RunOptions, several: bool) -> None:
-    from reedtool.commands.layout import write_diagram
+    from reedtool.assembly.diagram import write_diagram
 
     target = options.diagram
     if several or options.diagram_per_model:
         target = target.with_name(f"{target.stem}-{robot.name}{target.suffix}")
     write_diagram(robot, target, findings, options.force)
-
-
-def validation_errors(model: Path, robot) -> list:
-    """The error findings `validate` reports for an already loaded robot (its config's
-    selection, severities and suppressions): what hover-test refuses to fly."""
-    from reedtool.checks.runner import apply_suppressions, parse_selectors, run_checks
-    from reedtool.config import load_config
-
-    config = load_config(model)
-    origin = str(config.path) if config.path else "config"
-    findings = run_checks(robot, selection_for(config))
-    kept, _ = apply_suppressions(
-        findings, lambda file: parse_selectors(config.ignores_for(file or model), origin=origin))
-    return [f for f in kept if f.severity == "error"]
-
-
-def targets_of(paths: Sequence[str], options: RunOptions):
-    from reedtool.config import load_config
-    from reedtool.io.model_inputs import expand_targets, include_tree_of
-    from reedtool.report import display_path
-
-    def mappings_for(path: Path) -> dict[str, str]:
-        try:
-            config = load_config(path)
-        except ReedtoolError:
-            return dict(options.mappings)
-        return model_arguments(path, config, options)[0]
-
-    return expand_targets(paths, include_tree_of(mappings_for, options.package_paths),
-                          display=lambda p: display_path(str(p)) or str(p))
 
 
 def print_settings(targets, options: RunOptions) -> int:
@@ -242,13 +136,13 @@ def print_settings(targets, options: RunOptions) -> int:
             click.echo(f"  config: {relative_to_cwd(config.path)}")
             for other in config.candidates[1:]:
                 click.echo(f"  also found (not used, the nearest wins): {relative_to_cwd(other)}")
-        selection = selection_for(config, options.select, options.ignore)
+        selection = selection_for(config, options.request.select, options.request.ignore)
         click.echo(f"  select: {', '.join(s or 'ALL' for s in selection.select)}")
         click.echo(f"  ignore: {', '.join(selection.ignore) or '-'}")
         click.echo("  severity: " + (", ".join(f"{k} = {v}" for k, v in selection.severity.items())
                                      or "-"))
         click.echo(f"  strict: {str(config.strict).lower()}")
-        mappings, _, origins, _ = model_arguments(target.path, config, options)
+        mappings, _, origins, _ = model_arguments(target.path, config, options.request)
         for name in sorted(mappings):
             click.echo(f"  arg {name}:={mappings[name]}  ({origins[name]})")
         ignores = config.ignores_for(target.path)
@@ -309,7 +203,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
             no_color: bool, controller_files: tuple[Path, ...] = (),
             airframe_files: tuple[Path, ...] = (), autopilot_files: tuple[Path, ...] = (),
             diagram: Path | None = None) -> int:
-    """Check models (.urdf, .xacro or .sdf files, directories, globs, ROS packages) for
+    """Check models (.urdf, .xacro, .gazebo, .sdf or .world files, directories, globs, ROS
+    packages, or a changed pyproject.toml/reedtool.toml: the models it configures) for
     mistakes; NAME:=VALUE words are xacro arguments for every model.
 
     Exit 0 when there is no error, 1 when there are errors (or warnings with --strict),
@@ -322,26 +217,38 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
 
     mappings = parse_mappings([w for w in inputs if MAPPING_SEPARATOR in w])
     paths = [w for w in inputs if MAPPING_SEPARATOR not in w]
-    options = RunOptions(mappings=mappings, package_paths=list(package_paths),
-                         select=select, ignore=ignore, model_name=model_name,
-                         launch_file=launch_file, diagram=diagram, force=force)
+    from reedtool.io.mappings import suggest_mapping
+
+    for word in paths:
+        if not Path(word).exists() and suggest_mapping(word) is not None:
+            # `mav_name=foo` names no file: an argument missing its `:`, not a model.
+            raise ReedtoolError(f"'{word}' is not a file; xacro arguments are written "
+                                "name:=value", hint=f"did you mean '{suggest_mapping(word)}'?")
+    request = ModelRequest(mappings=mappings, package_paths=list(package_paths),
+                           select=select, ignore=ignore, model_name=model_name,
+                           launch_file=launch_file)
+    options = RunOptions(request=request, diagram=diagram, force=force)
     if launch_file is not None:
         from reedtool.io.launch import read_launch
 
-        options.launch = read_launch(launch_file, package_paths=list(package_paths))
+        request.launch = read_launch(launch_file, package_paths=list(package_paths))
         if not paths:
-            if options.launch.model is None:
+            if request.launch.model is None:
                 raise ReedtoolError("the launch file's xacro call names no model reedtool "
                                     "can evaluate", file=launch_file,
                                     hint="pass the model path before the options")
-            paths = [str(options.launch.model)]
+            paths = [str(request.launch.model)]
     if not paths:
         raise click.UsageError("missing argument 'MODEL' (or use --explain CODE)")
     if len(paths) == 1 and not Path(paths[0]).exists() and not re.search(r"[*?\[]", paths[0]):
         # One model that is not there: the one-line error of every command, exit 2.
-        raise ReedtoolError("file not found", file=paths[0], hint="check the model path")
+        from reedtool.io.model_inputs import not_found_message
 
-    targets = targets_of(paths, options)
+        message = not_found_message(paths[0])
+        raise ReedtoolError(message, file=paths[0],
+                            hint=None if message != "file not found" else "check the model path")
+
+    targets = targets_of(paths, request)
     if show_settings:
         return print_settings(targets, options)
     if controller_files:
@@ -370,6 +277,13 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
             results.append(ModelResult(target.name, error=target.error, error_file=target.name))
             continue
         model_results = check_model(target.name, target.path, options)
+        if target.checked_for is not None:
+            for result in model_results:
+                if result.error is not None:
+                    # The failure is this model's; name the file it was checked for.
+                    result.error += (f" [checked for {target.checked_for}, which it includes; "
+                                     f"give {target.checked_for} its arguments (name:=value) "
+                                     "to validate it as a model of its own]")
         results.extend(model_results)
         if len(targets) == 1 and results[-1].error is not None:
             # One model: its input error is the one-line error of every command.
@@ -389,6 +303,9 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
         atomic_write_text(output_file, text, force=force)
     else:
         click.echo(text, nl=False, color=color)
+    for note in options.notes:
+        # Text on the terminal carries it; machine formats and files stay as they are.
+        click.echo(note, err=fmt != "text" or output_file is not None)
     if any(r.error is not None for r in results):
         return 2
     if exit_zero:

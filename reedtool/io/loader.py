@@ -17,6 +17,7 @@ def load_robots(path: Path | str, mappings: Mapping[str, str] | None = None,
     """The models `validate` checks: one for URDF/xacro, a model file or `model_name`; for
     an SDF world, each multirotor model (each model when none has motor plugins)."""
     path = Path(path)
+    refuse_mesh(path)
     if model_name is None and _sdf_path(path) is not None:
         from reedtool.io.packages import PackageResolver
         from reedtool.io.sdf import load_sdf_models
@@ -26,6 +27,20 @@ def load_robots(path: Path | str, mappings: Mapping[str, str] | None = None,
         return [_with_package_notes(robot, resolver)
                 for robot in load_sdf_models(sdf, resolver=resolver)]
     return [load_robot(path, mappings, package_paths, model_name=model_name)]
+
+
+def refuse_mesh(path: Path) -> None:
+    """A mesh named where a model belongs: say so, and how a mesh becomes part of one
+    (read as XML it would only be "malformed XML at column 1")."""
+    from reedtool.io.meshes import GZ_MESH_SUFFIXES
+
+    suffix = path.suffix.lower()
+    if suffix in GZ_MESH_SUFFIXES and not path.is_dir():
+        raise ReedtoolError(
+            f"is a mesh ({suffix[1:].upper()}), not a robot model (.urdf, .xacro, .gazebo, "
+            ".sdf or .world)", file=path,
+            hint=f"`reedtool import-stl {path.name} --package DIR` puts it in a package in "
+                 "metres and FLU with its inertia, and prints the <link> that uses it")
 
 
 def _with_package_notes(robot: Robot, resolver) -> Robot:
@@ -72,6 +87,7 @@ def load_robot(path: Path | str, mappings: Mapping[str, str] | None = None,
     path = Path(path)
     if not path.exists():
         raise ReedtoolError("file not found", file=path, hint="check the model path")
+    refuse_mesh(path)
     if path.is_dir():
         path = _model_dir_sdf(path)
     if path.suffix.lower() in SDF_SUFFIXES:

@@ -3,8 +3,16 @@
 pre-commit passes every changed file; CI passes a directory or a glob. Each target becomes
 a list of model files:
 
-- a file: itself, unless it is a xacro part that a model beside it includes (pre-commit
-  passes the changed part alone): then that model, which is what the part is checked in;
+- a file: itself when it is a model (issue 18: arguments mean "this model"). A xacro file
+  given arguments (`name:=value`, `--launch`, a per-file table of the config) is validated
+  as itself; without them, a file that expands alone (with the config's repository-wide
+  `args`) into a robot with links is too. Only a file that
+  cannot stand alone (a macro library, or a part that needs the arguments of the model
+  that includes it) is checked through a model beside it that includes it, preferring one
+  that loads; that model's failure is reported against it, naming the part;
+- a configuration file (pyproject.toml with `[tool.reedtool]`, reedtool.toml): the models
+  of its directory, since the xacro arguments it carries reach all of them (pre-commit
+  passes it when it changes);
 - a directory holding `model.sdf`: that SDF model;
 - a ROS package (a directory with `package.xml`): the top-level models of its `urdf/`
   (and `models/`, `sdf/` for SDF), skipping xacro macro libraries;
@@ -13,22 +21,30 @@ a list of model files:
 
 A top-level model is one that a robot can be built from: its root is `<robot>` (or
 `<sdf>`) and it does more than define macros, properties and arguments; a file that
-another candidate includes is part of that model, not a model of its own.
+another candidate includes is part of that model, not a model of its own. An include whose
+file name uses an argument without a value (`$(arg mav_name)_base.xacro`) may include
+every file its name matches, so `*_base.xacro` beside such a top file is a part of it.
 A target that names nothing is an input error for that target alone.
 """
 
 from __future__ import annotations
 
+import fnmatch
 import glob as globmod
 import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Mapping, Sequence
 
-MODEL_SUFFIXES = (".urdf", ".xacro", ".sdf", ".world")
-# In a package, RotorS keeps its top-level models in `.gazebo` files (mav_generic_odometry_
-# sensor.gazebo includes <mav>_base.xacro), so a package's urdf/ is searched for them too.
-PACKAGE_SUFFIXES = (*MODEL_SUFFIXES, ".gazebo")
+# Every model file a ROS/Gazebo package uses (`.urdf.xacro` ends in `.xacro`). RotorS keeps
+# its top-level models in `.gazebo` files (mav_generic_odometry_sensor.gazebo includes
+# <mav>_base.xacro); worlds are `.world`. .pre-commit-hooks.yaml matches the same list.
+MODEL_SUFFIXES = (".urdf", ".xacro", ".gazebo", ".sdf", ".world")
+PACKAGE_SUFFIXES = MODEL_SUFFIXES
+# Files that xacro expands: a part of one of them may be checked through another.
+XACRO_SUFFIXES = (".xacro", ".gazebo")
+# Configuration files that carry xacro arguments (reedtool.config).
+CONFIG_NAMES = ("pyproject.toml", "reedtool.toml")
 PACKAGE_MODEL_DIRS = ("urdf", "models", "sdf", "worlds")
 _GLOB_CHARS = re.compile(r"[*?\[]")
 _LIBRARY_CHILDREN = {"macro", "property", "arg", "include", "xacro:macro", "xacro:property",
@@ -43,6 +59,7 @@ class Target:
     path: Path | None
     error: str | None = None
     skipped: str | None = None   # why a named file is not checked (a macro library)
+    checked_for: str | None = None   # the named part this model is checked for (display)
 
 
 def _root_and_children(path: Path) -> tuple[str | None, list[str]]:
@@ -73,13 +90,29 @@ def is_macro_library(path: Path) -> bool:
     return bool(children) and all(c in _LIBRARY_CHILDREN for c in children)
 
 
-def _top_level(files: list[Path], include_tree: Callable[[Path], Sequence[Path]]) -> list[Path]:
+def _top_level(files: list[Path], include_tree: Callable[[Path], Sequence[Path]],
+               include_globs: Callable[[Path], Sequence[str]] | None = None) -> list[Path]:
     candidates = [f for f in files if not is_macro_library(f)]
     included: set[Path] = set()
-    for candidate in candidates:
-        if candidate.suffix.lower() not in (".sdf", ".world"):
-            included.update(p.resolve() for p in include_tree(candidate)[1:])
+    # Every file's includes count, a library's too: a file that only includes the vehicle
+    # picked by `$(arg mav_name)` reads like a library and still makes it a part.
+    for file in files:
+        if file.suffix.lower() not in (".sdf", ".world"):
+            included.update(p.resolve() for p in include_tree(file)[1:])
+            for pattern in (include_globs(file) if include_globs else ()):
+                included.update(c.resolve() for c in candidates
+                                if c != file and _matches(c, pattern))
     return [c for c in candidates if c.resolve() not in included]
+
+
+def _matches(path: Path, pattern: str) -> bool:
+    """Does `path` match an include pattern (a directory, then a file-name glob)?"""
+    wanted = Path(pattern)
+    try:
+        return (path.resolve().parent == wanted.parent.resolve()
+                and fnmatch.fnmatchcase(path.name, wanted.name))
+    except OSError:
+        return False
 
 
 def _model_files(directory: Path, recursive: bool,
@@ -95,67 +128,112 @@ def _model_files(directory: Path, recursive: bool,
 SIBLING_MAX_BYTES = 1024 * 1024
 
 
-def _includer(path: Path, include_tree: Callable[[Path], Sequence[Path]]) -> Path | None:
-    """A top-level model in the same directory whose includes read `path`, if any."""
+def _includers(path: Path, include_tree: Callable[[Path], Sequence[Path]],
+               include_globs: Callable[[Path], Sequence[str]] | None = None) -> list[Path]:
+    """The models in the same directory whose includes read `path`, top-level ones first
+    (a `<mav>_base.xacro` that a .gazebo file picks by argument still includes its parts)."""
     key = path.resolve()
     siblings = [f for f in _model_files(path.parent, recursive=False,
                                         suffixes=PACKAGE_SUFFIXES)
                 if f.resolve() != key and f.stat().st_size <= SIBLING_MAX_BYTES]
-    for sibling in _top_level(siblings, include_tree):
-        if key in {p.resolve() for p in include_tree(sibling)[1:]}:
-            return sibling
-    return None
+    top = set(_top_level(siblings, include_tree, include_globs))
+    includers = [sibling for sibling in siblings if not is_macro_library(sibling)
+                 and key in {p.resolve() for p in include_tree(sibling)[1:]}]
+    return sorted(includers, key=lambda sibling: sibling not in top)
+
+
+def _memo(function: Callable[[Path], Sequence]) -> Callable[[Path], Sequence]:
+    cache: dict[Path, Sequence] = {}
+
+    def cached(path: Path) -> Sequence:
+        key = path.resolve()
+        if key not in cache:
+            cache[key] = function(path)
+        return cache[key]
+
+    return cached
+
+
+def _never(_path: Path) -> bool:
+    return False
 
 
 def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequence[Path]],
-                   display: Callable[[Path], str] = str) -> list[Target]:
+                   display: Callable[[Path], str] = str, *,
+                   include_globs: Callable[[Path], Sequence[str]] | None = None,
+                   has_arguments: Callable[[Path], bool] = _never,
+                   stands_alone: Callable[[Path], bool] = _never,
+                   configures_models: Callable[[Path], bool] = _never) -> list[Target]:
     """Every model the targets name, in order, each once.
 
     `include_tree(path)` lists the files a xacro model reads (itself first); it decides
-    which files of a directory are parts of another model.
+    which files of a directory are parts of another model. `include_globs(path)` adds the
+    includes whose file names use an argument without a value, as glob patterns.
+    `has_arguments(path)`: the user gave this file arguments (command line, --launch or a
+    per-file table of the config). `stands_alone(path)`: the file loads alone into a robot
+    with links (the caller may keep what it loaded). `configures_models(path)`: the file is
+    a reedtool configuration (its directory's models are checked when it changes).
     """
+    include_tree = _memo(include_tree)
+    include_globs = _memo(include_globs) if include_globs is not None else None
     out: list[Target] = []
     seen: set[Path] = set()
 
-    def add(path: Path) -> None:
+    def add(path: Path, checked_for: str | None = None) -> None:
         key = path.resolve()
         if key not in seen:
             seen.add(key)
-            out.append(Target(display(path), path))
+            out.append(Target(display(path), path, checked_for=checked_for))
+
+    def add_directory(path: Path, raw: str) -> None:
+        if (path / "package.xml").is_file():
+            files = [f for sub in PACKAGE_MODEL_DIRS if (path / sub).is_dir()
+                     for f in _model_files(path / sub, recursive=sub != "urdf",
+                                           suffixes=PACKAGE_SUFFIXES)]
+        else:
+            files = _model_files(path, recursive=True)
+        models = _top_level(files, include_tree, include_globs)
+        if not models:
+            out.append(Target(raw, None, "no model file (" + ", ".join(MODEL_SUFFIXES)
+                              + ") found in this directory"))
+        for model in models:
+            add(model)
+
+    def add_file(path: Path) -> None:
+        xacro = path.is_file() and path.suffix.lower() in XACRO_SUFFIXES
+        includers = _includers(path, include_tree, include_globs) if xacro else []
+        library = xacro and is_macro_library(path)
+        if library and not includers:
+            # pre-commit passes every changed file: a macro library has no robot of its
+            # own; the models that include it are where its mistakes show.
+            out.append(Target(display(path), None, skipped="a xacro macro library (no "
+                              "robot of its own); validate the models that include it"))
+            return
+        if not library and (not includers or has_arguments(path) or stands_alone(path)):
+            add(path)     # a device or a pipe too: the loader says what is wrong with it
+            return
+        # A part that cannot stand alone: checked in a model that includes it, one that
+        # loads if there is one, so a broken sibling does not stand in for the part.
+        includer = next((i for i in includers if stands_alone(i)), includers[0])
+        out.append(Target(display(path), None,
+                          skipped=f"part of {display(includer)}, checked through it"))
+        add(includer, checked_for=display(path))
 
     for raw in targets:
         path = Path(raw)
-        if path.exists() and not path.is_dir():
-            if path.is_file() and path.suffix.lower() == ".xacro" and is_macro_library(path):
-                # pre-commit passes every changed file: a macro library has no robot of its
-                # own; the models that include it are where its mistakes show.
-                out.append(Target(display(path), None, skipped="a xacro macro library (no "
-                                  "robot of its own); validate the models that include it"))
-                continue
-            includer = (_includer(path, include_tree)
-                        if path.is_file() and path.suffix.lower() == ".xacro" else None)
-            if includer is not None:
-                out.append(Target(display(path), None,
-                                  skipped=f"part of {display(includer)}, checked through it"))
-                add(includer)
-                continue
-            add(path)     # a device or a pipe too: the loader says what is wrong with it
+        if path.is_file() and path.name in CONFIG_NAMES:
+            if configures_models(path):
+                add_directory(path.parent, raw)
+            else:
+                out.append(Target(display(path), None, skipped="not a model, and no "
+                                  "reedtool configuration in it"))
+        elif path.exists() and not path.is_dir():
+            add_file(path)
         elif path.is_dir():
             if (path / "model.sdf").is_file():
                 add(path)
-                continue
-            if (path / "package.xml").is_file():
-                files = [f for sub in PACKAGE_MODEL_DIRS if (path / sub).is_dir()
-                         for f in _model_files(path / sub, recursive=sub != "urdf",
-                                               suffixes=PACKAGE_SUFFIXES)]
             else:
-                files = _model_files(path, recursive=True)
-            models = _top_level(files, include_tree)
-            if not models:
-                out.append(Target(raw, None, "no .urdf, .xacro or .sdf model found in this "
-                                             "directory"))
-            for model in models:
-                add(model)
+                add_directory(path, raw)
         elif _GLOB_CHARS.search(raw):
             matches = sorted(Path(m) for m in globmod.glob(raw, recursive=True))
             files = [m for m in matches if m.is_file()]
@@ -164,8 +242,19 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
             for match in files:
                 add(match)
         else:
-            out.append(Target(raw, None, "file not found"))
+            out.append(Target(raw, None, not_found_message(raw)))
     return out
+
+
+def not_found_message(word: str) -> str:
+    """"file not found", or what the word looks like it meant (an argument without `:=`)."""
+    from reedtool.io.mappings import suggest_mapping
+
+    suggestion = suggest_mapping(word)
+    if suggestion is not None:
+        return (f"file not found; xacro arguments are written name:=value: did you mean "
+                f"'{suggestion}'?")
+    return "file not found"
 
 
 def include_tree_of(mappings_for: Callable[[Path], Mapping[str, str]],
@@ -182,3 +271,42 @@ def include_tree_of(mappings_for: Callable[[Path], Mapping[str, str]],
             return [path]
 
     return tree
+
+
+_ARG = re.compile(r"\$\(\s*arg\s+([^)\s]+)\s*\)")
+_FIND = re.compile(r"\$\(\s*find\s+([^)\s]+)\s*\)")
+
+
+def include_globs_of(mappings_for: Callable[[Path], Mapping[str, str]],
+                     package_paths: Sequence[Path]) -> Callable[[Path], Sequence[str]]:
+    """An `include_globs` for expand_targets: includes of a file (its own, not followed)
+    whose names use an argument without a value, that argument read as `*`. RotorS's
+    `$(find pkg)/urdf/$(arg mav_name)_base.xacro` becomes `.../urdf/*_base.xacro`."""
+
+    def globs(path: Path) -> Sequence[str]:
+        from reedtool.io.legacy_xacro import include_specs
+        from reedtool.io.packages import PackageResolver
+
+        try:
+            text = path.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError):
+            return []
+        mappings = dict(mappings_for(path))
+        resolver = PackageResolver(package_paths, model_path=path)
+        out = []
+        for spec in include_specs(text):
+            names = _ARG.findall(spec)
+            if not any(name not in mappings for name in names):
+                continue     # resolved exactly, or not at all, by the include tree
+            try:
+                pattern = _FIND.sub(lambda m: str(resolver.find(m.group(1))), spec)
+            except Exception:  # noqa: BLE001 - an unknown package: nothing to match
+                continue
+            pattern = _ARG.sub(lambda m: mappings.get(m.group(1), "*"), pattern)
+            if "$" in pattern or not Path(pattern).name.replace("*", ""):
+                continue     # other substitutions, or a name that is only a wildcard
+            full = Path(pattern) if Path(pattern).is_absolute() else path.parent / pattern
+            out.append(str(full))
+        return out
+
+    return globs

@@ -199,3 +199,70 @@ def import_mesh(path: str | Path, *, units: str = "auto", from_frame: str = "flu
                    "obj": "OBJ"}.get(read.format, read.format)
     return ImportedMesh(path, file_format, triangles, choice, frame, offset, recenter, check,
                         topo, props, mass_source, collision_m, spec, notes)
+
+
+# ------------------------------------------------------------------ what was assumed
+
+def assumption_lines(imported: ImportedMesh) -> list[str]:
+    """The unit and axis reasoning `import-stl` and `new-package --mesh` both print."""
+    return [f"units: {imported.units.unit} ({imported.units.reason})",
+            f"frame: {imported.frame.description}"]
+
+
+# A vehicle body is flatter than it is wide: its height is its thinnest extent. Another
+# axis this much thinner than the assumed height says the mesh stands on another axis
+# (a 300 x 60 x 350 mm Y-up body read as Z-up is 35 cm tall and 6 cm wide: ratio 5.8).
+TALLER_THAN_THINNEST = 1.5
+# A part drawn upward from its CAD origin on a Z-down (NED/FRD) export lies wholly on the
+# negative side of the assumed up axis; allow this fraction of its height as round-off.
+ORIGIN_SLACK = 0.01
+
+
+@dataclass(frozen=True)
+class AxisReading:
+    """What a mesh's extents say about its axes, against the convention assumed."""
+
+    suggested: tuple[str, ...]     # conventions the extents fit better; () = the assumed fits
+    reason: str
+
+
+def _conventions_with(source_axis: int, letter: str, assumed: str) -> tuple[str, ...]:
+    """Named conventions, then the letter codes closest to the `assumed` code, whose
+    source axis `source_axis` points `letter` (u or d)."""
+    from reedtool.frames import ALIASES, RIGHT_HANDED_CODES
+
+    named = [name for name, (code, _) in ALIASES.items() if code[source_axis] == letter]
+    # Closest first; on a tie, x forward (FLU, FRD, NED all keep it) before the rest.
+    codes = sorted((code for code in RIGHT_HANDED_CODES if code[source_axis] == letter),
+                   key=lambda code: (-sum(a == b for a, b in zip(code, assumed)),
+                                     code[0] != "f"))
+    return tuple(dict.fromkeys(named + codes[:1]))
+
+
+def read_axes(imported: ImportedMesh) -> AxisReading:
+    """Does the mesh sit as a body does in the assumed convention (thinnest extent up, not
+    hanging wholly below its origin)? Otherwise, the conventions that fit its extents."""
+    vertices = imported.triangles_m.reshape(-1, 3) - imported.offset_m   # before recentring
+    low, high = vertices.min(axis=0), vertices.max(axis=0)
+    size = high - low
+    R = imported.frame.R_flu_src
+    names = "xyz"
+    thinnest = int(np.argmin(size))
+    shown = " x ".join(f"{s * 1000:.4g}" for s in size)
+    if thinnest != 2 and size[2] > TALLER_THAN_THINNEST * size[thinnest]:
+        source_axis = int(np.argmax(np.abs(R[thinnest])))   # the source axis on FLU `thinnest`
+        return AxisReading(
+            _conventions_with(source_axis, "u", imported.frame.code),
+            f"read as {imported.frame.name.upper()} the body is {shown} mm (x, y, z in FLU): "
+            f"{size[2] * 1000:.4g} mm tall and {size[thinnest] * 1000:.4g} mm along "
+            f"{names[thinnest]}; a body is thinnest in height, so its source "
+            f"{names[source_axis]} axis is most likely up")
+    if low[2] < 0 and high[2] <= ORIGIN_SLACK * size[2]:
+        source_axis = int(np.argmax(np.abs(R[2])))
+        return AxisReading(
+            _conventions_with(source_axis, "d", imported.frame.code),
+            f"read as {imported.frame.name.upper()} the body lies wholly below its origin "
+            f"(z from {low[2] * 1000:.4g} to {high[2] * 1000:.4g} mm): a part drawn upward "
+            f"from its CAD origin in a {names[source_axis]}-down export")
+    return AxisReading((), f"read as {imported.frame.name.upper()} the body is {shown} mm "
+                           "(x, y, z in FLU), thinnest in height, as a body is")

@@ -1,0 +1,158 @@
+"""A model path and what the command line, a launch file and the configuration say about
+it -> the xacro arguments it is expanded with -> its robots.
+
+Arguments come from three places, later ones winning: `[tool.reedtool] args` (and
+`per-file-args`) of the nearest configuration, `--launch FILE`, and `name:=value` words.
+Every command resolves them here, so a model means the same robot to each of them.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Sequence
+
+from reedtool.errors import ReedtoolError
+
+_NOT_XACRO = {".urdf", ".sdf", ".world"}
+
+
+@dataclass
+class ModelRequest:
+    """What the command line says about the models of a run."""
+
+    mappings: dict[str, str] = field(default_factory=dict)
+    package_paths: list[Path] = field(default_factory=list)
+    model_name: str | None = None         # --model: one model of an SDF world
+    launch: object | None = None          # reedtool.io.launch.LaunchCall
+    launch_file: Path | None = None
+    select: tuple[str, ...] = ()
+    ignore: tuple[str, ...] = ()
+    # Models loaded while deciding what a named file means (io.model_inputs), kept so the
+    # check does not expand them twice: resolved path -> load_models pairs.
+    preloaded: dict = field(default_factory=dict)
+
+
+def _config_line(path: Path | None, name: str) -> int | None:
+    """The line of the configuration file that sets argument `name` (best effort)."""
+    if path is None:
+        return None
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except OSError:
+        return None
+    pattern = re.compile(r"(^|[{,\s])[\"']?" + re.escape(name) + r"[\"']?\s*=")
+    return next((n for n, line in enumerate(lines, 1) if pattern.search(line)), None)
+
+
+def model_arguments(model: Path, config, request: ModelRequest):
+    """The xacro arguments for `model` (configuration, then --launch, then the command
+    line, later ones winning) and their ArgumentUse for the argument rules."""
+    from reedtool.config import relative_to_cwd
+    from reedtool.model import SourceLoc
+
+    mappings: dict[str, str] = {}
+    given: dict[str, SourceLoc | None] = {}
+    origins: dict[str, str] = {}
+    checked: set[str] = set()        # the names rule S140 looks at
+    config_args, _ = config.args_for(model)
+    for name, value in config_args.items():
+        mappings[name] = value
+        line = _config_line(config.path, name)
+        given[name] = SourceLoc(relative_to_cwd(config.path), line) if config.path else None
+        origins[name] = f"config {relative_to_cwd(config.path)}"
+        if name not in config.args:   # per-file-args name this model on purpose
+            checked.add(name)
+    launch = request.launch
+    if launch is not None:
+        for name, value in launch.mappings.items():
+            mappings[name] = value
+            given[name] = launch.locs.get(name, launch.loc)
+            origins[name] = f"--launch {relative_to_cwd(request.launch_file)}"
+            checked.add(name)
+    for name, value in request.mappings.items():
+        mappings[name] = value
+        given[name] = SourceLoc(str(model))     # the model, no line: it was typed
+        origins[name] = "command line"
+        checked.add(name)
+    return mappings, given, origins, checked
+
+
+def argument_use(model: Path, mappings, given, origins, checked, config,
+                 request: ModelRequest):
+    """What rule S140 needs: the arguments the model declares against those it was given."""
+    from reedtool.io.xacro_args import ArgumentUse, known_arguments
+
+    if model.is_dir() or model.suffix.lower() in _NOT_XACRO or not given:
+        return None
+    declared, complete = known_arguments(model, mappings, request.package_paths)
+    # The config's `args` apply to every model of a repository; they are checked for a
+    # model that reads at least one of them (they are meant for it), so a plain xacro file
+    # next to a RotorS model is not told about arguments it never wanted.
+    if set(config.args) & declared:
+        checked |= set(config.args)
+    return ArgumentUse(declared=declared,
+                       given={n: loc for n, loc in given.items() if n in checked},
+                       origins={n: o for n, o in origins.items() if n in checked},
+                       complete=complete)
+
+
+def load_models(model: Path, mappings, package_paths, model_name):
+    """(display suffix, Robot) pairs of one model path: one, or each model of a world."""
+    from reedtool.io.loader import load_robots
+
+    robots = load_robots(model, mappings, list(package_paths), model_name=model_name)
+    return [("" if len(robots) == 1 else f" [model {r.name}]", r) for r in robots]
+
+
+def targets_of(paths: Sequence[str], request: ModelRequest):
+    """The models that command-line paths (files, directories, globs, packages, a changed
+    configuration) name; arguments mean "this model" (io.model_inputs)."""
+    from reedtool.config import find_config, load_config
+    from reedtool.io.model_inputs import expand_targets, include_globs_of, include_tree_of
+    from reedtool.report import display_path
+
+    def mappings_for(path: Path) -> dict[str, str]:
+        try:
+            config = load_config(path)
+        except ReedtoolError:
+            return dict(request.mappings)
+        return model_arguments(path, config, request)[0]
+
+    def has_arguments(path: Path) -> bool:
+        """Arguments meant for this file: typed, from --launch, or a per-file table.
+        (The config's `args` reach every model of a repository, so they do not say the
+        file is a model: whether it expands alone with them does.)"""
+        if request.mappings or (request.launch is not None and request.launch.mappings):
+            return True
+        try:
+            config = load_config(path)
+        except ReedtoolError:
+            return False
+        return set(config.args_for(path)[0].items()) != set(config.args.items())
+
+    def stands_alone(path: Path) -> bool:
+        """Loads alone into a robot with links; the robots are kept for the check."""
+        key = path.resolve()
+        if key in request.preloaded:
+            return True
+        try:
+            pairs = load_models(path, mappings_for(path), request.package_paths,
+                                request.model_name)
+        except ReedtoolError:
+            return False
+        if not any(robot.links for _, robot in pairs):
+            return False
+        request.preloaded[key] = pairs
+        return True
+
+    def configures_models(path: Path) -> bool:
+        found = find_config(path)
+        return found is not None and found[0] == path.resolve()
+
+    return expand_targets(paths, include_tree_of(mappings_for, request.package_paths),
+                          display=lambda p: display_path(str(p)) or str(p),
+                          include_globs=include_globs_of(mappings_for, request.package_paths),
+                          has_arguments=has_arguments, stands_alone=stands_alone,
+                          configures_models=configures_models)
