@@ -68,12 +68,18 @@ def non_finite_number(ctx: CheckContext) -> Iterator[Issue]:
                         hint="check the xacro expression that computes this value")
 
 
-@rule("S103", "legacy-xacro-tag", "error", "An old-style xacro tag was copied into the URDF.", clause="cannot-fly")
+@rule("S103", "legacy-xacro-tag", "warning", "An old-style xacro tag was copied into the URDF.",
+      clause="suspicious")
 def legacy_xacro_tag(ctx: CheckContext) -> Iterator[Issue]:
     """Old tutorials use `<property>`, `<include>`, `<macro>` and macro calls without the
     `xacro:` prefix. xacro 2.x no longer understands them and copies them into the URDF
-    unchanged, so properties are never defined and macros never expanded: the model is
-    silently broken.
+    unchanged, so properties are never defined and macros never expanded.
+
+    Severity (warning: suspicious, but the model loads): Gazebo ignores the copied tag. What
+    it should have made is missing, and where that breaks the model it shows elsewhere: an
+    undefined property stops the expansion (an input error), a missing link or joint is
+    a structure error (S104, S105). A copied call of a macro that makes only a
+    `<transmission>` (GRVC's aeroarms) changes nothing Gazebo flies.
 
     Spell them `<xacro:property>`, `<xacro:include>`, `<xacro:macro>` and `<xacro:NAME/>`
     (`reedtool expand --fix-legacy` rewrites them).
