@@ -352,3 +352,10 @@ def test_vtol_pusher_is_a_ca_rotor_but_not_in_the_hover(tmp_path):
     findings = [f for f in px4_findings(tmp_path, fixed_wing, vtol) if f.severity == "error"]
     assert [f.code for f in findings] == ["C418"] * 4
     assert {f.line for f in findings} == {line_of(fixed_wing, "set-default CA_AIRFRAME 1")}
+
+
+def test_unset_ardupilot_parameter_points_at_the_file_without_a_line(tmp_path):
+    """FRAME_CLASS missing: the finding names the file, not a line 1 that says nothing."""
+    (finding,) = ap_findings(tmp_path, PARM.replace("FRAME_CLASS 1\n", ""))
+    assert finding.code == "C430" and finding.line is None
+    assert finding.file.endswith(".parm")

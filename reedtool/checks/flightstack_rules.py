@@ -701,7 +701,8 @@ def _ap_where(params: "ArduPilotParams") -> str:
     from reedtool.flightstack.ardupilot import frame_name
 
     frame_class, frame_type = params.frame()
-    type_loc = str(frame_type.loc) if frame_type.explicit else "FRAME_TYPE not set: 1"
+    type_loc = str(frame_type.loc) if frame_type.explicit else \
+        f"not set: ArduCopter's default 1, {frame_type.loc}"
     return (f"FRAME_CLASS {frame_class.value:g} ({frame_class.loc}), FRAME_TYPE "
             f"{frame_type.value:g} ({type_loc}): "
             f"{frame_name(int(frame_class.value), int(frame_type.value))}")
