@@ -58,6 +58,8 @@ CASES = [
     ("S122_bad_mirrored_collision.urdf", ["S122"]),
     # 1.6's <use_parent_model_frame> in a 1.7 file: ignored, as libsdformat does.
     ("S123_bad_parent_frame_in_1_7.sdf", ["S123"]),
+    # A comment before the XML declaration: read (S119), and gz-sim would refuse it (S124).
+    ("S124_bad_comment_before_declaration.sdf", ["S119", "S124"]),
     # Good fixtures: the arm has a zero-mass fixed tool frame (fine), a plugin on a fixed
     # link kept by preserveFixedJoint, a limited revolute joint; the car a mesh in metres.
     ("clean_arm.urdf", []),

@@ -106,10 +106,10 @@ def test_urdf_still_refuses_what_tinyxml2_refuses():
 @pytest.mark.parametrize("text, what, line", [
     # PX4 classic's generated depth_camera.sdf: a comment line, then the declaration.
     ('<!-- generated -->\n<?xml version="1.0"?>\n<sdf version="1.6"><model name="m"/></sdf>\n',
-     "XML declaration not at the start", 2),
+     "XML declaration after a comment (TinyXML2, so gz-sim, refuses it)", 2),
     # PX4 classic's cloudship.sdf: blank lines before the declaration.
     ('\n\n\n<?xml version="1.0"?>\n<sdf version="1.6"><model name="m"/></sdf>\n',
-     "XML declaration not at the start", 4),
+     "XML declaration not at the start (after blank lines)", 4),
 ])
 def test_misplaced_xml_declaration_is_read(text, what, line):
     with pytest.raises(etree.XMLSyntaxError):
@@ -131,3 +131,20 @@ def test_angle_bracket_in_attribute_and_bare_ampersand_are_read_as_text():
     assert root.find("x").sourceline == 5
     assert sorted((t.line, t.what) for t in tolerated) == [
         (2, "'<' inside an attribute value"), (3, "'&' that starts no entity")]
+
+
+def test_late_declaration_is_a_warning_only_for_models_not_made_for_gazebo_classic(tmp_path):
+    """S124's fixture has no plugin (gz-sim may load it: warning). With a Gazebo classic
+    plugin it is loaded by TinyXML, which reads it: S119 alone."""
+    from pathlib import Path
+
+    from reedtool.checks.runner import run_checks
+    from reedtool.io.loader import load_robot
+
+    fixture = Path(__file__).parent / "fixtures" / "validate" / \
+        "S124_bad_comment_before_declaration.sdf"
+    text = fixture.read_text().replace(
+        "  </model>", '    <plugin name="imu" filename="libgazebo_imu_plugin.so"/>\n  </model>')
+    path = tmp_path / "classic.sdf"
+    path.write_text(text)
+    assert sorted(f.code for f in run_checks(load_robot(path))) == ["S119"]

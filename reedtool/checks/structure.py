@@ -26,6 +26,7 @@ _LEGACY_KINDS = {"legacy-xacro"}
 _TOLERATED_KINDS = {"xml-tolerated"}
 _DEFAULT_INERTIAL_KINDS = {"sdf-default-inertial"}
 _UNDEFINED_KINDS = {"sdf-undefined-element"}
+_LATE_DECLARATION_KINDS = {"xml-declaration-late"}
 # libsdformat's joint types (sdf/1.x/joint.sdf): what an SDF <joint type=> may be.
 SDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "ball", "screw",
                    "universal", "revolute2", "gearbox")
@@ -50,7 +51,8 @@ def urdf_parse_error(ctx: CheckContext) -> Iterator[Issue]:
     """
     for issue in ctx.robot.parse_issues:
         if issue.kind not in _NON_FINITE_KINDS | _LEGACY_KINDS | _TOLERATED_KINDS \
-                | _PACKAGE_KINDS | _DEFAULT_INERTIAL_KINDS | _UNDEFINED_KINDS:
+                | _PACKAGE_KINDS | _DEFAULT_INERTIAL_KINDS | _UNDEFINED_KINDS \
+                | _LATE_DECLARATION_KINDS:
             yield Issue(issue.message, issue.loc, issue.subject)
 
 
@@ -341,6 +343,28 @@ def sdf_element_not_in_version(ctx: CheckContext) -> Iterator[Issue]:
     for issue in ctx.robot.parse_issues:
         if issue.kind in _UNDEFINED_KINDS:
             yield Issue(issue.message, issue.loc, issue.subject)
+
+
+@rule("S124", "xml-declaration-late", "warning",
+      "A comment precedes the XML declaration: gz-sim refuses the file, Gazebo classic reads it.",
+      clause="suspicious")
+def xml_declaration_late(ctx: CheckContext) -> Iterator[Issue]:
+    """TinyXML (Gazebo classic's libsdformat 9) reads an XML declaration anywhere; TinyXML2
+    5 and later (libsdformat 10+, so gz-sim) refuse one that follows a comment (PX4
+    classic's generated depth_camera.sdf starts with a comment line). Blank lines before it
+    are fine for both.
+
+    Severity (warning): a model written for Gazebo classic (its plugins are classic ones)
+    loads where it is meant to, so nothing is reported for it beyond S119; for gz-sim the
+    file is refused, but reedtool cannot be sure which Gazebo a model without plugins is
+    for.
+    """
+    if ctx.simulator == "classic":
+        return
+    for issue in ctx.robot.parse_issues:
+        if issue.kind in _LATE_DECLARATION_KINDS:
+            yield Issue(issue.message, issue.loc, issue.subject,
+                        hint="move the comment below the <?xml ...?> line, or drop the line")
 
 
 @rule("S130", "mesh-format-unsupported", "error",

@@ -64,7 +64,12 @@ from reedtool.errors import ReedtoolError
 from reedtool.frames import make_T, matrix_to_rpy, rpy_to_matrix
 from reedtool.io.resources import resolve_model_file_uri
 from reedtool.io.sdf_include import SourceFile, SourceMap, expand_includes
-from reedtool.io.tolerant_xml import local_tag, parse_tolerant, tolerated_message
+from reedtool.io.tolerant_xml import (
+    late_declaration_issues,
+    local_tag,
+    parse_tolerant,
+    tolerated_message,
+)
 from reedtool.model import (
     INERTIA_KEYS,
     Box,
@@ -457,6 +462,7 @@ class _ModelReader:
             items = sorted(set(items), key=lambda t: t.line)   # a file included twice
             self.issues.append(ParseIssue("xml-tolerated", tolerated_message(items),
                                           SourceLoc(str(path), items[0].line), path.name))
+            self.issues += late_declaration_issues(items, path)
 
     def _T_link_X(self, link_scoped: str, scope: str, pose_el: etree._Element | None,
                   subject: str) -> np.ndarray:

@@ -78,6 +78,8 @@ def _clean_comments(text: str) -> tuple[str, list[Tolerated]]:
     return _COMMENT.sub(fix, text), found
 
 
+DECLARATION_AFTER_BLANKS = "XML declaration not at the start (after blank lines)"
+DECLARATION_AFTER_CONTENT = "XML declaration after a comment (TinyXML2, so gz-sim, refuses it)"
 _XML_DECL = re.compile(r"<\?xml\s[^>]*\?>")
 _ENTITY = re.compile(r"&(#\d+|#x[0-9A-Fa-f]+|[A-Za-z_][\w.-]*);")
 
@@ -89,8 +91,13 @@ def _clean_declaration(text: str) -> tuple[str, list[Tolerated]]:
     if match is None or match.start() == 0:
         return text, []
     blank = re.sub(r"[^\n]", " ", match.group(0))
+    # Blank lines before it: TinyXML and TinyXML2 alike read it. A comment before it:
+    # TinyXML (Gazebo classic's sdformat 9) reads it, TinyXML2 5+ (sdformat 10+, gz-sim)
+    # refuses it ('wellLocated').
+    what = (DECLARATION_AFTER_BLANKS if not text[:match.start()].strip()
+            else DECLARATION_AFTER_CONTENT)
     return (text[:match.start()] + blank + text[match.end():],
-            [Tolerated(_line_of(text, match.start()), "XML declaration not at the start")])
+            [Tolerated(_line_of(text, match.start()), what)])
 
 
 def _escape_markup(text: str) -> tuple[str, list[Tolerated]]:
@@ -214,6 +221,18 @@ def parse_tolerant(text: str, file: Path | str, *, remove_comments: bool = False
             raise ReedtoolError(f"{error}: {exc.msg}", file=file,
                                 line=exc.lineno if line_known else None, hint=hint) from None
         return root, sorted(tolerated, key=lambda t: t.line)
+
+
+def late_declaration_issues(items: list[Tolerated], file: Path | str) -> list:
+    """A parse issue ("xml-declaration-late") where a comment precedes the XML declaration:
+    Gazebo classic reads that file, gz-sim (TinyXML2 5+) refuses it (S124)."""
+    from reedtool.model import ParseIssue, SourceLoc
+
+    return [ParseIssue("xml-declaration-late", f"the XML declaration on line {t.line} follows "
+                       "a comment: TinyXML2 (libsdformat 10+, so gz-sim) refuses the file; "
+                       "Gazebo classic's TinyXML reads it", SourceLoc(str(file), t.line),
+                       Path(file).name)
+            for t in items if t.what == DECLARATION_AFTER_CONTENT]
 
 
 def tolerated_message(items: list[Tolerated]) -> str:

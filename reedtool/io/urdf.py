@@ -64,11 +64,13 @@ def parse_urdf(xml_text: str, file: Path | str, *, resolver=None,
     locate = _make_locator(root, file, element_locs, xml_text.splitlines())
     robot = _RobotReader(file, locate, resolver).read(root, xml_text)
     if tolerated:
-        from reedtool.io.tolerant_xml import tolerated_message
+        from reedtool.io.tolerant_xml import late_declaration_issues, tolerated_message
 
         line = tolerated[0].line if element_locs is None else None
         robot.parse_issues.append(ParseIssue("xml-tolerated", tolerated_message(tolerated),
                                              SourceLoc(str(file), line), file.name))
+        if element_locs is None:
+            robot.parse_issues += late_declaration_issues(tolerated, file)
     return robot
 
 
