@@ -60,6 +60,8 @@ CASES = [
     ("S123_bad_parent_frame_in_1_7.sdf", ["S123"]),
     # A comment before the XML declaration: read (S119), and gz-sim would refuse it (S124).
     ("S124_bad_comment_before_declaration.sdf", ["S119", "S124"]),
+    # A 3-number <pose>: libsdformat 9 reads a position, 12+ refuses (S125, not S101).
+    ("S125_bad_short_pose.sdf", ["S125", "S125"]),
     # Good fixtures: the arm has a zero-mass fixed tool frame (fine), a plugin on a fixed
     # link kept by preserveFixedJoint, a limited revolute joint; the car a mesh in metres.
     ("clean_arm.urdf", []),

@@ -258,3 +258,21 @@ def test_use_parent_model_frame_counts_only_where_the_version_defines_it(version
     np.testing.assert_allclose(axis, axis_in_base, atol=1e-9)
     kinds = [i.kind for i in robot.parse_issues]
     assert kinds == (["sdf-undefined-element"] if version == "1.7" else [])
+
+
+def test_three_number_pose_is_a_position_as_libsdformat_9_reads_it(tmp_path):
+    """GymFC's nf1 shape: "0 0 0.007083" and "0 0 0.0185" place the links 7.1 and 18.5 mm
+    up, no rotation: the battery sits 11.417 mm above the frame. With a Gazebo classic
+    plugin (the model's target) nothing is reported."""
+    from reedtool.checks.runner import run_checks
+    from reedtool.physics.kinematics import link_poses
+
+    text = (FIXTURES_VALIDATE / "S125_bad_short_pose.sdf").read_text()
+    robot = parse_sdf(text, tmp_path / "m.sdf")
+    np.testing.assert_allclose(link_poses(robot)["battery"], np.array(
+        [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0.0185 - 0.007083], [0, 0, 0, 1]]), atol=1e-15)
+    classic = text.replace("  </model>", '    <plugin name="imu" filename="libgazebo_imu_plugin.so"/>\n  </model>')
+    path = tmp_path / "classic.sdf"
+    path.write_text(classic)
+    from reedtool.io.loader import load_robot
+    assert [f.code for f in run_checks(load_robot(path))] == []

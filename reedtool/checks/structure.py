@@ -27,6 +27,7 @@ _TOLERATED_KINDS = {"xml-tolerated"}
 _DEFAULT_INERTIAL_KINDS = {"sdf-default-inertial"}
 _UNDEFINED_KINDS = {"sdf-undefined-element"}
 _LATE_DECLARATION_KINDS = {"xml-declaration-late"}
+_SHORT_POSE_KINDS = {"sdf-short-pose"}
 # libsdformat's joint types (sdf/1.x/joint.sdf): what an SDF <joint type=> may be.
 SDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "ball", "screw",
                    "universal", "revolute2", "gearbox")
@@ -52,7 +53,7 @@ def urdf_parse_error(ctx: CheckContext) -> Iterator[Issue]:
     for issue in ctx.robot.parse_issues:
         if issue.kind not in _NON_FINITE_KINDS | _LEGACY_KINDS | _TOLERATED_KINDS \
                 | _PACKAGE_KINDS | _DEFAULT_INERTIAL_KINDS | _UNDEFINED_KINDS \
-                | _LATE_DECLARATION_KINDS:
+                | _LATE_DECLARATION_KINDS | _SHORT_POSE_KINDS:
             yield Issue(issue.message, issue.loc, issue.subject)
 
 
@@ -365,6 +366,26 @@ def xml_declaration_late(ctx: CheckContext) -> Iterator[Issue]:
         if issue.kind in _LATE_DECLARATION_KINDS:
             yield Issue(issue.message, issue.loc, issue.subject,
                         hint="move the comment below the <?xml ...?> line, or drop the line")
+
+
+@rule("S125", "sdf-pose-short", "warning",
+      "A <pose> has 3 numbers: Gazebo classic reads a position, gz-sim refuses it.",
+      clause="suspicious")
+def sdf_pose_short(ctx: CheckContext) -> Iterator[Issue]:
+    """A pose is six numbers (x y z roll pitch yaw). libsdformat 9, Gazebo classic's, reads
+    `<pose>x y z</pose>` as a position with no rotation (its stream read has no failure
+    check); libsdformat 12 and later (gz-sim) refuse the file ("must have 6 values").
+    GymFC's nf1 twin is written so; reedtool reads it as libsdformat 9 does.
+
+    Severity (warning): a model made for Gazebo classic (classic plugins) loads where it
+    is meant to and is not reported; for any other model gz-sim may be its target.
+    """
+    if ctx.simulator == "classic":
+        return
+    for issue in ctx.robot.parse_issues:
+        if issue.kind in _SHORT_POSE_KINDS:
+            yield Issue(issue.message, issue.loc, issue.subject,
+                        hint="write all six numbers: x y z 0 0 0")
 
 
 @rule("S130", "mesh-format-unsupported", "error",

@@ -303,7 +303,14 @@ class _ModelReader:
                           [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
                           [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
             return make_T(R, v[:3]), relative_to
-        v = self._numbers(el, (6,), [0, 0, 0, 0, 0, 0], subject)
+        v = self._numbers(el, (6, 3), [0, 0, 0, 0, 0, 0], subject)
+        if len(v) == 3:
+            # libsdformat 9 (Gazebo classic) reads "x y z" as a position with no rotation
+            # (`ss >> pose` without a fail check); 12 and later refuse it (S125).
+            self._issue("sdf-short-pose", f"<pose>{' '.join(el.text.split())}</pose> has 3 "
+                        "numbers: Gazebo classic reads a position without rotation, "
+                        "libsdformat 12+ (gz-sim) refuses it", el, subject)
+            v = np.concatenate([v, np.zeros(3)])
         rpy = np.radians(v[3:]) if (el.get("degrees") or "").lower() in ("true", "1") else v[3:]
         return make_T(rpy_to_matrix(rpy), v[:3]), relative_to
 
