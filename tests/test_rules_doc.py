@@ -38,6 +38,8 @@ def test_every_rule_states_its_severity_clause():
     for rule in all_rules():
         allowed, wording = POLICY_CLAUSES[rule.clause]
         assert rule.severity in allowed, rule.code
+        # ... and its docstring says why, in its own words.
+        assert f"Severity ({rule.severity}" in rule.explanation, rule.code
         assert f"| {rule.severity} | {rule.clause} |" in text
         assert f"*Default severity: {rule.severity}* ({rule.clause}: {wording})" in text
     # The policy's error clauses are few on purpose; every warning-or-softer rule that can

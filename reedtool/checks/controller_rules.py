@@ -114,6 +114,9 @@ def controller_rotor_count(ctx: CheckContext) -> Iterator[Issue]:
     many motor speeds. With fewer entries than motors, some motors never receive a
     command; with more, the controller allocates thrust to rotors that do not exist.
     Either way the vehicle cannot hover level.
+
+    Severity (error, flight-stack): the controller commands another number of rotors
+    than the model has.
     """
     rotors = ctx.rotors
     for table in _tables(ctx):
@@ -131,6 +134,9 @@ def controller_rotor_joint_unknown(ctx: CheckContext) -> Iterator[Issue]:
     its arm from that joint's pose. A joint that does not exist makes gz-sim skip the
     rotor (and the allocation loses a column); a joint without a MulticopterMotorModel
     gets commands no motor turns into thrust.
+
+    Severity (error, flight-stack): the controller commands a motor the model does not
+    have.
     """
     motor_joints = {r.joint for r in ctx.rotors if r.joint}
     for table in _tables(ctx):
@@ -161,6 +167,8 @@ def controller_rotor_order(ctx: CheckContext) -> Iterator[Issue]:
     """The controller publishes one speed per table entry, in table order; the motor plugin
     with `<motorNumber>k` spins at speed k. Entry i must therefore name the joint of the
     motor whose motorNumber is i, or every speed goes to the wrong rotor.
+
+    Severity (error, flight-stack): the controller commands the wrong motor.
     """
     for table in _tables(ctx):
         if table.source != "velocity-control":
@@ -182,6 +190,8 @@ def controller_entry_invalid(ctx: CheckContext) -> Iterator[Issue]:
     rotor_force_constant, rotor_moment_constant and direction for RotorS (which keeps its
     default for a missing one). RotorS reads rotor_configuration '0', '1', ... and stops at
     the first missing index, so entries after a gap are never read. Directions are +1 or -1.
+
+    Severity (error, refused): the controller cannot read its table and does not start.
     """
     for table in ctx.controller_tables:
         for message, loc in table.problems:
@@ -199,6 +209,8 @@ def controller_com_link_missing(ctx: CheckContext) -> Iterator[Issue]:
     """`<comLinkName>` is the body frame gz-sim measures rotor arms in and reads the
     vehicle state from, almost always the base link. Without it, or when it names no
     link, the controller does not start.
+
+    Severity (error, refused): the velocity-control system does not load.
     """
     for table in ctx.controller_tables:
         if table.source != "velocity-control":
@@ -223,6 +235,9 @@ def controller_direction_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     and gz-sim (`<direction>`), whose allocation matrices use -direction * k_F * k_M for
     the yaw row. A flipped sign makes the controller push yaw the wrong way with that
     rotor: the vehicle spins up in yaw on take-off.
+
+    Severity (error, flight-stack): the controller spins the motor's torque the other
+    way in its yaw allocation.
     """
     for table in _tables(ctx):
         for entry, rotor in _pairs(ctx, table):
@@ -266,6 +281,9 @@ def controller_angle_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     from above. The controller's roll and pitch columns are sin(angle) and -cos(angle)
     times the arm: a wrong angle commands roll when pitch is wanted, and the vehicle
     drifts or flips. Compared in the base frame with a tolerance of 0.5°.
+
+    Severity (error, flight-stack): the controller gives the rotor roll and pitch torque
+    of the wrong sign.
     """
     for table in _tables(ctx):
         for entry, rotor in _pairs(ctx, table):
@@ -334,6 +352,9 @@ def controller_force_constant_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     motor turns speed into thrust with `motorConstant` [N/(rad/s)²]. If they differ by
     more than 1 %, the vehicle hovers off its commanded height and its attitude gains are
     scaled.
+
+    Severity (warning, suspicious): a force constant scales the controller's gains, it
+    does not flip a sign.
     """
     yield from _constant_issues(ctx, "force_constant", "motor_constant", "motorConstant",
                                 {"yaml": "rotor_force_constant",
@@ -346,6 +367,9 @@ def controller_moment_constant_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     """The yaw drag torque is momentConstant [m] times thrust. A controller that assumes
     another value gets the wrong yaw authority: sluggish or oscillating heading.
     Tolerance 1 %.
+
+    Severity (warning, suspicious): a moment constant scales the yaw gain, it does not
+    flip a sign.
     """
     yield from _constant_issues(ctx, "moment_constant", "moment_constant", "momentConstant",
                                 {"yaml": "rotor_moment_constant",
@@ -361,6 +385,9 @@ def controller_mass_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     of the model's link masses by more than 1 %, the vehicle sinks or climbs until an
     integrator (if any) catches up, and position gains are scaled. RotorS ships parameter
     files with the base link's mass only; the model's total includes rotors and sensors.
+
+    Severity (warning, suspicious): a mass scales the controller's feed-forward;
+    integrators absorb it.
     """
     for table in _tables(ctx):
         if table.mass_kg is None or not math.isfinite(table.mass_kg):
@@ -380,6 +407,9 @@ def controller_inertia_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     body axes [kg·m²]; attitude control feeds forward with it. Each element is compared
     with the model's (all links at zero joint positions), within 10 % of that diagonal
     moment (off-diagonal: of the largest one).
+
+    Severity (warning, suspicious): an inertia scales the attitude gains; it does not
+    flip a sign.
     """
     for table in _tables(ctx):
         I_c = table.inertia_kg_m2

@@ -144,6 +144,9 @@ def px4_rotor_count(ctx: CheckContext) -> Iterator[Issue]:
     allocates thrust to rotors that do not exist. Either way the vehicle cannot hover.
     A missing CA_ROTOR_COUNT is PX4's default 0. Pushers and pullers count: PX4 lists
     every rotor (a standard VTOL has five).
+
+    Severity (error, flight-stack): PX4 allocates thrust to rotors the model does not
+    have, or leaves some unused.
     """
     rotors = _all_rotors(ctx)
     for params in _px4(ctx):
@@ -163,6 +166,9 @@ def px4_output_mapping(ctx: CheckContext) -> Iterator[Issue]:
     actuator number k-1, and output k carries CA rotor i when SIM_GZ_EC_FUNCk is 101 + i
     ("Motor i+1"). A CA rotor on no output is never spun; an output whose motor does not
     exist in the model spins nothing; a model motor on no motor output never turns.
+
+    Severity (error, flight-stack): PX4 commands a motor the model does not have, or
+    never commands one it has.
     """
     from reedtool.flightstack.px4 import MAX_GZ_OUTPUTS, MOTOR_FUNCTION_BASE
 
@@ -228,6 +234,8 @@ def px4_rotor_position(ctx: CheckContext) -> Iterator[Issue]:
     wrong sign and the first take-off flips. The model's rotor is taken about the
     whole-robot centre of mass, with y and z negated (FLU to FRD). Two swapped CA_ROTOR
     entries show up here, one finding per entry.
+
+    Severity (error, flight-stack): PX4 commands the wrong motor for a roll or pitch.
     """
     for params in _px4(ctx):
         for ca, k, rotor in _px4_pairs(ctx, params):
@@ -270,6 +278,8 @@ def px4_rotor_position_offset(ctx: CheckContext) -> Iterator[Issue]:
     That is common and often deliberate: PX4's own x500 airframe describes the real
     frame's rotor positions while the x500 Gazebo model places its rotors on a 45° square.
     Reported so the numbers can be compared; differences under 5 mm are not reported.
+
+    Severity (info, explains): the allocation keeps its signs; only the gains differ.
     """
     for params in _px4(ctx):
         for ca, k, rotor in _px4_pairs(ctx, params):
@@ -327,6 +337,8 @@ def px4_moment_ratio(ctx: CheckContext) -> Iterator[Issue]:
     momentConstant. A different value scales PX4's yaw effectiveness, which the yaw
     rate controller's gains absorb: PX4's own gz airframes use 0.05 against models with
     0.016. Reported with both numbers, as information.
+
+    Severity (info, explains): a yaw gain that the rate controller's tuning absorbs.
     """
     for params in _px4(ctx):
         for ca, k, rotor in _px4_pairs(ctx, params):
@@ -497,6 +509,9 @@ def px4_command_above_max(ctx: CheckContext) -> Iterator[Issue]:
     the top of PX4's output range changes nothing: PX4's mixer believes it has thrust in
     reserve that does not exist, and saturation goes unnoticed (px4vision: 1100 against
     1000, 9 % of the range lost).
+
+    Severity (warning, suspicious): the vehicle flies; PX4 believes in a reserve of
+    thrust that does not exist.
     """
     for params in _px4(ctx):
         for ca, k, rotor in _px4_pairs(ctx, params):
@@ -521,6 +536,9 @@ def px4_command_below_max(ctx: CheckContext) -> Iterator[Issue]:
     motor's top speed; thrust grows with speed squared, so the vehicle has
     (MAX / maxRotVelocity)² of the thrust the model was built with. That may be a
     deliberate limit; the finding gives the fraction.
+
+    Severity (warning, suspicious): it may be a deliberate limit; the vehicle flies with
+    less thrust.
     """
     for params in _px4(ctx):
         for ca, k, rotor in _px4_pairs(ctx, params):
@@ -618,6 +636,8 @@ def px4_hover_throttle(ctx: CheckContext) -> Iterator[Issue]:
     u = (ω - SIM_GZ_EC_MIN) / (SIM_GZ_EC_MAX - SIM_GZ_EC_MIN), through PX4's thrust model
     THR_MDL_FAC·u² + (1 - THR_MDL_FAC)·u, averaged over the rotors. Within 0.15 of each
     other this is information (C422 warns beyond).
+
+    Severity (info, explains): it shows two numbers side by side.
     """
     for params in _px4(ctx):
         values = _hover_throttle(ctx, params)
@@ -632,6 +652,9 @@ def px4_hover_throttle_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     """As C421, with the two values more than 0.15 apart: PX4 takes off with the wrong
     feed-forward, sinks or balloons after take-off until the hover thrust estimator
     catches up, and a position controller without the estimator never does.
+
+    Severity (warning, suspicious): the vehicle flies; take-off sinks or balloons until
+    the hover estimator catches up.
     """
     for params in _px4(ctx):
         values = _hover_throttle(ctx, params)
@@ -650,6 +673,9 @@ def px4_param_out_of_range(ctx: CheckContext) -> Iterator[Issue]:
     MPC_THR_HOVER 0.1..0.8, THR_MDL_FAC 0..1. QGroundControl refuses such values, and
     PX4 may clamp them. SIM_GZ_EC_MIN/MAX are left to C419/C420/C424, which compare them
     with the model's motors (PX4's own px4vision airframe commands up to 1100 rad/s).
+
+    Severity (warning, suspicious): QGroundControl refuses the value and PX4 may clamp
+    it, but the vehicle loads.
     """
     from reedtool.flightstack.px4 import out_of_range
 
@@ -742,6 +768,9 @@ def ardupilot_motor_count(ctx: CheckContext) -> Iterator[Issue]:
     """FRAME_CLASS fixes the number of motors ArduCopter mixes for (quad 4, hexa 6, octa
     and octaquad 8, Y6 6). A model with a different number of lift rotors cannot be flown
     by that mixer.
+
+    Severity (error, flight-stack): ArduPilot's mixer mixes for another number of motors
+    than the model has.
     """
     rotors = _lift_rotors(ctx)
     for params in _ardupilot(ctx):
@@ -762,6 +791,9 @@ def ardupilot_motor_position(ctx: CheckContext) -> Iterator[Issue]:
     receives (ArduPilotPlugin channel = output - 1, or actuator number = output - 1 without
     the plugin) must sit there, within 20° of bearing and in the same quadrant: a plus
     frame type on an X model, or two swapped channels, flip the vehicle on take-off.
+
+    Severity (error, flight-stack): ArduPilot commands the wrong motor for a roll or
+    pitch.
     """
     for params in _ardupilot(ctx):
         for motor, output, line, rotor in _ap_pairs(ctx, params):
@@ -793,6 +825,8 @@ def ardupilot_motor_spin(ctx: CheckContext) -> Iterator[Issue]:
     seen from above. The rotor the motor's output drives must turn that way (the model's
     turningDirection, or the sign of the ArduPilotPlugin multiplier), or yaw control has
     the wrong sign for it.
+
+    Severity (error, flight-stack): ArduPilot yaws with the motor the other way.
     """
     for params in _ardupilot(ctx):
         for motor, output, line, rotor in _ap_pairs(ctx, params):
@@ -816,6 +850,9 @@ def ardupilot_motor_unassigned(ctx: CheckContext) -> Iterator[Issue]:
     """Motor m goes out on the servo output whose SERVOn_FUNCTION is 32 + m (default:
     output m). When that output drives no rotor of the model, or a model rotor's output
     carries no motor, the mixer and the model disagree about which rotors exist.
+
+    Severity (error, flight-stack): ArduPilot commands a motor the model does not have,
+    or never one it has.
     """
     for params in _ardupilot(ctx):
         motors = _ap_frame(params)

@@ -106,6 +106,8 @@ def mass_not_positive(ctx: CheckContext) -> Iterator[Issue]:
     """A negative mass is never valid. A zero mass is fine on a link merged into its parent
     by a fixed joint (a frame marker), but a link that moves on its own joint needs mass:
     physics engines divide by it.
+
+    Severity (error, cannot-fly): physics engines divide by a moving link's mass.
     """
     for link in ctx.robot.links:
         inertial = link.inertial
@@ -276,6 +278,9 @@ def robot_mass_not_positive(ctx: CheckContext) -> Iterator[Issue]:
     """The links' declared masses add up to zero or less (one link with `mass 0` or
     `-0.0`, or negative masses cancelling positive ones). Gazebo cannot integrate a body
     without mass, and every thrust and hover figure divides by it.
+
+    Severity (error, cannot-fly): there is nothing to integrate, and every thrust figure
+    divides by the mass.
     """
     problem = robot_mass_problem(ctx.robot)
     if problem:
@@ -294,6 +299,9 @@ def massless_link_with_inertia(ctx: CheckContext) -> Iterator[Issue]:
     rotational inertia but no translational one. A massless link with a zero tensor on a
     fixed joint is a frame and stays quiet. (On a moving link I201 already reports the
     zero mass.)
+
+    Severity (error, refused): gz-math rejects a tensor without mass, and engines treat
+    the link as half a body.
     """
     for link, comparison in zip(ctx.robot.links, ctx.link_comparisons):
         if comparison.verdict == "massless-inertia" and not ctx.is_moving(link):
@@ -456,6 +464,9 @@ def mesh_scale_implausible(ctx: CheckContext) -> Iterator[Issue]:
     brings it into range: as this warning when the rest of the robot leaves room for it
     being intended (a large ground plane, a tiny marker), as I210 (error) when the unit is
     certainly wrong.
+
+    Severity (warning, ambiguous): a large ground plane or a tiny marker may be
+    intended; I210 is the certain case.
     """
     yield from _mesh_scale_findings(ctx, certain=False)
 
@@ -474,5 +485,8 @@ def mesh_unit_wrong(ctx: CheckContext) -> Iterator[Issue]:
 
     Gazebo shows and collides with a body a thousand times its size (or invisible), and
     a mesh used for inertia gives a tensor a million times off.
+
+    Severity (error, cannot-fly): the body collides and weighs as one a thousand times
+    its size (or invisible).
     """
     yield from _mesh_scale_findings(ctx, certain=True)

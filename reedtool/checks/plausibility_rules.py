@@ -131,6 +131,9 @@ def rotor_joint_axis(ctx: CheckContext) -> Iterator[Issue]:
     its gyroscopic torque acts about the wrong axis, and usually one of the two poses
     is wrong (a rotor link rotated by a mesh correction, an axis given in the parent's
     frame).
+
+    Severity (warning, suspicious): the motor plugin pushes along the link's z axis, so
+    the vehicle flies; the prop spins and precesses about the wrong axis.
     """
     if not ctx.tree_ok:
         return
@@ -164,6 +167,8 @@ def uneven_hover_trim(ctx: CheckContext) -> Iterator[Issue]:
     than 15 % above the smallest, with the COM shift that would even them out. A nearly
     singular allocation (R306) spreads the thrusts by its geometry alone; that is R306's
     finding, not this one.
+
+    Severity (warning, suspicious): it hovers, with less margin on one side.
     """
     if not _physics_ready(ctx):
         return

@@ -114,6 +114,9 @@ def motor_number_duplicate(ctx: CheckContext) -> Iterator[Issue]:
     `<control channel>`) is the rotor's index in the command the flight stack sends. Two
     rotors with the same number receive the same command and another index drives
     nothing; the vehicle flips on take-off.
+
+    Severity (error, cannot-fly): two rotors read one command and another command spins
+    nothing.
     """
     seen: dict[int, "Rotor"] = {}
     for rotor in _rotors(ctx):
@@ -182,6 +185,9 @@ def rotor_direction_invalid(ctx: CheckContext) -> Iterator[Issue]:
     """`<turningDirection>` must be exactly `ccw` or `cw` (lower case: the motor plugins
     compare the string). Anything else makes the plugin refuse to load or spin the
     rotor with an undefined sign.
+
+    Severity (error, refused): the motor plugin refuses the direction and the rotor
+    never turns.
     """
     for rotor in _rotors(ctx):
         if rotor.kind == "ardupilot":
@@ -208,6 +214,8 @@ def yaw_moment_imbalance(ctx: CheckContext) -> Iterator[Issue]:
     must unbalance the rotors just to hold heading.
 
     The hint names the rotor whose direction, flipped, balances the set when there is one.
+
+    Severity (error, cannot-fly): the vehicle spins up in yaw at take-off.
     """
     found = None if ctx.omnidirectional else _yaw_imbalance(ctx)
     if found is None:
@@ -301,6 +309,8 @@ def allocation_rank_deficient(ctx: CheckContext) -> Iterator[Issue]:
     directions and constants. With rank below 4 some combination of the four cannot be
     commanded: typically neighbouring rotors of a quad-X turn the same way (yaw becomes
     roll or pitch), or all rotors lie on one line.
+
+    Severity (error, cannot-fly): some axis cannot be controlled.
     """
     if not _physics_ready(ctx):
         return
@@ -352,6 +362,9 @@ def allocation_ill_conditioned(ctx: CheckContext) -> Iterator[Issue]:
     """With each row scaled to unit norm, the allocation matrix of a symmetric frame has
     condition number 1. Above 25 one axis is controlled only by large, opposing thrust
     changes: the controller saturates motors on small commands.
+
+    Severity (warning, suspicious): every axis is controllable, with little authority on
+    one.
     """
     if not _physics_ready(ctx) or ctx.omnidirectional or _rank(ctx) < 4:
         return
@@ -374,6 +387,8 @@ def trim_infeasible(ctx: CheckContext) -> Iterator[Issue]:
     yaw moments cannot cancel.
 
     Not reported when R304, R305 or R308 already explain it.
+
+    Severity (error, cannot-fly): the vehicle cannot hover level.
     """
     if not _physics_ready(ctx):
         return
@@ -420,6 +435,8 @@ def thrust_to_weight_below_one(ctx: CheckContext) -> Iterator[Issue]:
     sum(k·ω_max²·axis_z), over the robot's weight m·g. Below 1 the model cannot leave
     the ground. Usually a mass in grams read as kilograms, a motor constant off by a
     power of ten, or maxRotVelocity in rpm instead of rad/s.
+
+    Severity (error, cannot-fly): the vehicle cannot leave the ground.
     """
     trim = _weight_and_trim(ctx)
     if trim is None or trim.thrust_to_weight >= THRUST_TO_WEIGHT_MIN:
@@ -439,6 +456,8 @@ def thrust_to_weight_low(ctx: CheckContext) -> Iterator[Issue]:
     """A multirotor that can lift itself but with thrust-to-weight below 1.5 hovers near
     full throttle, with little left for attitude control or climbing; real vehicles are
     built for 2 or more.
+
+    Severity (warning, suspicious): it flies, with little margin to climb and control.
     """
     trim = _weight_and_trim(ctx)
     if trim is None or not THRUST_TO_WEIGHT_MIN <= trim.thrust_to_weight < THRUST_TO_WEIGHT_WARN:
@@ -457,6 +476,8 @@ def hover_throttle_high(ctx: CheckContext) -> Iterator[Issue]:
     """Hover throttle is the trim speed over maxRotVelocity. Above 0.8 for any rotor,
     that rotor has almost no speed left to correct attitude and the controller
     saturates in the first gust (or the first Gazebo step with an unlucky contact).
+
+    Severity (warning, suspicious): it hovers, with little left for control.
     """
     trim = _weight_and_trim(ctx)
     if trim is None or not trim.feasible or trim.hover_throttle_max <= HOVER_THROTTLE_MAX:
@@ -485,6 +506,8 @@ def rotor_axis_tilted(ctx: CheckContext) -> Iterator[Issue]:
     yaw torques cancel, as on the AscTec Neo) is information, not this warning. Propulsion
     rotors (R319) and omnidirectional frames are not judged by tilt, nor rotors carried by
     an actuated joint (R319: the servo sets their tilt in flight).
+
+    Severity (warning, suspicious): a tilt may be deliberate.
     """
     if ctx.omnidirectional or ctx.articulated_rotors or balanced_tilt(ctx) is not None:
         return
@@ -570,6 +593,9 @@ def rotor_plugin_target_missing(ctx: CheckContext) -> Iterator[Issue]:
     """`<jointName>` and `<linkName>` of a motor plugin must name the rotor's joint and
     link exactly (namespace prefix included); the plugin fails to load otherwise and the
     rotor does not exist in the simulation.
+
+    Severity (error, refused): the plugin finds no joint or link and the rotor never
+    turns.
     """
     import difflib
 
@@ -597,6 +623,9 @@ def rotor_link_not_joint_child(ctx: CheckContext) -> Iterator[Issue]:
     """The plugin spins `<jointName>` and applies thrust to `<linkName>`; they must be the
     same rotor: the link is the joint's child. Otherwise thrust is applied to a link that
     does not turn, typically after copying a rotor block and renaming only one of them.
+
+    Severity (error, cannot-fly): thrust is applied to another body than the one that
+    spins.
     """
     for rotor in _rotors(ctx):
         joint = ctx.robot.joint_map.get(rotor.joint or "")
@@ -617,6 +646,8 @@ def rotor_constant_invalid(ctx: CheckContext) -> Iterator[Issue]:
     negative. Missing values silently fall back to a plugin default that differs between
     RotorS, PX4 and gz-sim; write them out. (ArduPilot rotors have no such elements:
     R317 says what is estimated for them.)
+
+    Severity (error, cannot-fly): the rotor gives no thrust, or pulls down.
     """
     for rotor in filter(_written, _rotors(ctx)):
         for attr, tag, unit in CONSTANTS:
@@ -694,6 +725,9 @@ def rotor_constants_estimated(ctx: CheckContext) -> Iterator[Issue]:
     |multiplier| (the joint target is multiplier × the [0, 1] command). The hover rules use
     these numbers; LiftDrag in flight also sees the inflow, so the real thrust is lower.
     Without blades the rotor's thrust is unknown and the hover rules are skipped.
+
+    Severity (info, explains): it says how numbers the model does not write were
+    estimated.
     """
     for rotor in _rotors(ctx):
         if rotor.kind != "ardupilot":
@@ -753,6 +787,8 @@ def rotor_role(ctx: CheckContext) -> Iterator[Issue]:
     carried by an actuated joint (a tilt servo, an arm, a leg: SITL_Models' hexapod_copter
     flies with its rotors where its leg servos put them) have no fixed flight pose: the
     hover rules do not judge them at the model's zero pose.
+
+    Severity (info, explains): it says which rotors the hover rules leave out, and why.
     """
     for rotor in _rotors(ctx):
         if rotor.role == "propulsion":
@@ -782,6 +818,8 @@ def rotor_tilt_pattern(ctx: CheckContext) -> Iterator[Issue]:
     tangentially. At equal thrust their side forces cancel and so do the yaw torques the
     tilts make through the lever arms. Such a pattern is reported here; a single or
     unbalanced tilt is R311's warning.
+
+    Severity (info, explains): a balanced tilt pattern is a design.
     """
     if ctx.omnidirectional:
         return

@@ -49,6 +49,8 @@ def urdf_parse_error(ctx: CheckContext) -> Iterator[Issue]:
     urdfdom refuses such a file outright (check_urdf fails); Gazebo's parser may instead
     substitute defaults (zero mass, zero inertia) and simulate something you did not write.
     Fix the element at the reported line.
+
+    Severity (error, refused): urdfdom and sdformat's URDF parser refuse the element.
     """
     for issue in ctx.robot.parse_issues:
         if issue.kind not in _NON_FINITE_KINDS | _LEGACY_KINDS | _TOLERATED_KINDS \
@@ -64,6 +66,9 @@ def non_finite_number(ctx: CheckContext) -> Iterator[Issue]:
 
     Physics engines propagate a NaN through the whole simulation: the model explodes or
     vanishes on the first step.
+
+    Severity (error, cannot-fly): a NaN spreads through the whole simulation on the
+    first step.
     """
     for issue in ctx.robot.parse_issues:
         if issue.kind in _NON_FINITE_KINDS:
@@ -99,6 +104,8 @@ def single_root(ctx: CheckContext) -> Iterator[Issue]:
     """A URDF is a tree: exactly one link is not the child of any joint. Two roots mean a
     joint is missing (or names the wrong child); urdfdom rejects the file with "two root
     links found". A model without any link is rejected too.
+
+    Severity (error, refused): urdfdom rejects a URDF without exactly one root.
     """
     if not ctx.robot.links:
         yield Issue("the model has no <link>", ctx.robot.loc, ctx.robot.name,
@@ -118,6 +125,8 @@ def single_root(ctx: CheckContext) -> Iterator[Issue]:
 def joint_link_missing(ctx: CheckContext) -> Iterator[Issue]:
     """Every joint's `<parent link=>` and `<child link=>` must name a link of the model.
     A typo or a missing namespace prefix here makes urdfdom reject the file.
+
+    Severity (error, refused): urdfdom rejects the joint and Gazebo cannot create it.
     """
     links = ctx.robot.link_map
     for joint in ctx.robot.joints:
@@ -138,6 +147,8 @@ def _closest_hint(name: str, candidates) -> str:
 def duplicate_link_name(ctx: CheckContext) -> Iterator[Issue]:
     """Link names must be unique. A macro instantiated twice without a distinct prefix or
     suffix is the usual cause; urdfdom rejects the file.
+
+    Severity (error, refused): urdfdom and libsdformat reject two elements of one name.
     """
     yield from _redeclared(ctx.robot.links, ctx.robot.link_map, "link")
 
@@ -146,6 +157,8 @@ def duplicate_link_name(ctx: CheckContext) -> Iterator[Issue]:
 def duplicate_joint_name(ctx: CheckContext) -> Iterator[Issue]:
     """Joint names must be unique; urdfdom rejects the file otherwise, and Gazebo plugins
     that look a joint up by name would find only one of them.
+
+    Severity (error, refused): urdfdom and libsdformat reject two elements of one name.
     """
     yield from _redeclared(ctx.robot.joints, ctx.robot.joint_map, "joint")
 
@@ -165,6 +178,8 @@ def _redeclared(elements, first_by_name, kind: str) -> Iterator[Issue]:
 def link_multiple_parents(ctx: CheckContext) -> Iterator[Issue]:
     """In a tree every link has at most one parent joint. A second joint naming the same
     child closes a loop that URDF cannot express.
+
+    Severity (error, refused): urdfdom rejects a link with two parents.
     """
     for child, joints in ctx.tree.extra_parents.items():
         first = ctx.tree.parent_joint[child]
@@ -178,6 +193,8 @@ def link_multiple_parents(ctx: CheckContext) -> Iterator[Issue]:
 def kinematic_cycle(ctx: CheckContext) -> Iterator[Issue]:
     """Following parent links from some link leads back to it. urdfdom reports this as
     "no root link found"; the links on the cycle are named here.
+
+    Severity (error, refused): urdfdom and libsdformat reject a loop in the tree.
     """
     for cycle in ctx.tree.cycles:
         joint = ctx.tree.parent_joint[cycle[0]]
@@ -191,6 +208,8 @@ def joint_type_invalid(ctx: CheckContext) -> Iterator[Issue]:
     an SDF model's are SDFormat's: revolute, continuous, prismatic, fixed, ball, screw,
     universal, revolute2 and gearbox (ardupilot_gazebo's zephyr_with_parachute hangs its
     parachute on a ball joint). Each file is held to its own format, as its parser does.
+
+    Severity (error, refused): the parser does not know the type.
     """
     import difflib
 
@@ -208,6 +227,9 @@ def joint_limit_missing(ctx: CheckContext) -> Iterator[Issue]:
     """Revolute and prismatic joints need `<limit lower= upper= effort= velocity=/>`;
     urdfdom requires effort and velocity and rejects the joint without them. A spinning
     joint (a wheel, a rotor) should be `continuous` instead.
+
+    Severity (error, refused): urdfdom rejects a revolute or prismatic joint without
+    effort and velocity limits.
     """
     for joint in ctx.robot.joints:
         if joint.type not in _LIMITED_JOINTS:
@@ -228,6 +250,8 @@ def joint_limit_missing(ctx: CheckContext) -> Iterator[Issue]:
 def joint_limit_inverted(ctx: CheckContext) -> Iterator[Issue]:
     """With lower > upper the allowed range is empty; simulators pin the joint or
     behave erratically.
+
+    Severity (error, cannot-fly): the joint cannot move between its limits.
     """
     for joint in ctx.robot.joints:
         limit = joint.limit
@@ -241,6 +265,8 @@ def joint_limit_inverted(ctx: CheckContext) -> Iterator[Issue]:
 def joint_axis_zero(ctx: CheckContext) -> Iterator[Issue]:
     """Revolute, continuous, prismatic and planar joints move along or about their
     `<axis xyz=>`, which must not be zero (it is normalised by every consumer).
+
+    Severity (error, refused): libsdformat refuses an axis whose norm is zero.
     """
     for joint in ctx.robot.joints:
         axis = np.asarray(joint.axis, dtype=float)
@@ -256,6 +282,9 @@ def gazebo_reference_missing(ctx: CheckContext) -> Iterator[Issue]:
     """A `<gazebo reference="NAME">` block applies to the link or joint called NAME.
     When there is none, Gazebo ignores the block silently: its material, friction or
     sensor never appears.
+
+    Severity (warning, suspicious): Gazebo ignores the block and the model loads; the
+    settings meant for it are lost.
     """
     names = set(ctx.robot.link_map) | set(ctx.robot.joint_map)
     for block in ctx.robot.gazebo:
@@ -294,6 +323,8 @@ def mesh_unresolved(ctx: CheckContext) -> Iterator[Issue]:
     or truncated file (not XML, a `<triangles>` index past the positions, an STL whose
     size does not match its facet count), an empty export, or one with NaN coordinates
     is reported with what is wrong with it. (glTF/GLB/FBX are only checked to exist.)
+
+    Severity (error, refused): Gazebo cannot load a mesh it cannot find.
     """
     for link, kind, shape, mesh in _mesh_shapes(ctx):
         if _refused(ctx, mesh):
@@ -340,6 +371,8 @@ def sdf_element_not_in_version(ctx: CheckContext) -> Iterator[Issue]:
     to `expressed_in="__model__"`) therefore leaves the joint axis in the joint frame, and
     reedtool reads it so too (SITL_Models' alti_transition_quad and skywalker_x8 declare
     1.7 and keep it).
+
+    Severity (info, explains): libsdformat ignores the element the same way.
     """
     for issue in ctx.robot.parse_issues:
         if issue.kind in _UNDEFINED_KINDS:
@@ -400,6 +433,8 @@ def mesh_format_unsupported(ctx: CheckContext) -> Iterator[Issue]:
     classic plugins (`lib*.so`: gazebo_ros, RotorS, PX4 classic) and no gz system mean
     classic; a model with neither is held to gz-sim's list. Case does not matter
     (`body.STL` is an STL).
+
+    Severity (error, refused): the simulator's mesh loader does not read the format.
     """
     from reedtool.io.meshes import format_problem, uri_problem
 
@@ -454,6 +489,9 @@ def geometry_size_invalid(ctx: CheckContext) -> Iterator[Issue]:
     mesh scale non-zero. A zero size makes a collision shape degenerate (objects fall
     through it); libsdformat refuses a non-positive box size or radius. A negative mesh
     scale is a mirror, which Gazebo draws (S121, S122).
+
+    Severity (error, refused): libsdformat refuses a non-positive box size or radius,
+    and a zero scale makes the shape degenerate.
     """
     for link in ctx.robot.links:
         for shape in [*link.visuals, *link.collisions]:
@@ -484,6 +522,8 @@ def visual_mesh_mirrored(ctx: CheckContext) -> Iterator[Issue]:
     """A negative `<mesh scale>` component mirrors the mesh. For a visual that is a
     convention: the MRS UAV models draw their clockwise propellers as the counter-clockwise
     mesh with scale -1. Gazebo draws it mirrored.
+
+    Severity (info, explains): a mirrored visual is drawn as written.
     """
     for link, shape, axes in _mirrored_meshes(ctx, collisions=False):
         yield Issue(f"link '{link.name}': visual mesh '{shape.geometry.uri}' is mirrored "
@@ -517,6 +557,8 @@ def link_dropped_by_sdf(ctx: CheckContext) -> Iterator[Issue]:
 
     Negative or zero masses are reported by I201. Native SDF models are not converted
     (sdformat gives a link without `<inertial>` 1 kg), so this rule reads URDF input only.
+
+    Severity (error, refused): Gazebo's URDF to SDF conversion drops the link.
     """
     if ctx.robot.source_format != "urdf":
         return
@@ -569,6 +611,9 @@ def plugin_link_merged(ctx: CheckContext) -> Iterator[Issue]:
     </gazebo>` (`disableFixedJointLumping` on older Gazebo), or make it a revolute joint
     with zero limits, as RotorS does for its sensor links. Native SDF models are not
     lumped, so this rule reads URDF input only.
+
+    Severity (warning, suspicious): the model loads, and the plugin looks for a link
+    that is gone.
     """
     if ctx.robot.source_format != "urdf":
         return
@@ -597,6 +642,8 @@ def xml_tolerated(ctx: CheckContext) -> Iterator[Issue]:
 
     Nothing breaks in simulation. To keep other tools happy, write single hyphens in
     comments and declare the prefix on the root element (`<sdf xmlns:gz="...">`).
+
+    Severity (info, explains): Gazebo reads the file; only strict XML tools do not.
     """
     for issue in ctx.robot.parse_issues:
         if issue.kind in _TOLERATED_KINDS:
@@ -613,6 +660,9 @@ def package_name_ambiguous(ctx: CheckContext) -> Iterator[Issue]:
     reach the simulation. The finding names both and the one used.
 
     Remove or rename the copy, or put the intended one first with `--package-path`.
+
+    Severity (warning, suspicious): one package is used; edits to the other never reach
+    the simulation.
     """
     for issue in ctx.robot.parse_issues:
         if issue.kind in _PACKAGE_KINDS:
