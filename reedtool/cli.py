@@ -27,6 +27,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "hover-test": ("reedtool.commands.hover_test", "Trim a multirotor for hover and fly it headless: does it settle and stay?"),
     "authority": ("reedtool.commands.authority", "Control authority (ACAI) about hover, intact and after each single rotor failure."),
     "layout": ("reedtool.commands.layout", "Draw the rotor layout seen from above (SVG/PNG): numbers, spin, COM, arms."),
+    "migrate": ("reedtool.commands.migrate", "Port a Gazebo Classic multirotor to Gazebo Sim and prove the port flies the same."),
 }
 
 

@@ -97,7 +97,7 @@ def test_seed_with_one_rotor_direction_flipped_fails_on_yaw(capsys, tmp_path):
     edit(xacro, 'suffix="front_left"\ndirection="cw"', 'suffix="front_left"\ndirection="ccw"')
     code, report = run_variant(capsys, tmp_path)
     assert code == 1 and report["passed"] is False
-    assert (report["status"], report["trim"]["cause"]) == ("trim-infeasible", "yaw-unbalanced")
+    assert (report["status"], report["trim"]["cause"]) == ("cannot-hover", "yaw-unbalanced")
     assert report["sim"] is None
 
 
@@ -107,7 +107,7 @@ def test_seed_with_motor_constant_divided_by_ten_fails_at_trim(capsys, tmp_path)
          'name="motor_constant" value="8.54858e-07"')
     code, report = run_variant(capsys, tmp_path)
     assert code == 1
-    assert (report["status"], report["trim"]["cause"]) == ("trim-infeasible",
+    assert (report["status"], report["trim"]["cause"]) == ("cannot-hover",
                                                            "insufficient-thrust")
 
 
@@ -126,7 +126,7 @@ def test_seed_with_com_outside_the_rotor_square_fails(capsys, tmp_path):
     code, report = run_variant(capsys, tmp_path)
     assert code == 1
     assert report["model"]["com_m"][0] > 0.18738
-    assert (report["status"], report["trim"]["cause"]) == ("trim-infeasible", "com-unbalanced")
+    assert (report["status"], report["trim"]["cause"]) == ("cannot-hover", "com-unbalanced")
 
 
 # ------------------------------------------------------------------ generated frames

@@ -30,9 +30,12 @@ def test_generated_autopilot_file_is_clean(tmp_path, frame, autopilot):
     assert [f for f in findings if f.severity != "info"] == []
     # PX4: only the hover-throttle comparison, no position offset, no KM mismatch; a
     # hexacopter's alternating spins also get the fault-tolerance information (R350).
-    expected = (["C421"] if autopilot == "px4" else []) + (["R350"] if frame.startswith("hex")
-                                                            else [])
-    assert sorted(f.code for f in findings) == expected
+    # ArduPilot (gz): its plugin drives every rotor through LiftDrag blades, whose
+    # constants validate estimates (R317, info, one per rotor).
+    rotors = len(load_robot(model).joints) - 1          # base_joint + one joint per rotor
+    expected = (["C421"] if autopilot == "px4" else ["R317"] * rotors) + (
+        ["R350"] if frame.startswith("hex") else [])
+    assert sorted(f.code for f in findings) == sorted(expected)
     if autopilot == "px4":
         assert px4.out_of_range(params) == []               # PX4's documented ranges
         assert params.rotor_count == len(params.rotors()) > 0
@@ -63,3 +66,27 @@ def test_octo_x_for_ardupilot_takes_its_spins(tmp_path):
     params = ardupilot.load_parm(table)
     assert (params.get("FRAME_CLASS").value, params.get("FRAME_TYPE").value) == (3, 1)
     assert spec.frame.rotors[0].direction == "cw"          # AP motor 1 at 22.5°: CW
+
+
+@pytest.mark.parametrize("frame", ["quad-x", "hex-x", "octo-x"])
+def test_ardupilot_gz_package_is_driven_by_the_plugin(tmp_path, frame):
+    """--sim gz --autopilot ardupilot: the rotors are ArduPilotPlugin controls on channel =
+    motor number whose SERVO(channel+1)_FUNCTION is the AP motor at that rotor's bearing
+    (C431/C432 clean above), spinning as the .parm's frame spins them, with the constants
+    the catalogue gives (R317's estimate from the blades, to round-off)."""
+    from reedtool.physics.rotors import discover_rotors
+
+    model, table, spec = _generate(tmp_path, frame, "ardupilot")
+    rotors = discover_rotors(load_robot(model))
+    assert {r.kind for r in rotors} == {"ardupilot"}
+    assert sorted(r.channel for r in rotors) == sorted(s.motor_number for s in spec.frame.rotors)
+    spins = {s.motor_number: s.direction for s in spec.frame.rotors}
+    for rotor in rotors:
+        assert rotor.direction == spins[rotor.channel]
+        assert rotor.motor_constant == pytest.approx(spec["motor_constant"], rel=1e-12)
+        assert rotor.moment_constant == pytest.approx(spec["moment_constant"], rel=1e-12)
+        assert rotor.max_rot_velocity_rad_s == pytest.approx(spec["max_rot_velocity"], rel=1e-12)
+    text = model.read_text()
+    assert 'name="gz::sim::systems::MulticopterMotorModel"' not in text
+    assert 'name="gz::sim::systems::MulticopterVelocityControl"' not in text
+

@@ -316,11 +316,40 @@ def test_heavy_spread_makes_some_vehicles_fail():
     assert failing and all(abs(w["mass_kg"] / 1.5 - 1.0) > 0.2 for w in failing)
 
 
-def test_gains_scale_with_mass_and_inertia_not_per_model():
-    small = ControllerGains.from_params(symmetric_multirotor(4, mass_kg=0.5))
-    big = ControllerGains.from_params(symmetric_multirotor(4, mass_kg=5.0))
-    assert (small.kp_1_s2, small.kR_1_s2) == (big.kp_1_s2, big.kR_1_s2)
-    assert big.mass_kg == 10 * small.mass_kg
+def test_gains_follow_the_vehicles_accelerations_not_its_size():
+    # Mass, inertia and motor constants ten times larger: the same accelerations, the
+    # same gains per unit mass and inertia.
+    base = symmetric_multirotor(4, mass_kg=0.5)
+    big = base.with_changes(mass_kg=5.0, inertia_kg_m2=10 * base.inertia_kg_m2,
+                            motor_constant=10 * base.motor_constant)
+    small, large = ControllerGains.from_params(base), ControllerGains.from_params(big)
+    assert large.kp_1_s2 == pytest.approx(small.kp_1_s2, rel=1e-12)
+    assert large.kR_1_s2 == pytest.approx(small.kR_1_s2, rel=1e-12)
+    assert large.mass_kg == pytest.approx(10 * small.mass_kg, rel=1e-15)
+
+
+def test_attitude_bandwidth_is_capped_by_the_torque_authority():
+    # Twenty times the inertia of the 1.5 kg quad: 12 rad/s would ask J * 144 * 0.2 rad,
+    # beyond the rotors. By hand for an 'x' quad (arm a, lever a / sqrt 2 on both axes):
+    # a pure roll torque moves the four thrusts by +-d, so it reaches
+    # 4 (a / sqrt 2) (T_max - T_hover) before the two rising rotors saturate
+    # (T_hover > T_max / 2 here, so they meet their top before the others meet 0).
+    base = symmetric_multirotor(4)
+    heavy = base.with_changes(inertia_kg_m2=20 * base.inertia_kg_m2)
+    T_max = base.motor_constant[0] * 838.0 ** 2
+    T_hover = base.weight_N / 4
+    assert T_hover > T_max / 2
+    torque_N_m = 4 * (0.2 / math.sqrt(2)) * (T_max - T_hover)
+    alpha = torque_N_m / (20 * 0.03)
+    gains = ControllerGains.from_params(heavy)
+    assert gains.limited_by == "torque authority"
+    assert gains.angular_authority_rad_s2 == pytest.approx(alpha, rel=1e-12)
+    # the design start tilt (0.2 rad) asks exactly that acceleration: kR * 0.2 = alpha
+    assert gains.kR_1_s2 == pytest.approx(alpha / 0.2, rel=1e-12)
+    assert gains.position_bandwidth_rad_s == pytest.approx(
+        gains.attitude_bandwidth_rad_s / 6, rel=1e-15)
+    # the 1.5 kg quad itself keeps the 12 rad/s of the fixed design
+    assert ControllerGains.from_params(base).attitude_bandwidth_rad_s == 12.0
 
 
 def test_initial_attitude_is_the_urdf_rpy_convention():

@@ -1,5 +1,6 @@
-"""One model path -> a robot that can be computed on -> its vehicle and validate's errors:
-the call every analysing or flying command makes.
+"""One model path -> a robot that can be computed on -> validate's errors on it, split by
+the refusal policy (assembly/validation.py) -> its vehicle: the call every analysing or
+flying command makes.
 """
 
 from __future__ import annotations
@@ -7,7 +8,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from reedtool.assembly.models import ModelRequest, model_arguments
+from reedtool.assembly.models import ModelRequest, model_mappings
+from reedtool.assembly.validation import Verdict, judge
 from reedtool.assembly.vehicle import Vehicle, check_batch_resources
 
 
@@ -19,7 +21,11 @@ class Assembled:
     robot: object                          # reedtool.model.Robot
     mappings: dict[str, str]               # the xacro arguments it was expanded with
     vehicle: Vehicle
-    errors: list = field(default_factory=list)   # validate's error findings
+    verdict: Verdict = field(default_factory=Verdict)   # validate's errors, split
+
+    @property
+    def errors(self) -> list:
+        return self.verdict.errors
 
 
 def load_robot_for(model: Path, request: ModelRequest, *, require_sound: bool = True):
@@ -27,10 +33,9 @@ def load_robot_for(model: Path, request: ModelRequest, *, require_sound: bool = 
     name:=value), refused (one line, exit 2) when it is not a sound tree to compute on
     (unless the caller checks that itself, after its own refusals)."""
     from reedtool.checks.preflight import require_sound_model
-    from reedtool.config import load_config
     from reedtool.io.loader import load_robot
 
-    mappings = model_arguments(model, load_config(model), request)[0]
+    mappings = model_mappings(model, request)
     robot = load_robot(model, mappings, list(request.package_paths),
                        model_name=request.model_name)
     if require_sound:
@@ -38,18 +43,18 @@ def load_robot_for(model: Path, request: ModelRequest, *, require_sound: bool = 
     return robot, mappings
 
 
-def assemble(model: Path, request: ModelRequest, *, samples: int | None = None,
-             max_memory_bytes: int | None = None, validate: bool = True) -> Assembled:
-    """Load `model`, build its vehicle and (with `validate`) find validate's errors on it.
+def assemble(model: Path, request: ModelRequest, command: str, *,
+             samples: int | None = None, max_memory_bytes: int | None = None,
+             require_sound: bool = True) -> Assembled:
+    """Load `model`, build its vehicle and judge validate's errors on it for `command`
+    (a key of COMMAND_NEEDS).
 
     A model with more rotors than a hover test handles (or a batch of `samples` larger
     than `max_memory_bytes`) is refused before any rule runs on it.
     """
-    from reedtool.assembly.validation import validation_errors
-
-    robot, mappings = load_robot_for(model, request)
+    robot, mappings = load_robot_for(model, request, require_sound=require_sound)
     vehicle = Vehicle.of(robot)
     if max_memory_bytes is not None:
         check_batch_resources(vehicle.every_rotor, samples, max_memory_bytes)
-    errors = validation_errors(model, robot) if validate else []
-    return Assembled(model, robot, mappings, vehicle, errors)
+    verdict = judge(model, robot, request, command)
+    return Assembled(model, robot, mappings, vehicle, verdict)

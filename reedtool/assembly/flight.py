@@ -35,18 +35,22 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
                record: bool = False, progress: Progress | None = None,
                engine: str = "numpy", envelope: bool = False,
                max_memory_bytes: int = DEFAULT_MAX_MEMORY_MB * 1024 * 1024,
-               vehicle: Vehicle | None = None) -> dict:
+               vehicle: Vehicle | None = None, requirement=None,
+               auto_duration: bool = False) -> dict:
     """Trim, simulate and (optionally) batch one robot; the JSON-ready report.
 
-    Keys: "model", "trim", "sim" (None when the trim failed), "batch" (None without
-    samples), "passed"; plus "_run" (the HoverRun, for CSV/plot), "_omega_max" and
+    Keys: "model", "trim", "sim" (None when not flown), "batch" (None without samples),
+    "verdict" (sim.verdict: what the vehicle can do, with its cause), "status" (the
+    verdict's), "message", "passed" (the verdict against `requirement`, default
+    --require stable); plus "_run" (the HoverRun, for CSV/plot), "_omega_max" and
     "_envelope" (the batch's, with `envelope`).
     """
     import numpy as np
 
     from reedtool.physics.rotors import rotor_table
-    from reedtool.sim import ExitStatus
+    from reedtool.sim import verdict as judge
 
+    requirement = requirement or judge.Requirement()
     progress = progress or Progress()
     vehicle = vehicle or Vehicle.of(robot)
     every_rotor, rotors = vehicle.every_rotor, vehicle.rotors
@@ -63,37 +67,81 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
         "passed": False,
         "_omega_max": np.array([r.max_rot_velocity_rad_s for r in rotors], dtype=float),
     }
-    if not trim.feasible:
-        report["status"] = ExitStatus.TRIM_INFEASIBLE.value
-        report["message"] = f"no hover trim: {trim.message}"
+
+    def conclude(found) -> dict:
+        report["verdict"] = found.to_dict()
+        report["status"] = found.verdict.value
+        report["message"] = found.message
+        report["passed"] = found.passes(requirement)
+        report["require"] = str(requirement)
         return report
+
+    if not trim.feasible:
+        from reedtool.sim.params import STANDARD_GRAVITY_M_S2
+        from reedtool.sim.rigid import tilting_joints
+
+        # Rotors on driven tilt joints get roll/pitch/yaw from the tilt: a fixed-axis
+        # trim that finds no torque balance says nothing about such a frame.
+        tilting = tilting_joints(robot, every_rotor)
+        # Their tilt can also turn the thrust upward: only all of it at full speed falling
+        # short of the weight (thrust-to-weight < 1 along any axis) still fails.
+        lift_N = sum(r.max_thrust_N for r in every_rotor)
+        if tilting and trim.cause is not None and (
+                trim.cause.value in judge.TILT_CAUSES
+                or (trim.cause.value == "insufficient-thrust" and lift_N >= props.mass_kg * STANDARD_GRAVITY_M_S2)):
+            return conclude(judge.tilt_rotor(trim.message, tilting))
+        return conclude(judge.HoverVerdict(judge.Verdict.CANNOT_HOVER,
+                                           f"no hover trim: {trim.message}"))
+    if vehicle.omnidirectional:
+        return conclude(judge.omnidirectional(trim.message))
 
     flying = prepare_flight(vehicle)
     report["model"]["derived"] = flying.derived
     params = flying.params
+    from reedtool.sim.rigid import locked_joints
 
+    # Passive joints (no plugin drives them) are flown rigid: which, and what they add.
+    report["model"]["locked_joints"] = [
+        lj.to_dict() for lj in locked_joints(robot, every_rotor, props.com_m)]
+    controllable, acai = judge.stabilisable(params)
+    if not controllable:
+        return conclude(judge.uncontrollable(acai))
+
+    from reedtool.sim.controller import ControllerGains
     from reedtool.sim.run import simulate_hover
 
+    gains = ControllerGains.from_params(params)
+    if auto_duration:
+        # A slowly tuned vehicle (a heavy one, little authority) gets the time its
+        # position loop needs to settle, not a fixed 10 s.
+        config = judge.with_time_to_settle(config, gains)
     with progress.flying(f"flying {config.duration_s:g} s at {config.rate_hz:g} Hz"):
-        run = simulate_hover(params, config, record=record, engine=engine)
+        run = simulate_hover(params, config, record=record, engine=engine, gains=gains)
+        found = judge.judge_flight(
+            params, config, run,
+            lambda start: simulate_hover(params, start, record=False, engine=engine,
+                                         gains=gains), requirement)
     sim = run.to_dict()
     sim["trim_omega_rad_s"] = dict(zip(params.rotor_names,
                                        (float(w) for w in trim.omega_rad_s)))
     report["sim"] = sim
     report["_run"] = run
-    report["status"] = run.status.value
-    report["message"] = run.message
-    report["passed"] = run.passed
+    conclude(found)
 
     if samples:
         from reedtool.sim.batch import Spreads, robustness_batch
 
+        # The batch flies the nominal tuning from the start the nominal vehicle recovers
+        # from: the start itself when it flies, its recoverable margin when marginal.
+        scale = judge.batch_start_scale(found)
+        batch_config = judge.scaled_start(config, scale)
         mass_rel, com_m, inertia_rel, motor_rel = spreads
         spread = Spreads(mass_rel=mass_rel, com_m=com_m, inertia_rel=inertia_rel,
                          motor_constant_rel=motor_rel)
         with progress.steps(f"flying {samples} vehicles", config.n_steps) as update:
-            batch = robustness_batch(params, samples, config, spread, seed, progress=update,
-                                     engine=engine, record=envelope)
+            batch = robustness_batch(params, samples, batch_config, spread, seed,
+                                     progress=update, engine=engine, record=envelope)
         report["batch"] = batch.to_dict()
+        report["batch"]["start_scale"] = scale
         report["_envelope"] = batch.envelope
     return report

@@ -79,6 +79,13 @@ def model_arguments(model: Path, config, request: ModelRequest):
     return mappings, given, origins, checked
 
 
+def model_mappings(model: Path, request: ModelRequest) -> dict[str, str]:
+    """The xacro arguments `model` is expanded with (configuration, --launch, command line)."""
+    from reedtool.config import load_config
+
+    return model_arguments(model, load_config(model), request)[0]
+
+
 def argument_use(model: Path, mappings, given, origins, checked, config,
                  request: ModelRequest):
     """What rule S140 needs: the arguments the model declares against those it was given."""
@@ -156,3 +163,72 @@ def targets_of(paths: Sequence[str], request: ModelRequest):
                           include_globs=include_globs_of(mappings_for, request.package_paths),
                           has_arguments=has_arguments, stands_alone=stands_alone,
                           configures_models=configures_models)
+
+
+def request_from_words(words: Sequence[str], *, package_paths: Sequence[Path] = (),
+                       model_name: str | None = None, launch_file: Path | None = None,
+                       select: Sequence[str] = (), ignore: Sequence[str] = ()):
+    """The command line's words (paths and name:=value) and model options -> (paths,
+    ModelRequest). With --launch and no path, the launch file's model is the path."""
+    from reedtool.io.mappings import MAPPING_SEPARATOR, parse_mappings
+
+    request = ModelRequest(mappings=parse_mappings([w for w in words if MAPPING_SEPARATOR in w]),
+                           package_paths=list(package_paths), model_name=model_name,
+                           launch_file=launch_file, select=tuple(select), ignore=tuple(ignore))
+    paths = [w for w in words if MAPPING_SEPARATOR not in w]
+    if launch_file is not None:
+        from reedtool.io.launch import read_launch
+
+        request.launch = read_launch(launch_file, package_paths=list(package_paths))
+        if not paths:
+            if request.launch.model is None:
+                raise ReedtoolError("the launch file's xacro call names no model reedtool "
+                                    "can evaluate", file=launch_file,
+                                    hint="pass the model path before the options")
+            paths = [str(request.launch.model)]
+    return paths, request
+
+
+_GLOB_CHARS = re.compile(r"[*?\[]")
+
+
+def one_model(paths: Sequence[str], request: ModelRequest, command: str) -> Path:
+    """The one model a single-model command reads from its paths (a file, a directory,
+    a glob or a ROS package naming exactly one model), or a one-line refusal naming the
+    models found."""
+    for n, word in enumerate(paths):
+        if Path(word).exists() or _GLOB_CHARS.search(word):
+            continue
+        if n == 0 and "=" not in word:
+            raise ReedtoolError("model file not found", file=word,
+                                hint="pass a model file (.urdf, .xacro, .sdf, .gazebo, "
+                                     ".world), a directory or a ROS package")
+        # A word after the model that names nothing is a mistyped argument.
+        from reedtool.io.mappings import suggest_mapping
+
+        suggestion = suggest_mapping(word)
+        raise ReedtoolError(f"cannot read argument '{word}'",
+                            hint=(f"did you mean '{suggestion}'? " if suggestion else "")
+                            + "xacro arguments are written name:=value, one per word, "
+                              "after the model")
+    if len(paths) == 1 and not _GLOB_CHARS.search(paths[0]):
+        path = Path(paths[0])
+        if not path.is_dir() or (path / "model.sdf").is_file():
+            return path      # itself, as every command always read a named file
+    targets = targets_of(paths, request)
+    problem = next((t for t in targets if t.error is not None), None)
+    if problem is not None:
+        raise ReedtoolError(problem.error, file=problem.name)
+    models = [t for t in targets if t.path is not None]
+    if not models:
+        first = next((t for t in targets if t.skipped is not None), None)
+        if first is None:
+            raise ReedtoolError("no model given", hint=f"reedtool {command} MODEL")
+        raise ReedtoolError(f"nothing to read: {first.skipped}", file=first.name)
+    if len(models) > 1:
+        shown = ", ".join(t.name for t in models[:5]) + (", ..." if len(models) > 5 else "")
+        raise ReedtoolError(f"{len(models)} models found ({shown}); {command} reads one "
+                            "model at a time", file=", ".join(paths),
+                            hint=f"name one of them, or run `reedtool {command}` once per "
+                                 "model (`reedtool validate` checks them all in one run)")
+    return models[0].path

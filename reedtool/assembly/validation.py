@@ -91,13 +91,87 @@ def check_model_path(model: Path, request: ModelRequest, *, controllers=(),
     return out
 
 
-def validation_errors(model: Path, robot) -> list:
-    """The error findings `validate` reports for an already loaded robot (its config's
-    selection, severities and suppressions): what hover-test refuses to fly."""
+# ------------------------------------------------------------------ what a command refuses
+#
+# The computing commands run validate's rules first (the model's configuration, then
+# --select/--ignore). An error in what a command builds on makes its result meaningless,
+# so it refuses the model (exit 1, the errors listed; --ignore CODE or --ignore-validation
+# flies it anyway). Every other error is reported beside the result. The groups, by rule
+# code prefix (the longest prefix wins, as in --select; "-CODE" takes a code out):
+REFUSAL_GROUPS: dict[str, tuple[str, ...]] = {
+    # The tree Gazebo and Pinocchio build: unreadable or non-finite numbers, links, joints,
+    # limits, geometry sizes, links Gazebo drops. The mesh files (S115 unresolved, S130
+    # format, S131 escaping URI) are the look and the collisions, not the dynamics.
+    "structure": ("S1", "-S115", "-S130", "-S131", "-S140"),
+    # The masses and inertias every number is computed from. I210 (a mesh in the wrong
+    # unit) is a mesh's size, not a declared mass.
+    "mass": ("I2", "-I210"),
+    # A rotor as written is not a rotor: no direction, no usable constants, its plugin
+    # names nothing, it does not turn, it spins against its blades. Motor numbering (R301,
+    # R302) and the MAVLink rotor count (R312) are the flight stack's wiring; yaw balance,
+    # rank, trim and thrust-to-weight (R304, R305, R307, R308) are what hover-test and
+    # authority compute and report themselves.
+    "rotors": ("R303", "R313", "R314", "R315", "R316", "R318"),
+}
+# What each command builds on. inertia's own output is the mass verdicts and layout's the
+# rotors (drawn, the rotors findings name in red), so neither refuses on those.
+COMMAND_NEEDS: dict[str, tuple[str, ...]] = {
+    "hover-test": ("structure", "mass", "rotors"),
+    "authority": ("structure", "mass", "rotors"),
+    "inertia": ("structure",),
+    "layout": ("structure",),
+}
+
+
+def refuses(code: str, groups: Sequence[str]) -> bool:
+    """Does an error of rule `code` make a result built on `groups` meaningless?"""
+    for group in groups:
+        best, take = -1, False
+        for prefix in REFUSAL_GROUPS[group]:
+            exclude = prefix.startswith("-")
+            stem = prefix.lstrip("-")
+            if code.startswith(stem) and len(stem) > best:
+                best, take = len(stem), not exclude
+        if take:
+            return True
+    return False
+
+
+@dataclass
+class Verdict:
+    """validate's errors on a model, split by what a command does with them."""
+
+    refusing: list = field(default_factory=list)   # the result would be meaningless
+    reported: list = field(default_factory=list)   # shown beside the result
+
+    @property
+    def errors(self) -> list:
+        return [*self.refusing, *self.reported]
+
+
+def judge(model: Path, robot, request: ModelRequest, command: str) -> Verdict:
+    """validate's errors on `robot` (its configuration, then the request's --select and
+    --ignore), split into those `command` refuses on and those it reports."""
     from reedtool.checks.runner import apply_suppressions, run_checks
     from reedtool.config import load_config
 
     config = load_config(model)
-    findings = run_checks(robot, selection_for(config))
+    findings = run_checks(robot, selection_for(config, request.select, request.ignore))
     kept, _ = apply_suppressions(findings, _ignores_for(config, model))
-    return [f for f in kept if f.severity == "error"]
+    needs = COMMAND_NEEDS[command]
+    verdict = Verdict()
+    for f in kept:
+        if f.severity == "error":
+            (verdict.refusing if refuses(f.code, needs) else verdict.reported).append(f)
+    return verdict
+
+
+def refusal_table() -> list[tuple[str, str, str]]:
+    """(command, groups, rule codes) rows for the docs and --help."""
+    from reedtool.checks.registry import all_rules
+
+    rows = []
+    for command, needs in COMMAND_NEEDS.items():
+        codes = [r.code for r in all_rules() if r.severity == "error" and refuses(r.code, needs)]
+        rows.append((command, ", ".join(needs), " ".join(codes)))
+    return rows

@@ -64,6 +64,35 @@ def build_tree(robot: Robot) -> Tree:
     return tree
 
 
+# Meshes shared by the models of one run (a repository's models use the same few files):
+# read once per process, keyed by the file's identity (device, inode, size, mtime), so an
+# edited file is read again. Large meshes are not kept.
+SHARED_MESHES_MAX = 64
+SHARED_MESH_MAX_BYTES = 8 * 1024 * 1024
+_shared_meshes: dict[tuple, Any] = {}        # (path, identity) -> MeshFile | ReedtoolError
+_shared_mesh_errors: dict[tuple, str] = {}   # (path, identity) -> why not usable ("": fine)
+
+
+def _shared_key(path) -> tuple | None:
+    import os
+
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    if st.st_size > SHARED_MESH_MAX_BYTES:
+        return None
+    return (str(path), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+
+
+def _remember(cache: dict, key: tuple | None, value) -> None:
+    if key is None:
+        return
+    if len(cache) >= SHARED_MESHES_MAX:
+        cache.pop(next(iter(cache)))      # the oldest first
+    cache[key] = value
+
+
 class CheckContext:
     def __init__(self, robot: Robot, controllers: Sequence[Any] = (),
                  flight_params: Sequence[Any] = (), arguments: Any = None):
@@ -295,10 +324,18 @@ class CheckContext:
                     or uri_problem(mesh.uri, mesh.path):
                 self._mesh_files[key] = None   # only the light readers run in validate
             else:
-                try:
-                    self._mesh_files[key] = read_mesh(key)
-                except ReedtoolError as exc:
-                    self._mesh_files[key] = exc
+                shared = _shared_key(mesh.path)
+                if shared in _shared_meshes:
+                    self._mesh_files[key] = _shared_meshes[shared]
+                else:
+                    try:
+                        self._mesh_files[key] = read_mesh(key)
+                    except ReedtoolError as exc:
+                        self._mesh_files[key] = exc
+                    read = self._mesh_files[key]
+                    if shared is not None and hasattr(read, "triangles"):
+                        read.triangles.flags.writeable = False   # shared: never edited
+                    _remember(_shared_meshes, shared, read)
         return self._mesh_files[key]
 
     def mesh_error(self, mesh) -> str | None:
@@ -314,6 +351,9 @@ class CheckContext:
         if isinstance(read, ReedtoolError):
             return read.message
         key = str(mesh.path)
+        shared = _shared_key(mesh.path)
+        if key not in self._mesh_errors and shared in _shared_mesh_errors:
+            self._mesh_errors[key] = _shared_mesh_errors[shared]
         if key not in self._mesh_errors:
             from reedtool.io.fileio import MAX_MESH_COORDINATE
             from reedtool.io.meshes import check_triangles, triangle_areas
@@ -328,6 +368,7 @@ class CheckContext:
             except ReedtoolError as exc:
                 error = exc.message
             self._mesh_errors[key] = error
+            _remember(_shared_mesh_errors, shared, error)
         return self._mesh_errors[key] or None
 
     def mesh_bounds(self, mesh) -> np.ndarray | None:

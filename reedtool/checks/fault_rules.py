@@ -17,7 +17,7 @@ from reedtool.checks.finding import Issue
 from reedtool.checks.registry import rule
 from reedtool.checks.rotor_rules import _physics_ready, _rotors
 from reedtool.physics.allocation import allocation_matrix
-from reedtool.physics.authority import full_control_after_failures
+from reedtool.physics.authority import full_control_after_failures_many
 from reedtool.physics.trim import STANDARD_GRAVITY_M_S2
 
 # Fewer rotors cannot survive a failure with full control whatever the spin order
@@ -26,22 +26,29 @@ MIN_ROTORS = 6
 MAX_ROTORS_SEARCHED = 8
 
 
-def _survivors(rotors, com_m, signs, weight_N) -> tuple[int, float]:
-    """(number of single failures that keep full control, their worst ACAI)."""
-    B = _allocation_with_signs(rotors, com_m, signs)
+def _survivors(rotors, com_m, sign_rows, weight_N) -> list[tuple[int, float]]:
+    """Per spin order (a row of signs): (number of single failures that keep full
+    control, their worst ACAI)."""
+    Bs = _allocations_with_signs(rotors, com_m, np.atleast_2d(sign_rows))
     K = np.array([r.max_thrust_N for r in rotors])
-    ok = [acai for acai in full_control_after_failures(B, K, weight_N) if acai is not None]
-    return len(ok), (min(ok) if ok else -math.inf)
+    out = []
+    for acai in full_control_after_failures_many(Bs, K, weight_N):
+        ok = acai[~np.isnan(acai)]
+        out.append((len(ok), float(ok.min()) if len(ok) else -math.inf))
+    return out
 
 
-def _allocation_with_signs(rotors, com_m, signs) -> np.ndarray:
+def _allocations_with_signs(rotors, com_m, sign_rows) -> np.ndarray:
+    """(orders, 4, n): the allocation of each spin order of the same rotors."""
     B = allocation_matrix(rotors, com_m)
     # Only the drag term depends on the spin: flip it where the sign differs.
     axis = np.array([r.axis / np.linalg.norm(r.axis) for r in rotors])
     km = np.array([r.moment_constant for r in rotors])
     old = np.array([r.turning_sign for r in rotors], dtype=float)
-    B[1:] += ((old - np.asarray(signs, dtype=float)) * km)[None, :] * axis.T
-    return B
+    Bs = np.repeat(B[None], len(sign_rows), axis=0)
+    Bs[:, 1:] += ((old[None] - np.asarray(sign_rows, dtype=float)) * km)[:, None, :] \
+        * axis.T[None]
+    return Bs
 
 
 def _order(rotors, signs) -> str:
@@ -78,15 +85,17 @@ def spin_order_not_fault_tolerant(ctx: CheckContext) -> Iterator[Issue]:
     weight_N = whole.mass_kg * STANDARD_GRAVITY_M_S2
     com_m = np.asarray(whole.com_m, dtype=float)
     signs = np.array([r.turning_sign for r in rotors], dtype=float)
-    survived, _ = _survivors(rotors, com_m, signs, weight_N)
+    (survived, _), = _survivors(rotors, com_m, signs, weight_N)
     if survived > 0:
         return
     n_ccw = int(np.sum(signs > 0))
-    best = None
+    orders = []
     for ccw in itertools.combinations(range(len(rotors)), n_ccw):
         candidate = -np.ones(len(rotors))
         candidate[list(ccw)] = 1.0
-        score = _survivors(rotors, com_m, candidate, weight_N)
+        orders.append(candidate)
+    best = None
+    for score, candidate in zip(_survivors(rotors, com_m, np.array(orders), weight_N), orders):
         if score[0] > 0 and (best is None or score > best[0]):
             best = (score, candidate)
     if best is None:

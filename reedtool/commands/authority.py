@@ -15,7 +15,12 @@ from pathlib import Path
 
 import click
 
-from reedtool.commands.params import FiniteFloatRange, model_arguments
+from reedtool.commands.params import (
+    FiniteFloatRange,
+    model_inputs,
+    one_model_request,
+    validation_options,
+)
 from reedtool.errors import ReedtoolError
 
 SCHEMA = "reedtool.authority/1"
@@ -122,7 +127,7 @@ def render_text(name: str, report: dict, policy: str) -> str:
 
 
 @click.command(name="authority")
-@model_arguments
+@model_inputs()
 @click.option("--efficiency", "efficiency_items", multiple=True, metavar="ROTOR=ETA",
               help="Degrade a rotor: its maximum thrust times ETA in [0, 1] (repeatable).")
 @click.option("--degrade", "degrade", type=FiniteFloatRange(0.0, 1.0, max_open=True),
@@ -144,18 +149,22 @@ def render_text(name: str, report: dict, policy: str) -> str:
 @click.option("--force", is_flag=True, help="Overwrite an existing --plot file.")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
               show_default=True, help="Output format.")
-def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
-            model_name: str | None, efficiency_items: tuple[str, ...], degrade: float,
+@validation_options
+def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
+            model_name: str | None, launch_file: Path | None, efficiency_items: tuple[str, ...], degrade: float,
             policy: str, fly: bool,
             fail_at_s: float, duration_s: float, plot_path: Path | None, force: bool,
-            fmt: str) -> int:
+            fmt: str, ignore: tuple[str, ...] = (), ignore_validation: bool = False) -> int:
     """Control authority of MODEL about hover, intact and after each single rotor failure.
 
-    MODEL is a .urdf or .xacro (with xacro NAME:=VALUE arguments) with motor plugins.
+    MODEL is a .urdf, .xacro (.urdf.xacro), .gazebo, .sdf or .world file with motor
+    plugins, or a directory, glob or ROS package holding one such model; NAME:=VALUE words
+    are its xacro arguments. validate's rules run first: a structure, mass or rotor error
+    refuses the model (exit 1) unless --ignore CODE or --ignore-validation is given; other
+    errors are listed beside the analysis.
     """
-    if not model.is_file():
-        raise ReedtoolError("model file not found", file=model,
-                            hint="pass the path of a .urdf or .xacro file")
+    model, request = one_model_request("authority", inputs, package_paths, model_name,
+                                       launch_file, ignore)
     from reedtool.sim import HoverConfig
 
     hold_s = HoverConfig().hold_s
@@ -177,18 +186,31 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
             raise ReedtoolError(f"cannot tell the plot format from '{plot_path.name}'",
                                 file=plot_path, hint="name the --plot file .png or .svg")
     from reedtool.assembly.assemble import assemble
-    from reedtool.assembly.models import ModelRequest
-    from reedtool.io.mappings import parse_mappings
+    from reedtool.report.validation_note import validation_json, validation_text, why_line
 
-    request = ModelRequest(mappings=parse_mappings(mappings),
-                           package_paths=list(package_paths), model_name=model_name)
-    assembled = assemble(model, request, validate=False)
-    robot, vehicle = assembled.robot, assembled.vehicle
+    assembled = assemble(model, request, "authority")
+    robot, vehicle, verdict = assembled.robot, assembled.vehicle, assembled.verdict
     # A VTOL's pusher or a plane's puller holds no hover: the lift rotors are analysed.
     rotors = vehicle.rotors
     if len(rotors) < 1:
         raise ReedtoolError("no motor plugins found: nothing to analyse", file=model,
                             hint="authority needs RotorS, PX4 or gz-sim motor plugins")
+    refused = bool(verdict.refusing) and not ignore_validation
+    if fmt == "text":
+        click.echo(validation_text(str(model), verdict.refusing, verdict.reported, refused,
+                                   "analysing it", ignore_validation), nl=False)
+    if refused:
+        if fmt == "json":
+            from reedtool.report.json_format import envelope
+
+            click.echo(json.dumps({**envelope(SCHEMA), "model": robot.name, "require": policy,
+                                   "passed": False, "status": "refused",
+                                   "message": why_line(verdict.refusing, verdict.reported,
+                                                       True, "analysing it"),
+                                   "validation": validation_json(verdict.refusing,
+                                                                 verdict.reported, True)},
+                                  indent=2))
+        return 1
     bad = [r.name for r in rotors
            if not (math.isfinite(r.max_thrust_N) and r.max_thrust_N > 0 and r.turning_sign != 0
                    and all(math.isfinite(v) for v in r.position_m)
@@ -211,7 +233,8 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
                                               record=plot_path is not None)
         if plot_path is not None and chosen is not None:
             _plot(robot, chosen, params, config, plot_path, force)
-    report = {"model": robot.name, "require": policy, "passed": meets(report, policy), **report}
+    report = {"model": robot.name, "require": policy, "passed": meets(report, policy), **report,
+              "validation": validation_json(verdict.refusing, verdict.reported, False)}
     if fmt == "json":
         from reedtool.report.json_format import envelope
 

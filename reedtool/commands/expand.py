@@ -6,6 +6,7 @@ from pathlib import Path
 
 import click
 
+from reedtool.commands.params import model_inputs, one_model_request
 from reedtool.errors import ReedtoolError
 
 
@@ -25,28 +26,33 @@ def _fix_legacy(model: Path, mappings: dict[str, str], package_paths: list[Path]
 
 
 @click.command(name="expand")
-@click.argument("model", type=click.Path(path_type=Path, dir_okay=False))
-@click.argument("args", nargs=-1, metavar="[NAME:=VALUE]...")
+@model_inputs()
 @click.option("-o", "--output", type=click.Path(path_type=Path, dir_okay=False),
               help="Write the URDF here instead of standard output ('-': standard output).")
-@click.option("--package-path", "package_paths", multiple=True,
-              type=click.Path(path_type=Path, file_okay=False),
-              help="Directory searched first for ROS packages (repeatable).")
 @click.option("--force", is_flag=True, help="Overwrite an existing output file.")
 @click.option("--fix-legacy", is_flag=True,
               help="Rewrite legacy xacro tags (<property>, <macro>, <include>, unprefixed "
                    "macro calls) in the model's files first, keeping a .bak of each.")
-def command(model: Path, args: tuple[str, ...], output: Path | None,
-            package_paths: tuple[Path, ...], force: bool, fix_legacy: bool) -> int:
+def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name: str | None,
+            launch_file: Path | None, output: Path | None, force: bool,
+            fix_legacy: bool) -> int:
     """Expand a xacro MODEL into URDF, with $(find) and package:// resolved without ROS.
 
-    Arguments NAME:=VALUE set $(arg NAME), as roslaunch and xacro take them.
+    MODEL is a .xacro (.urdf.xacro, .gazebo) or .urdf file, or a directory, glob or ROS
+    package holding one; NAME:=VALUE words set $(arg NAME), as roslaunch and xacro take
+    them, after `[tool.reedtool] args` and --launch's.
     """
     from reedtool.io.fileio import atomic_write_text, check_writable, is_stdout, note_input
-    from reedtool.io.mappings import parse_mappings
     from reedtool.io.xacro_expand import expand_xacro
 
-    mappings = parse_mappings(args)
+    if model_name is not None:
+        raise ReedtoolError("--model picks one model of an SDF world; expand writes a "
+                            "xacro's URDF", hint="drop --model")
+    model, request = one_model_request("expand", inputs, package_paths, model_name,
+                                       launch_file)
+    from reedtool.assembly.models import model_mappings
+
+    mappings = model_mappings(model, request)
     if is_stdout(output):
         output = None
     note_input(model)

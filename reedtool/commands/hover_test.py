@@ -19,7 +19,12 @@ import click
 
 from reedtool.assembly.flight import Progress
 from reedtool.assembly.vehicle import DEFAULT_MAX_MEMORY_MB
-from reedtool.commands.params import FiniteFloatRange, model_arguments
+from reedtool.commands.params import (
+    FiniteFloatRange,
+    model_inputs,
+    one_model_request,
+    validation_options,
+)
 from reedtool.errors import ReedtoolError
 
 SPREAD_HELP = "Half-width of the uniform perturbation"
@@ -29,10 +34,7 @@ MAX_COM_SPREAD_M = 1.0
 # (`--duration 1e9`) that would keep the machine busy for days.
 MAX_STEPS = 10_000_000
 SCHEMA = "reedtool.hover-test/1"
-
-
-def _validation_json(errors, refused: bool) -> dict:
-    return {"errors": [f.to_dict() for f in errors], "refused": refused}
+DEFAULT_DURATION_S = 10.0
 
 
 # A run longer than this on a terminal shows that it is still working.
@@ -40,9 +42,10 @@ PROGRESS_AFTER_S = 2.0
 
 
 @click.command(name="hover-test")
-@model_arguments
-@click.option("--duration", "duration_s", type=float, default=10.0, show_default=True,
-              help="Simulated time [s].")
+@model_inputs()
+@click.option("--duration", "duration_s", type=float, default=None,
+              help="Simulated time [s]. Default 10 s, longer when the vehicle's tuned "
+                   "position loop needs more to settle (the text and JSON say how long).")
 @click.option("--rate", "rate_hz", type=float, default=1000.0, show_default=True,
               help="Integration and control rate [Hz] (fixed step).")
 @click.option("--offset", "offset_m", type=float, nargs=3, default=(0.5, 0.0, 0.0),
@@ -81,29 +84,46 @@ PROGRESS_AFTER_S = 2.0
                    "needs pip install 'reedtool[fast]').")
 @click.option("--min-pass-rate", type=FiniteFloatRange(0.0, 1.0), default=0.95,
               show_default=True, help="Batch pass rate needed to exit 0.")
-@click.option("--ignore-validation", is_flag=True,
-              help="Fly a model that `validate` reports errors for (by default it is "
-                   "refused: exit 1 without flying).")
-def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
-            model_name: str | None,
+@click.option("--require", "require", default="stable", show_default=True,
+              metavar="hover|stable|margin:DEG",
+              help="What exit 0 needs: a hover trim (hover); and a vehicle some controller "
+                   "can stabilise (stable); and recovery from a start tilted DEG degrees "
+                   "(margin:DEG).")
+@validation_options
+def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
+            model_name: str | None, launch_file: Path | None,
             duration_s: float, rate_hz: float, offset_m: tuple[float, float, float],
             roll_rad: float, pitch_rad: float, yaw_rad: float, plot_path: Path | None,
             csv_path: Path | None, force: bool, fmt: str, samples: int | None,
             max_memory_mb: int, seed: int,
             mass_spread: float, com_spread_m: float, inertia_spread: float,
             motor_spread: float, engine: str, min_pass_rate: float,
-            ignore_validation: bool = False) -> int:
-    """Trim MODEL (.urdf or .xacro, with xacro NAME:=VALUE arguments) for hover and fly it.
+            require: str = "stable",
+            ignore: tuple[str, ...] = (), ignore_validation: bool = False) -> int:
+    """Trim MODEL for hover and fly it.
+
+    MODEL is a .urdf, .xacro (.urdf.xacro), .gazebo, .sdf or .world file, or a directory,
+    glob or ROS package holding one model; NAME:=VALUE words are its xacro arguments.
 
     Starts from a disturbance (default 0.5 m off the setpoint, rolled 0.2 rad) and passes
-    when it settles within 5 cm and 2 deg and stays there. A model `validate` reports
-    errors for is not flown (exit 1) unless --ignore-validation is given: a hover of a
-    model Gazebo would simulate differently is not a pass.
+    when it settles within 5 cm and 2 deg and stays there. validate's rules run first: a
+    model with a structure, mass or rotor error (the flight would be another vehicle's) is
+    not flown (exit 1) unless --ignore CODE or --ignore-validation is given; other errors
+    are listed and the model flown.
     """
     from reedtool.errors import check_plausible
     from reedtool.sim import HoverConfig
+    from reedtool.sim.verdict import Requirement
+
+    try:
+        requirement = Requirement.parse(require)
+    except ValueError as exc:
+        raise ReedtoolError(f"bad option: {exc}",
+                            hint="e.g. --require stable, or --require margin:10") from exc
 
     check_plausible("rate", rate_hz, "--rate")
+    auto_duration = duration_s is None
+    duration_s = DEFAULT_DURATION_S if auto_duration else duration_s
     check_plausible("duration", duration_s, "--duration")
     for axis, value in zip("xyz", offset_m):
         check_plausible("offset", value, f"--offset {axis}", magnitude=True)
@@ -129,7 +149,9 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
                                 hint="or use --engine numpy (the default)")
     from reedtool.io.fileio import check_writable, note_input
 
-    note_input(model)           # the model is never an output of its own test
+    for word in inputs:         # the model is never an output of its own test
+        if Path(word).is_file():
+            note_input(Path(word))
     if plot_path is not None:   # fail before flying, not after
         check_writable(plot_path, force)
     if csv_path is not None:
@@ -138,21 +160,19 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     if plot_path is not None and plot_path.suffix.lower() not in (".png", ".svg"):
         raise ReedtoolError(f"cannot tell the plot format from '{plot_path.suffix or plot_path.name}'",
                             file=plot_path, hint="name the --plot file .png or .svg")
-    if not model.is_file():
-        raise ReedtoolError("model file not found", file=model,
-                            hint="pass the path of a .urdf or .xacro file")
+    model, request = one_model_request("hover-test", inputs, package_paths, model_name,
+                                       launch_file, ignore)
+    note_input(model)
 
     from reedtool.assembly.assemble import assemble
-    from reedtool.assembly.models import ModelRequest
-    from reedtool.io.mappings import parse_mappings
 
-    request = ModelRequest(mappings=parse_mappings(mappings),
-                           package_paths=list(package_paths), model_name=model_name)
     # A model or batch too large for the machine is refused before any rule runs on it.
-    assembled = assemble(model, request, samples=samples,
+    assembled = assemble(model, request, "hover-test", samples=samples,
                          max_memory_bytes=max_memory_mb * 1024 * 1024)
-    robot, errors, every_rotor = assembled.robot, assembled.errors, assembled.vehicle.every_rotor
-    if errors and not ignore_validation:
+    robot, verdict = assembled.robot, assembled.verdict
+    every_rotor = assembled.vehicle.every_rotor
+    refused = bool(verdict.refusing) and not ignore_validation
+    if refused:
         # Bad input (exit 2) comes before what validate finds (exit 1): unreadable rotor
         # parameters.
         from reedtool.sim.params import check_rotor_dynamics
@@ -160,25 +180,22 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
         # ArduPilotPlugin rotors carry no time constants: hover_test derives them from
         # the joint's velocity PID (or refuses with the reason) only when it flies.
         check_rotor_dynamics([r for r in every_rotor if r.kind != "ardupilot"])
-    if errors:
-        from reedtool.report import ModelResult, render
+    from reedtool.report.validation_note import validation_json, validation_text, why_line
 
-        refused = not ignore_validation
-        why = (f"validate reports {len(errors)} error{'s' if len(errors) != 1 else ''} for "
-               f"this model; " + ("not flying it (--ignore-validation flies it anyway)"
-                                  if refused else "flying it anyway (--ignore-validation)"))
-        if fmt == "text":
-            click.echo(render([ModelResult(str(model), errors)], "text"), nl=False)
-            click.echo(why if not refused else f"FAILED: {why}")
-        if refused:
-            if fmt == "json":
-                from reedtool.report.json_format import envelope
+    if fmt == "text":
+        click.echo(validation_text(str(model), verdict.refusing, verdict.reported, refused,
+                                   "flying it", ignore_validation), nl=False)
+    if refused:
+        if fmt == "json":
+            from reedtool.report.json_format import envelope
 
-                click.echo(json.dumps({**envelope(SCHEMA), "model": {"file": str(model)},
-                                       "validation": _validation_json(errors, True),
-                                       "passed": False, "status": "refused",
-                                       "message": why}, indent=2))
-            return 1
+            click.echo(json.dumps({**envelope(SCHEMA), "model": {"file": str(model)},
+                                   "validation": validation_json(verdict.refusing,
+                                                                 verdict.reported, True),
+                                   "passed": False, "status": "refused",
+                                   "message": why_line(verdict.refusing, verdict.reported,
+                                                       True, "flying it")}, indent=2))
+        return 1
     from reedtool.assembly.flight import hover_test
 
     report = hover_test(robot, config, samples=samples, seed=seed,
@@ -187,7 +204,8 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
                         progress=TerminalProgress() if fmt == "text" else None,
                         engine=engine, envelope=plot_path is not None,
                         max_memory_bytes=max_memory_mb * 1024 * 1024,
-                        vehicle=assembled.vehicle)
+                        vehicle=assembled.vehicle, requirement=requirement,
+                        auto_duration=auto_duration)
     batch = report.get("batch")
     if batch is not None:
         batch["min_pass_rate"] = min_pass_rate
@@ -219,7 +237,7 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
         from reedtool.report.json_format import envelope
 
         document = {**envelope(SCHEMA), **report,
-                    "validation": _validation_json(errors, False)}
+                    "validation": validation_json(verdict.refusing, verdict.reported, False)}
         click.echo(json.dumps(_finite(document), indent=2, allow_nan=False))
     else:
         click.echo(render_text(report))
@@ -284,6 +302,15 @@ def render_text(report: dict) -> str:
                                                          for r in others))
     for line in model.get("derived", ()):
         lines.append(f"derived: {line}")
+    for lj in model.get("locked_joints", ()):
+        # Passive joints (no plugin drives them) are flown rigid: say so, with what the
+        # mass beyond them adds to the inertia about the COM.
+        added = [lj["inertia_about_com_kg_m2"][i][i] for i in range(3)]
+        total = [model["inertia_kg_m2"][i][i] for i in range(3)]
+        share = ", ".join(f"{axis} {a:.3g} kg*m^2 ({100 * a / t:.0f}%)" if t > 0 else
+                          f"{axis} {a:.3g} kg*m^2" for axis, a, t in zip("xyz", added, total))
+        lines.append(f"locked rigid: {lj['joint']} ({lj['type']}, no plugin drives it; "
+                     f"{lj['mass_kg']:.3g} kg beyond it adds {share} about the COM)")
     if trim["feasible"]:
         lines.append(f"trim: {trim['message']}")
     else:
@@ -300,7 +327,10 @@ def render_text(report: dict) -> str:
                      f"hover: roll {a['roll']:.3g}, pitch {a['pitch']:.3g}, "
                      f"yaw {a['yaw']:.3g} N*m")
     if sim is not None:
+        from reedtool.sim.verdict import tuning_line
+
         c = sim["config"]
+        lines.append(f"tuning: {tuning_line(sim['gains'])}")
         lines.append(f"sim: {sim['status'].upper()}: {sim['message']}")
         lines.append(f"  start {c['offset_m']} m off, roll {c['roll_rad']:g} pitch "
                      f"{c['pitch_rad']:g} yaw {c['yaw_rad']:g} rad; {c['duration_s']:g} s at "
@@ -321,11 +351,16 @@ def render_text(report: dict) -> str:
                      f"{100 * batch['min_pass_rate']:.0f}%): {counts}")
         lines.append(f"  spreads: mass +-{100 * s['mass_rel']:g}%, COM +-{1000 * s['com_m']:g} mm, "
                      f"inertia +-{100 * s['inertia_rel']:g}%, motor constant "
-                     f"+-{100 * s['motor_constant_rel']:g}%; seed {batch['seed']}")
+                     f"+-{100 * s['motor_constant_rel']:g}%; seed {batch['seed']}"
+                     + (f"; from {batch['start_scale']:.3g} of the start (the recoverable margin)"
+                        if batch.get("start_scale", 1.0) != 1.0 else ""))
         for w in batch["worst"]:
             lines.append(f"  #{w['index']}: {w['status']}: {w['message']} "
                          f"(mass {w['mass_kg']:.4g} kg, COM shift "
                          f"{', '.join(f'{1000 * v:.1f}' for v in w['com_shift_m'])} mm)")
+    verdict = report.get("verdict")
+    if verdict is not None:
+        lines.append(f"verdict: {verdict['status'].upper()}: {verdict['message']}")
     lines.append("PASSED" if report["passed"] else f"FAILED: {report.get('message', '')}")
     return "\n".join(lines)
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 import numpy as np
 
-from reedtool.commands.params import model_arguments
+from reedtool.commands.params import model_inputs, one_model_request, validation_options
 from reedtool.errors import ReedtoolError
 
 
@@ -49,10 +49,11 @@ def _finite_or_none(value):
 SHARED_CODES = ("S130", "S131", "I207", "I210")
 
 
-def shared_findings(robot) -> list:
-    from reedtool.checks.runner import Selection, run_checks
+def shared_findings(robot, ignore=()) -> list:
+    from reedtool.checks.runner import Selection, parse_selectors, run_checks
 
-    return run_checks(robot, Selection(select=SHARED_CODES))
+    return run_checks(robot, Selection(select=SHARED_CODES,
+                                       ignore=parse_selectors(ignore, origin="--ignore")))
 
 
 def format_text(model: Path, robot, comparisons, whole, own, findings=()) -> str:
@@ -227,7 +228,7 @@ def print_fix_xacro(comparisons) -> list[str]:
 
 
 @click.command("inertia")
-@model_arguments
+@model_inputs()
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
               show_default=True, help="Output format.")
 @click.option("--fix", is_flag=True,
@@ -236,26 +237,31 @@ def print_fix_xacro(comparisons) -> list[str]:
 @click.option("--force", is_flag=True,
               help="Kept for compatibility: --fix never overwrites a backup (it picks the first "
                    "free NAME.bak, NAME.bak.1, ...).")
-def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
-            model_name: str | None, fmt: str,
-            fix: bool, force: bool) -> int:
+@validation_options
+def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
+            model_name: str | None, launch_file: Path | None, fmt: str,
+            fix: bool, force: bool, ignore: tuple[str, ...] = (),
+            ignore_validation: bool = False) -> int:
     """Compare each link's declared inertia with its geometry's; whole-robot mass properties.
 
-    MODEL is a .urdf or .xacro (xacro arguments as NAME:=VALUE). Geometry is the first
-    collision shape, else the first visual, as a uniform solid with the declared mass.
-    The verdicts are validate's (one function): exit 1 exactly when validate reports an
-    inertia error (I201-I203, I207-I210) or a mesh Gazebo cannot load or must not open
-    (S130, S131); 0 otherwise, 2 on unreadable input.
+    MODEL is a .urdf, .xacro (.urdf.xacro), .gazebo, .sdf or .world file, or a directory,
+    glob or ROS package holding one model; NAME:=VALUE words are its xacro arguments.
+    Geometry is the first collision shape, else the first visual, as a uniform solid with
+    the declared mass. The verdicts are validate's (one function): exit 1 exactly when
+    validate reports an inertia error (I201-I203, I207-I210) or a mesh Gazebo cannot load
+    or must not open (S130, S131); 0 otherwise, 2 on unreadable input. validate's other
+    errors are listed too; a structure error refuses the model (exit 1) unless --ignore
+    CODE or --ignore-validation is given.
     """
+    model, request = one_model_request("inertia", inputs, package_paths, model_name,
+                                       launch_file, ignore)
     from reedtool.assembly.assemble import load_robot_for
-    from reedtool.assembly.models import ModelRequest
+    from reedtool.assembly.validation import judge
     from reedtool.checks.preflight import require_sound_model
-    from reedtool.io.mappings import parse_mappings
     from reedtool.physics.inertia import compare_links, whole_robot
     from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
+    from reedtool.report.validation_note import validation_text, why_line
 
-    request = ModelRequest(mappings=parse_mappings(mappings),
-                           package_paths=list(package_paths), model_name=model_name)
     robot, _ = load_robot_for(model, request, require_sound=False)
     if fix and robot.source_format != "urdf":
         # The blocks --fix writes or prints are URDF <inertial>; SDF spells them differently.
@@ -265,11 +271,29 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
     if not robot.links:
         raise ReedtoolError("the model has no links", file=model)
     require_sound_model(robot)
+    verdict = judge(model, robot, request, "inertia")
+    if verdict.refusing and not ignore_validation:
+        if fmt == "text":
+            click.echo(validation_text(str(model), verdict.refusing, verdict.reported, True,
+                                       "computing it"), nl=False)
+        else:
+            from reedtool.report.json_format import envelope
+
+            click.echo(json.dumps({**envelope("reedtool.inertia/1"), "model": str(model),
+                                   "status": "refused",
+                                   "message": why_line(verdict.refusing, verdict.reported,
+                                                       True, "computing it"),
+                                   "findings": [f.to_dict() for f in verdict.errors]},
+                                  indent=2))
+        return 1
     comparisons = compare_links(robot)
     own = whole_robot(robot)
     whole = whole_robot_pinocchio(robot)
 
-    findings = shared_findings(robot)
+    # The shared model-level findings (any severity), then validate's other errors.
+    findings = shared_findings(robot, request.ignore)
+    shown = {(f.code, f.subject, f.message) for f in findings}
+    findings += [f for f in verdict.errors if (f.code, f.subject, f.message) not in shown]
     render = format_json if fmt == "json" else format_text
     click.echo(render(model, robot, comparisons, whole, own, findings), nl=False)
     failing = [c for c in comparisons if c.failing]
@@ -282,5 +306,5 @@ def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, .
         if is_urdf:
             # What --fix rewrote no longer fails; what it could not fix still does.
             failing = [c for c in failing if c.corrected() is None]
-    errors = [f for f in findings if f.severity == "error"]
+    errors = [f for f in findings if f.severity == "error" and f.code in SHARED_CODES]
     return 1 if failing or errors else 0

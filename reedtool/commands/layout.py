@@ -8,36 +8,51 @@ from pathlib import Path
 
 import click
 
-from reedtool.commands.params import model_arguments
-from reedtool.errors import ReedtoolError
+from reedtool.commands.params import model_inputs, one_model_request, validation_options
 from reedtool.report.layout_picture import output_format
 
 
 @click.command("layout")
-@model_arguments
+@model_inputs()
 @click.option("-o", "--output", "output", type=click.Path(path_type=Path, dir_okay=False),
               required=True, help="Picture to write: .svg or .png.")
 @click.option("--force", is_flag=True, help="Overwrite an existing output file.")
-def command(model: Path, mappings: tuple[str, ...], package_paths: tuple[Path, ...],
-            model_name: str | None, output: Path, force: bool) -> int:
+@validation_options
+def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
+            model_name: str | None, launch_file: Path | None, output: Path, force: bool,
+            ignore: tuple[str, ...] = (), ignore_validation: bool = False) -> int:
     """Draw MODEL's rotor layout seen from above (x forward up the page, y left).
 
+    MODEL is a .urdf, .xacro (.urdf.xacro), .gazebo, .sdf or .world file, or a directory,
+    glob or ROS package holding one model; NAME:=VALUE words are its xacro arguments.
     Numbered rotors (autopilot's 1-based number and the model's index), disc radius, spin
     arrows, body outline, front marker, COM and arm lengths; SVG or PNG by the extension.
+    validate's rules run first: the rotors its findings name are drawn in red and its
+    errors listed; a structure error refuses the model (exit 1) unless --ignore CODE or
+    --ignore-validation is given.
     """
-    from reedtool.io.fileio import check_writable
+    from reedtool.io.fileio import check_writable, note_input
 
     output_format(output)
+    for word in inputs:              # the model is never the picture
+        if Path(word).is_file():
+            note_input(Path(word))
     check_writable(output, force)         # a device, FIFO or existing file is refused here
-    if not model.is_file():
-        raise ReedtoolError("model file not found", file=model,
-                            hint="pass the path of a .urdf, .xacro or .sdf file")
-    from reedtool.assembly.diagram import write_layout
-    from reedtool.io.loader import load_robot
-    from reedtool.io.mappings import parse_mappings
+    model, request = one_model_request("layout", inputs, package_paths, model_name,
+                                       launch_file, ignore)
+    note_input(model)
+    from reedtool.assembly.assemble import load_robot_for
+    from reedtool.assembly.diagram import write_diagram
+    from reedtool.assembly.validation import judge
+    from reedtool.report.validation_note import validation_text
 
-    robot = load_robot(model, parse_mappings(mappings), list(package_paths),
-                       model_name=model_name)
-    write_layout(robot, output, force)
+    robot, _ = load_robot_for(model, request)
+    verdict = judge(model, robot, request, "layout")
+    refused = bool(verdict.refusing) and not ignore_validation
+    click.echo(validation_text(str(model), verdict.refusing, verdict.reported, refused,
+                               "drawing it", ignore_validation), nl=False)
+    if refused:
+        return 1
+    write_diagram(robot, output, verdict.errors, force)
     click.echo(f"wrote {output}")
     return 0

@@ -92,7 +92,7 @@ def new_package(spec, output_dir: Path, *, force: bool = False, mesh_units: str 
     `autopilot` ('px4' | 'ardupilot') adds the autopilot's rotor table, written from the
     same frame as the model (reedtool.scaffold.autopilot).
     """
-    from reedtool.scaffold.autopilot import autopilot_files, prepare_spec
+    from reedtool.scaffold.autopilot import autopilot_context, autopilot_files, prepare_spec
     from reedtool.scaffold.render import RenderedFile, check_target, render_tree, write_tree
 
     spec = prepare_spec(spec, autopilot)
@@ -105,6 +105,7 @@ def new_package(spec, output_dir: Path, *, force: bool = False, mesh_units: str 
     from reedtool.scaffold.package_spec import template_context
 
     context = template_context(spec, body_props)
+    context.update(autopilot_context(spec, autopilot))
     files = render_tree(template_sets(spec.kind, spec.ros, spec.sim), context)
     if mesh_data is not None:
         files.append(RenderedFile(PurePosixPath("meshes", context["mesh_file"]), mesh_data, 0o644))

@@ -17,7 +17,7 @@ import click
 
 from reedtool.assembly.models import ModelRequest, model_arguments, targets_of
 from reedtool.assembly.validation import selection_for
-from reedtool.commands.params import model_option
+from reedtool.commands.params import ignore_option, model_inputs
 from reedtool.errors import ReedtoolError
 
 FORMATS = ("text", "json", "github", "sarif", "junit")
@@ -56,6 +56,16 @@ class RunOptions:
     diagram_per_model: bool = False       # several models: NAME.svg -> NAME-MODEL.svg
     force: bool = False
     notes: list[str] = field(default_factory=list)   # one line per clean cross-check
+
+
+def check_target(target, options: RunOptions) -> tuple[list, list[str]]:
+    """check_model for a Target, and the notes it made (what --jobs hands each worker:
+    a worker's changes to `options` do not come back, its return value does)."""
+    notes, options.notes = options.notes, []
+    try:
+        return check_model(target.name, target.path, options), options.notes
+    finally:
+        options.notes = notes
 
 
 def check_model(name: str, model: Path, options: RunOptions) -> list:
@@ -154,14 +164,7 @@ def print_settings(targets, options: RunOptions) -> int:
 # ------------------------------------------------------------------ the command
 
 @click.command(name="validate")
-@click.argument("inputs", nargs=-1, metavar="[MODEL|DIR|GLOB]... [NAME:=VALUE]...")
-@click.option("--package-path", "package_paths", multiple=True, metavar="DIR",
-              type=click.Path(path_type=Path, file_okay=False),
-              help="Directory to search for ROS packages first (repeatable).")
-@model_option
-@click.option("--launch", "launch_file", type=click.Path(path_type=Path, dir_okay=False),
-              metavar="FILE", help="Read the model and its xacro arguments from a roslaunch "
-                                   "XML or ROS 2 (XML or Python) launch file.")
+@model_inputs(metavar="[MODEL|DIR|GLOB|PACKAGE]... [NAME:=VALUE]...")
 @click.option("--format", "fmt", type=click.Choice(FORMATS), default="text",
               show_default=True, help="Output format.")
 @click.option("--output-file", "-o", "output_file", type=click.Path(path_type=Path,
@@ -171,8 +174,7 @@ def print_settings(targets, options: RunOptions) -> int:
               help="Overwrite an existing --output-file or --diagram file.")
 @click.option("--select", multiple=True, metavar="CODE,...",
               help="Run only rules whose code starts with these prefixes (or these rule names).")
-@click.option("--ignore", multiple=True, metavar="CODE,...",
-              help="Skip rules whose code starts with these prefixes (or these rule names).")
+@ignore_option
 @click.option("--explain", "explain_code", metavar="CODE",
               help="Print the documentation of one rule (code or name) and exit.")
 @click.option("--strict/--no-strict", default=None,
@@ -196,16 +198,20 @@ def print_settings(targets, options: RunOptions) -> int:
               help="ArduPilot .parm file to cross-check (FRAME_CLASS/TYPE, SERVOn_FUNCTION).")
 @click.option("--diagram", type=click.Path(path_type=Path, dir_okay=False), default=None,
               help="Also draw the rotor layout (.svg/.png), rotors named by findings in red.")
+@click.option("--jobs", "-j", type=click.IntRange(min=0), default=1, show_default=True,
+              metavar="N", help="Check the models in N processes (0: one per available "
+                                "CPU); the report keeps the models' order.")
 def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name: str | None,
             launch_file: Path | None, fmt: str, output_file: Path | None, force: bool,
             select: tuple[str, ...], ignore: tuple[str, ...], explain_code: str | None,
             strict: bool | None, exit_zero: bool, show_statistics: bool, show_settings: bool,
             no_color: bool, controller_files: tuple[Path, ...] = (),
             airframe_files: tuple[Path, ...] = (), autopilot_files: tuple[Path, ...] = (),
-            diagram: Path | None = None) -> int:
-    """Check models (.urdf, .xacro, .gazebo, .sdf or .world files, directories, globs, ROS
-    packages, or a changed pyproject.toml/reedtool.toml: the models it configures) for
-    mistakes; NAME:=VALUE words are xacro arguments for every model.
+            diagram: Path | None = None, jobs: int = 1) -> int:
+    """Check models (.urdf, .xacro (.urdf.xacro), .gazebo, .sdf or .world files,
+    directories, globs, ROS packages, or a changed pyproject.toml/reedtool.toml: the
+    models it configures) for mistakes; NAME:=VALUE words are xacro arguments for every
+    model.
 
     Exit 0 when there is no error, 1 when there are errors (or warnings with --strict),
     2 on bad usage or when a model could not be read.
@@ -213,10 +219,15 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
     if explain_code:
         return explain(explain_code)
 
-    from reedtool.io.mappings import MAPPING_SEPARATOR, parse_mappings
+    from reedtool.assembly.models import request_from_words
+    from reedtool.io.packages import shared_crawls
 
-    mappings = parse_mappings([w for w in inputs if MAPPING_SEPARATOR in w])
-    paths = [w for w in inputs if MAPPING_SEPARATOR not in w]
+    context = click.get_current_context(silent=True)
+    if context is not None:       # every model of the run resolves against the same roots
+        context.with_resource(shared_crawls())
+    paths, request = request_from_words(inputs, package_paths=package_paths,
+                                        model_name=model_name, launch_file=launch_file,
+                                        select=select, ignore=ignore)
     from reedtool.io.mappings import suggest_mapping
 
     for word in paths:
@@ -224,20 +235,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
             # `mav_name=foo` names no file: an argument missing its `:`, not a model.
             raise ReedtoolError(f"'{word}' is not a file; xacro arguments are written "
                                 "name:=value", hint=f"did you mean '{suggest_mapping(word)}'?")
-    request = ModelRequest(mappings=mappings, package_paths=list(package_paths),
-                           select=select, ignore=ignore, model_name=model_name,
-                           launch_file=launch_file)
     options = RunOptions(request=request, diagram=diagram, force=force)
-    if launch_file is not None:
-        from reedtool.io.launch import read_launch
-
-        request.launch = read_launch(launch_file, package_paths=list(package_paths))
-        if not paths:
-            if request.launch.model is None:
-                raise ReedtoolError("the launch file's xacro call names no model reedtool "
-                                    "can evaluate", file=launch_file,
-                                    hint="pass the model path before the options")
-            paths = [str(request.launch.model)]
     if not paths:
         raise click.UsageError("missing argument 'MODEL' (or use --explain CODE)")
     if len(paths) == 1 and not Path(paths[0]).exists() and not re.search(r"[*?\[]", paths[0]):
@@ -261,9 +259,16 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
         options.flight_params = load_flight_params(airframe_files, autopilot_files)
     options.diagram_per_model = len(targets) > 1
 
+    import functools
+
+    from reedtool.assembly.parallel import map_models
     from reedtool.config import load_config
     from reedtool.report import ModelResult, render
 
+    checkable = [t for t in targets if t.skipped is None and t.path is not None]
+    checked = dict(zip((id(t) for t in checkable),
+                       map_models(functools.partial(check_target, options=options), checkable,
+                                  jobs)))
     results = []
     failed = False       # a finding at its model's failing severity
     strict_any = False
@@ -276,7 +281,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
                 raise ReedtoolError(target.error, file=target.name)
             results.append(ModelResult(target.name, error=target.error, error_file=target.name))
             continue
-        model_results = check_model(target.name, target.path, options)
+        model_results, notes = checked[id(target)]
+        options.notes += notes
         if target.checked_for is not None:
             for result in model_results:
                 if result.error is not None:

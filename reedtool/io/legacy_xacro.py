@@ -13,6 +13,7 @@ edit at exact offsets, and because legacy files are often not namespace-clean.
 
 from __future__ import annotations
 
+import functools
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -56,7 +57,7 @@ class LegacyTag:
         return f"{self.file}:{self.line}: {what} <{self.tag}> -> write <{self.modern}>"
 
 
-@dataclass
+@dataclass(frozen=True)
 class _Tag:
     name: str
     start: int        # offset of the name in the text
@@ -66,7 +67,22 @@ class _Tag:
     closing: bool
 
 
+# The tags of a file are read for its includes, its macros and its legacy tags, and a
+# repository's models include the same macro files: the tags of recent texts are kept
+# (texts up to 1 MB; the key is the text itself, so an edited file is read again).
+TAG_CACHE_MAX_CHARS = 1024 * 1024
+
+
+@functools.lru_cache(maxsize=64)
+def _cached_tags(text: str) -> tuple[_Tag, ...]:
+    return tuple(_read_tags(text))
+
+
 def _tags(text: str) -> Iterable[_Tag]:
+    return _cached_tags(text) if len(text) <= TAG_CACHE_MAX_CHARS else _read_tags(text)
+
+
+def _read_tags(text: str) -> Iterable[_Tag]:
     line, last = 1, 0
     for match in _TOKEN.finditer(text):
         line += text.count("\n", last, match.start())

@@ -95,9 +95,10 @@ def _top_level(files: list[Path], include_tree: Callable[[Path], Sequence[Path]]
     candidates = [f for f in files if not is_macro_library(f)]
     included: set[Path] = set()
     # Every file's includes count, a library's too: a file that only includes the vehicle
-    # picked by `$(arg mav_name)` reads like a library and still makes it a part.
+    # picked by `$(arg mav_name)` reads like a library and still makes it a part. SDF is
+    # not xacro, and a .urdf is read as written: neither includes a xacro part.
     for file in files:
-        if file.suffix.lower() not in (".sdf", ".world"):
+        if file.suffix.lower() not in (".sdf", ".world", ".urdf"):
             included.update(p.resolve() for p in include_tree(file)[1:])
             for pattern in (include_globs(file) if include_globs else ()):
                 included.update(c.resolve() for c in candidates

@@ -17,6 +17,7 @@ skips hidden directories and honours CATKIN_IGNORE/COLCON_IGNORE/AMENT_IGNORE ma
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import os
 import xml.etree.ElementTree as ET
@@ -149,6 +150,36 @@ def _crawl(root: Path, duplicates: list[tuple[str, Path, Path]] | None = None,
     return found
 
 
+# Within one run (`shared_crawls()`), each search root is crawled once: a repository's
+# models are resolved against the same roots, and a workspace holds hundreds of packages.
+_crawls: dict[tuple[str, str], tuple[dict[str, Path], list]] | None = None
+
+
+@contextlib.contextmanager
+def shared_crawls():
+    """Share package crawls between the resolvers created inside (one command's run)."""
+    global _crawls
+    outer = _crawls
+    if outer is None:
+        _crawls = {}
+    try:
+        yield
+    finally:
+        if outer is None:
+            _crawls = None
+
+
+def _crawl_root(root: SearchRoot) -> tuple[dict[str, Path], list[tuple[str, Path, Path]]]:
+    key = (str(root.path.absolute()), root.origin)
+    if _crawls is not None and key in _crawls:
+        return _crawls[key]
+    duplicates: list[tuple[str, Path, Path]] = []
+    found = _crawl(root.path, duplicates, root.origin)
+    if _crawls is not None:
+        _crawls[key] = (found, duplicates)
+    return found, duplicates
+
+
 class PackageResolver:
     """Resolves package names and mesh/include URIs the way ROS would, without ROS."""
 
@@ -197,8 +228,7 @@ class PackageResolver:
                 return candidate
             return None
         if root not in self._index:
-            duplicates: list[tuple[str, Path, Path]] = []
-            self._index[root] = _crawl(root.path, duplicates, root.origin)
+            self._index[root], duplicates = _crawl_root(root)
             for dup_name, used, ignored in duplicates:
                 self.duplicates.append((dup_name, used, ignored, root.describe()))
                 self.notes.append(f"two packages named '{dup_name}' under {root.describe()}: "

@@ -167,24 +167,55 @@ def full_control_after_failures(B: np.ndarray, thrust_max_N: Sequence[float],
 
     The verdict of `failure_cases` alone (no yaw-less set, no thrust scale), with the
     failed rotor's column removed rather than zeroed: fewer facets, the same zonotope.
-    For searches over many layouts (R350 tries every spin order).
     """
-    B = np.asarray(B, dtype=float)
+    acai = full_control_after_failures_many(np.asarray(B, dtype=float)[None], thrust_max_N,
+                                            weight_N)[0]
+    return [None if np.isnan(a) else float(a) for a in acai]
+
+
+def full_control_after_failures_many(Bs: np.ndarray, thrust_max_N: Sequence[float],
+                                     weight_N: float) -> np.ndarray:
+    """`full_control_after_failures` for a stack of allocations (o, 4, n) of the same
+    rotors (R350 tries every spin order): (o, n) ACAIs, NaN where full control is lost.
+
+    Every failure of every layout is computed at once: the facets without rotor i are
+    the facets of all n rotors whose spanning columns leave out i, and removing column i
+    takes its term out of each facet's half-width and moves the centre by b_i K_i / 2.
+    """
+    Bs = np.asarray(Bs, dtype=float)
     K = np.asarray(thrust_max_N, dtype=float)
+    o, k, n = Bs.shape
     G = np.array([weight_N, 0.0, 0.0, 0.0])
-    tol = ACAI_REL_TOL * (float(np.linalg.norm(B, axis=0) @ K) or 1.0)
-    out: list[float | None] = []
-    for i in range(B.shape[1]):
-        keep = np.arange(B.shape[1]) != i
-        B_i, K_i = B[:, keep], K[keep]
-        if np.linalg.matrix_rank(B_i[:, K_i > 0]) < 4:
-            out.append(None)
-            continue
-        normals = _facet_normals(B_i)
-        centre = B_i @ K_i / 2.0
-        acai = float(np.min(np.abs(normals @ B_i) @ (K_i / 2.0) - np.abs(normals @ (G - centre))))
-        out.append(acai if acai > tol else None)
-    return out
+    if n - 1 < k:
+        return np.full((o, n), np.nan)   # fewer than k working rotors cannot have rank k
+    tol = ACAI_REL_TOL * np.array([float(np.linalg.norm(B, axis=0) @ K) or 1.0 for B in Bs])
+    others = ~np.eye(n, dtype=bool)                       # others[i]: every rotor but i
+    working = Bs[:, None, :, :] * (others & (K > 0))[None, :, None, :]
+    ranks = np.linalg.matrix_rank(working)                # (o, n) rank without rotor i
+    combos = np.array(list(itertools.combinations(range(n), k - 1)), dtype=int)
+    m = len(combos)
+    spans = np.swapaxes(Bs, 1, 2)[:, combos]              # (o, m, k-1, k)
+    minors = np.stack([np.delete(spans, i, axis=3) for i in range(k)], axis=2)
+    normals = np.linalg.det(minors) * (-1.0) ** np.arange(k)     # (o, m, k), unnormalised
+    norms = np.linalg.norm(normals, axis=2)
+    unit = normals / np.where(norms > 0, norms, 1.0)[..., None]
+    column_norm = np.linalg.norm(Bs, axis=1)              # (o, n)
+    # _facet_normals' degeneracy threshold, per failure: the largest remaining column.
+    scale = np.stack([column_norm[:, others[i]].max(axis=1) for i in range(n)],
+                     axis=1) ** (k - 1)                   # (o, n)
+    spans_rotor = np.zeros((m, n), dtype=bool)
+    spans_rotor[np.arange(m)[:, None], combos] = True
+    valid = (~spans_rotor[None]
+             & (norms[:, :, None] > SPAN_REL_TOL * np.maximum(scale, 1e-300)[:, None, :]))
+    P = unit @ Bs                                         # (o, m, n)
+    half_K = K / 2.0
+    half_width = (np.abs(P) @ half_K)[..., None] - np.abs(P) * half_K     # without rotor i
+    centre = Bs @ half_K                                  # (o, k)
+    offset = np.einsum("omk,ok->om", unit, G - centre)[..., None] + P * half_K
+    margin = np.where(valid, half_width - np.abs(offset), np.inf)
+    acai = margin.min(axis=1)                             # (o, n)
+    keep = (ranks >= k) & np.isfinite(acai) & (acai > tol[:, None])
+    return np.where(keep, acai, np.nan)
 
 
 def failure_cases(B: np.ndarray, thrust_max_N: Sequence[float], weight_N: float,

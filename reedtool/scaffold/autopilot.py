@@ -100,3 +100,15 @@ def autopilot_files(spec, autopilot: str | None):
         text = parm_text(spec.name, frame_class, frame_type, outputs)
         path = PurePosixPath("ardupilot", f"{spec.name}.parm")
     return [RenderedFile(path, text.encode("utf-8"), 0o644)]
+
+
+def autopilot_context(spec, autopilot: str | None) -> dict:
+    """Template variables for --autopilot: `ardupilot_block`, the ArduPilotPlugin and its
+    LiftDrag blades for a gz-sim multirotor (scaffold.ardupilot_gz), else empty."""
+    if autopilot == "ardupilot" and spec.kind == "multirotor" and spec.sim == "gz":
+        from reedtool.scaffold.ardupilot_gz import package_block
+
+        positions = spec.frame.rotor_positions_m(spec["arm_length"], spec["rotor_offset_top"])
+        return {"ardupilot_block": package_block(spec, positions, _com_m(spec, positions))}
+    return {"ardupilot_block": ""}
+

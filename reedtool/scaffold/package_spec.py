@@ -506,6 +506,21 @@ def template_context(spec: PackageSpec, body_props=None) -> dict:
     return ctx
 
 
+def scaled_lee_gains(mass_kg: float, inertia_kg_m2) -> dict[str, list[str]]:
+    """RotorS' firefly Lee gains scaled by this vehicle's mass (position, velocity) and
+    principal inertia diagonal (attitude, angular rate), 4 significant digits: the gains
+    the generated controllers (Lee YAML, gz MulticopterVelocityControl) carry."""
+    from reedtool.physics.inertia import fmt_number
+
+    mass_ratio = mass_kg / _FIREFLY_MASS_KG
+    inertia_ratio = [inertia_kg_m2[i][i] / _FIREFLY_INERTIA_KG_M2[i] for i in range(3)]
+    gains = {}
+    for key, values in _FIREFLY_LEE_GAINS.items():
+        ratio = [mass_ratio] * 3 if key in ("position_gain", "velocity_gain") else inertia_ratio
+        gains[key] = [fmt_number(float(f"{v * r:.4g}")) for v, r in zip(values, ratio)]
+    return gains
+
+
 def _multirotor_context(spec: PackageSpec, body_props) -> dict:
     import numpy as np
 
@@ -553,12 +568,7 @@ def _multirotor_context(spec: PackageSpec, body_props) -> dict:
                                     box_inertia(spec["mass_rotor"], blade)))
     total = combine(parts)
     I_total = total.inertia_kg_m2
-    mass_ratio = total.mass_kg / _FIREFLY_MASS_KG
-    inertia_ratio = [I_total[i, i] / _FIREFLY_INERTIA_KG_M2[i] for i in range(3)]
-    gains = {}
-    for key, values in _FIREFLY_LEE_GAINS.items():
-        ratio = [mass_ratio] * 3 if key in ("position_gain", "velocity_gain") else inertia_ratio
-        gains[key] = [fmt_number(float(f"{v * r:.4g}")) for v, r in zip(values, ratio)]
+    gains = scaled_lee_gains(total.mass_kg, I_total)
     return {
         "rotor_count": frame.rotor_count,
         "rotors": rotors,

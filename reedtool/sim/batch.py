@@ -180,6 +180,9 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
     up, down = (per_rotor(f) for f in speed_filter_factors(
         dt, params.time_constant_up_s, params.time_constant_down_s))
     inv_k_hat = per_rotor(1.0 / gains.motor_constant)
+    lead = gains.motor_lead_factors(dt)
+    if lead is not None:
+        lead_up, lead_down = (per_rotor(f) for f in lead)
     omega_max = per_rotor(gains.omega_max_rad_s)
     thrust_max = per_rotor(gains.motor_constant * gains.omega_max_rad_s ** 2)
     i_max = gains.max_integral_m_s
@@ -311,6 +314,14 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
         # The allocation keeps thrusts within [0, k w_max^2], so no clamp.
         mul(thrust_cmd, inv_k_hat, omega_cmd)
         sqrt(omega_cmd, omega_cmd)
+        if lead is not None:
+            # The controller's lead on slow motors (ControllerGains.motor_lead_factors).
+            np.greater(omega_cmd, omega, spinning_up)
+            sub(omega_cmd, omega, omega_cmd)
+            mul(omega_cmd, np.where(spinning_up, lead_up, lead_down), omega_cmd)
+            add(omega_cmd, omega, omega_cmd)
+            np.minimum(omega_cmd, omega_max, out=omega_cmd)
+            np.maximum(omega_cmd, 0.0, out=omega_cmd)
         evaluate_body_wrench()
         advance_body()
         np.greater(omega_cmd, omega, spinning_up)

@@ -59,7 +59,7 @@ OUT_FIELDS = ("reason_value", "end_time_s", "settle_time_s", "max_position_error
 # Layout of the scalar settings vector.
 CFG_FIELDS = ("dt", "g", "m_ctl", "kp", "kd", "ki", "kR", "kw", "a_h", "a_v", "i_max",
               "sp_x", "sp_y", "sp_z", "pos_tol", "cos_tol", "yaw_spin", "div_dist",
-              "div_rate", "duration", "hold", "sat_limit", "n_steps", "every")
+              "div_rate", "duration", "hold", "sat_limit", "n_steps", "every", "lead")
 BLOCK = 64              # vehicles per block of the batch kernel (its state fits in L1)
 # Rows of the block kernel's working memory (see _w_control); rotor rows are sized for
 # up to MAX_BLOCK_ROTORS rotors (vehicles with more fly on the per-vehicle kernel).
@@ -288,11 +288,16 @@ if numba is not None:
         q[3] = nz * inv_q
 
     @njit(cache=True, error_model="numpy")
-    def _advance_motors(T, inv_k, up, down, omega):
-        """motor.speed_command (the allocation keeps T in range) and the first-order lag.
+    def _advance_motors(T, inv_k, up, down, omega, lead, lead_up, lead_down, omega_max):
+        """motor.speed_command (the allocation keeps T in range), the controller's lead
+        on it when `lead` (ControllerGains.motor_lead_factors), and the first-order lag.
         The one place a per-rotor failure (alive mask) would zero the command and speed."""
         for i in range(omega.shape[0]):
             cmd = math.sqrt(T[i] * inv_k[i]) if T[i] > 0.0 else 0.0
+            if lead:
+                om = omega[i]
+                cmd = om + (cmd - om) * (lead_up[i] if cmd > om else lead_down[i])
+                cmd = omega_max[i] if cmd > omega_max[i] else (0.0 if cmd < 0.0 else cmd)
             omega[i] = cmd + (omega[i] - cmd) * (up[i] if cmd > omega[i] else down[i])
 
     @njit(cache=True, error_model="numpy")
@@ -305,7 +310,8 @@ if numba is not None:
         error per sample) when they have rows; returns the samples judged.
         """
         pos_r, axis, tmap, cd, cr, up, down, pinv, thrust_max, inv_k, omega_max, Jc, J0, \
-            J0inv = nominal
+            J0inv, lead_up, lead_down = nominal
+        lead = cfg[24] > 0.0
         dt, g = cfg[0], cfg[1]
         ki_dt, i_max = dt, cfg[10]
         n_steps, every = int(cfg[22]), int(cfg[23])
@@ -423,7 +429,7 @@ if numba is not None:
                     break
             # ---- advance one step: wrench at the current speeds, then the speeds respond
             _body_wrench(pos_r, axis, tmap, cd, cr, k, shift, omega, R, v, w, Fb, Tb)
-            _advance_motors(T, inv_k, up, down, omega)
+            _advance_motors(T, inv_k, up, down, omega, lead, lead_up, lead_down, omega_max)
             _rigid_body(dt, g, mass, J0, J0inv, S, R, Fb, Tb, p, v, q, w)
             for a in range(3):
                 integ[a] += e[a] * ki_dt
@@ -613,15 +619,25 @@ if numba is not None:
                     W[(_TQ + 2) * BLOCK + j] += m2 * Th
 
     @njit(cache=True, error_model="numpy")
-    def _w_motors(W, n, inv_k, up, down):
+    def _w_motors(W, n, inv_k, up, down, lead, lead_up, lead_down, omega_max):
         for i in range(n):
             ik, fu, fd = inv_k[i], up[i], down[i]
+            lu, ld, top = lead_up[i], lead_down[i], omega_max[i]
             t_row, om_row = (_T + i) * BLOCK, (_OM + i) * BLOCK
-            for j in range(BLOCK):
-                Ti = W[t_row + j]
-                cmd = math.sqrt(Ti * ik) if Ti > 0.0 else 0.0
-                om = W[om_row + j]
-                W[om_row + j] = cmd + (om - cmd) * (fu if cmd > om else fd)
+            if lead:
+                for j in range(BLOCK):
+                    Ti = W[t_row + j]
+                    want = math.sqrt(Ti * ik) if Ti > 0.0 else 0.0
+                    om = W[om_row + j]
+                    cmd = om + (want - om) * (lu if want > om else ld)
+                    cmd = top if cmd > top else (0.0 if cmd < 0.0 else cmd)
+                    W[om_row + j] = cmd + (om - cmd) * (fu if cmd > om else fd)
+            else:
+                for j in range(BLOCK):
+                    Ti = W[t_row + j]
+                    cmd = math.sqrt(Ti * ik) if Ti > 0.0 else 0.0
+                    om = W[om_row + j]
+                    W[om_row + j] = cmd + (om - cmd) * (fu if cmd > om else fd)
 
     @njit(cache=True, error_model="numpy")
     def _w_body(W, cfg, J0, J0inv):
@@ -719,7 +735,8 @@ if numba is not None:
         numpy batch parks them, and no longer judged. Lanes past the block's vehicles fly
         copies of its first vehicle and are not reported."""
         pos_r, axis, tmap, cd, cr, up, down, pinv, thrust_max, inv_k, omega_max, Jc, J0, \
-            J0inv = nominal
+            J0inv, lead_up, lead_down = nominal
+        lead = cfg[24] > 0.0
         dt = cfg[0]
         n_steps, every = int(cfg[22]), int(cfg[23])
         sample_dt = every * dt
@@ -876,7 +893,7 @@ if numba is not None:
                     break
             # ---- advance one step: wrench at the current speeds, then the speeds respond
             _w_wrench(W, n, pos_r, axis, tmap, cd, cr)
-            _w_motors(W, n, inv_k, up, down)
+            _w_motors(W, n, inv_k, up, down, lead, lead_up, lead_down, omega_max)
             if _w_body(W, cfg, J0, J0inv) > 0:
                 for j in range(BLOCK):
                     if W[_BIG * BLOCK + j] > 0.0:
@@ -950,7 +967,8 @@ def _settings(params, gains: ControllerGains, config: HoverConfig, setpoint) -> 
         "div_dist": config.divergence_distance_m, "div_rate": config.diverged_rate_rad_s,
         "duration": config.duration_s, "hold": config.hold_s,
         "sat_limit": config.saturation_limit_s, "n_steps": config.n_steps,
-        "every": config.sample_every}
+        "every": config.sample_every,
+        "lead": 1.0 if gains.has_motor_lead else 0.0}
     return np.array([float(values[name]) for name in CFG_FIELDS])
 
 
@@ -974,7 +992,9 @@ def _nominal(params, gains: ControllerGains, config: HoverConfig, plant) -> tupl
             c(gains.allocation_pinv, dtype=float),
             c(gains.motor_constant * gains.omega_max_rad_s ** 2, dtype=float),
             c(1.0 / gains.motor_constant, dtype=float), c(gains.omega_max_rad_s, dtype=float),
-            c(gains.inertia_kg_m2, dtype=float), J0, np.linalg.inv(J0))
+            c(gains.inertia_kg_m2, dtype=float), J0, np.linalg.inv(J0),
+            *(c(f) for f in (gains.motor_lead_factors(config.dt_s)
+                             or (np.ones(params.n_rotors), np.ones(params.n_rotors)))))
 
 
 def _start(params, gains, config: HoverConfig) -> tuple[np.ndarray, tuple, np.ndarray]:

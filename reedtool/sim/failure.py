@@ -78,6 +78,12 @@ class FailureRun:
                 "failure_time_s": self.schedule.time_s, "yaw_controlled": self.yaw_controlled}
 
 
+# The loop gains and limits an autopilot keeps through a rotor failure.
+TUNING = ("kp_1_s2", "kd_1_s", "ki_1_s3", "kR_1_s2", "kw_1_s", "max_horizontal_accel_m_s2",
+          "max_vertical_accel_m_s2", "max_integral_m_s", "attitude_bandwidth_rad_s",
+          "position_bandwidth_rad_s", "limited_by", "angular_authority_rad_s2")
+
+
 def without_rotor(params: VehicleParams, index: int) -> VehicleParams:
     """The vehicle with rotor `index` stopped for good (no thrust, no drag torque)."""
     keep = [i for i in range(params.n_rotors) if i != index]
@@ -87,9 +93,16 @@ def without_rotor(params: VehicleParams, index: int) -> VehicleParams:
 
 
 def reconfigured_gains(params: VehicleParams, design: ControllerDesign,
-                       yaw_controlled: bool) -> ControllerGains:
-    """Gains for the remaining rotors; without yaw the allocation ignores the yaw demand."""
+                       yaw_controlled: bool,
+                       tuned: ControllerGains | None = None) -> ControllerGains:
+    """Gains for the remaining rotors; without yaw the allocation ignores the yaw demand.
+
+    With `tuned` (the intact vehicle's gains) the loops keep that tuning: an autopilot
+    reconfigures its allocation after a failure, it does not retune its loops in flight.
+    """
     gains = ControllerGains.from_params(params, design)
+    if tuned is not None:
+        gains = dataclasses.replace(gains, **{name: getattr(tuned, name) for name in TUNING})
     if yaw_controlled:
         return gains
     pinv3 = np.linalg.pinv(params.allocation()[:3])
@@ -107,7 +120,7 @@ def after_failure(params: VehicleParams, schedule: FailureSchedule, config: Hove
     before_omega = hover_speeds(params, intact_gains)
     keep = [i for i in range(params.n_rotors) if i != schedule.rotor_index]
     after_params = without_rotor(params, schedule.rotor_index)
-    gains = reconfigured_gains(after_params, design, yaw_controlled)
+    gains = reconfigured_gains(after_params, design, yaw_controlled, intact_gains)
     after_config = dataclasses.replace(
         config, duration_s=config.duration_s - schedule.time_s, offset_m=(0.0, 0.0, 0.0),
         roll_rad=0.0, pitch_rad=0.0, yaw_rad=0.0,

@@ -294,10 +294,17 @@ def _source(params, gains, config, setpoint_m) -> str:
     for k, name in enumerate("xyz"):
         adv.append(f"Fb{name} = {_or_zero(_lin(force[k]))}")
         adv.append(f"Tb{name} = {_or_zero(_lin(torque[k]))}")
+    lead = gains.motor_lead_factors(dt_s)
     for i in rotors:
         # motor.speed_command, then the first-order lag (allocation keeps T <= k w_max^2)
         adv.append(f"cmd = sqrt({T[i]} * {L(1.0 / gains.motor_constant[i])}) "
                    f"if {T[i]} > 0.0 else 0.0")
+        if lead is not None and (lead[0][i] != 1.0 or lead[1][i] != 1.0):
+            # the controller's lead on a slow motor (ControllerGains.motor_lead_factors)
+            top = gains.omega_max_rad_s[i]
+            adv.append(f"cmd = {om[i]} + (cmd - {om[i]}) * ({L(lead[0][i])} if cmd > {om[i]} "
+                       f"else {L(lead[1][i])})")
+            adv.append(f"cmd = {L(top)} if cmd > {L(top)} else (0.0 if cmd < 0.0 else cmd)")
         adv.append(f"{om[i]} = cmd + ({om[i]} - cmd) * ({L(up[i])} if cmd > {om[i]} "
                    f"else {L(down[i])})")
     adv += [

@@ -1,0 +1,354 @@
+"""The proof of a port: read it back and compare it with the original, side by side.
+
+Compared (numbers to `REL_TOL` relative, each against the size of its own kind so a zero
+is compared against the vehicle's scale, not against itself):
+- links: every port link's mass, COM and inertia against the original link plus the
+  links folded into it (combined with physics.inertia.combine, the one audited place);
+  every link's pose in the base frame;
+- the joint tree: type, parent (after folding), child, axis, limits;
+- the whole robot: Pinocchio's mass, COM and inertia of each model;
+- rotors, matched by joint: position, thrust axis, spin, number, constants, time
+  constants, drag coefficients, role;
+- the hover trim (thrusts and speeds) and the hover-test verdict, both flown with the
+  same settings;
+- validate's findings: an error or warning code on one side only is a difference.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from reedtool.model import Robot
+
+# Every compared number is written as the shortest text that reads back exactly, and the
+# folded inertials are one parallel-axis sum (a few ulps): 1e-9 leaves six orders of
+# magnitude for round-off and still catches any real change (a digit, a unit, a sign).
+REL_TOL = 1e-9
+
+
+@dataclass
+class Difference:
+    section: str                   # 'links' | 'joints' | 'mass' | 'rotors' | 'trim' | 'hover' | 'findings'
+    subject: str
+    quantity: str
+    original: object
+    port: object
+
+    def to_dict(self) -> dict:
+        return {"section": self.section, "subject": self.subject, "quantity": self.quantity,
+                "original": _jsonable(self.original), "port": _jsonable(self.port)}
+
+    def __str__(self) -> str:
+        return (f"{self.section}: {self.subject} {self.quantity}: original "
+                f"{_show(self.original)}, port {_show(self.port)}")
+
+
+@dataclass
+class Proof:
+    differences: list[Difference] = field(default_factory=list)
+    compared: dict[str, int] = field(default_factory=dict)     # section -> numbers compared
+    side_by_side: dict[str, dict] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def equal(self) -> bool:
+        return not self.differences
+
+    def to_dict(self) -> dict:
+        return {"equal": self.equal, "rel_tol": REL_TOL, "compared": dict(self.compared),
+                "differences": [d.to_dict() for d in self.differences],
+                "side_by_side": _jsonable(self.side_by_side), "notes": list(self.notes)}
+
+
+def _jsonable(value):
+    if isinstance(value, np.ndarray):
+        return _jsonable(value.tolist())
+    if isinstance(value, dict):
+        return {k: _jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, (np.floating, float)):
+        return float(value) if math.isfinite(value) else None
+    if isinstance(value, np.integer):
+        return int(value)
+    return value
+
+
+def _show(value) -> str:
+    if isinstance(value, (np.ndarray, list, tuple)):
+        return "[" + ", ".join(_show(v) for v in np.asarray(value, dtype=object).ravel()) + "]"
+    if isinstance(value, (float, np.floating)):
+        return f"{float(value):.12g}"
+    return str(value)
+
+
+class _Comparer:
+    def __init__(self, proof: Proof):
+        self.proof = proof
+
+    def numbers(self, section: str, subject: str, quantity: str, original, port,
+                scale: float) -> None:
+        a = np.asarray(original, dtype=float)
+        b = np.asarray(port, dtype=float)
+        self.proof.compared[section] = self.proof.compared.get(section, 0) + a.size
+        if a.shape != b.shape:
+            self.differ(section, subject, quantity, original, port)
+            return
+        both_nan = np.isnan(a) & np.isnan(b)
+        size = max(scale, float(np.max(np.abs(np.nan_to_num(a)), initial=0.0)),
+                   float(np.max(np.abs(np.nan_to_num(b)), initial=0.0)))
+        close = both_nan | (np.abs(a - b) <= REL_TOL * size)
+        if not np.all(close):
+            self.differ(section, subject, quantity, original, port)
+
+    def same(self, section: str, subject: str, quantity: str, original, port) -> None:
+        self.proof.compared[section] = self.proof.compared.get(section, 0) + 1
+        if original != port:
+            self.differ(section, subject, quantity, original, port)
+
+    def differ(self, section, subject, quantity, original, port) -> None:
+        self.proof.differences.append(Difference(section, subject, quantity, original, port))
+
+
+# ------------------------------------------------------------------ structure
+
+def _link_props(T_link_part_inertials):
+    """Mass properties in the port link's frame of (T_link_part, Inertial) parts."""
+    from reedtool.physics.inertia import MassProperties, combine
+
+    parts = []
+    for T_link_part, inertial in T_link_part_inertials:
+        T_link_com = T_link_part @ inertial.T_link_com
+        R = T_link_com[:3, :3]
+        parts.append(MassProperties(inertial.mass_kg, T_link_com[:3, 3],
+                                    R @ inertial.inertia_kg_m2 @ R.T))
+    return combine(parts)
+
+
+def compare_structure(original: Robot, port: Robot, fold: dict, proof: Proof) -> None:
+    """Links, poses and joints; `fold` maps every original link to (port link, T)."""
+    from reedtool.physics.kinematics import link_poses
+
+    check = _Comparer(proof)
+    size_m = _size_m(original)
+    poses_original, poses_port = link_poses(original), link_poses(port)
+    expected: dict[str, list] = {}
+    for link in original.links:
+        survivor, T = fold.get(link.name, (None, None))
+        if survivor is not None and link.inertial is not None:
+            expected.setdefault(survivor, []).append((T, link.inertial))
+    port_names = {link.name for link in port.links}
+    for name in sorted(set(expected) | {s for s, _ in fold.values()} | port_names):
+        link = port.link_map.get(name)
+        if link is None:
+            check.differ("links", name, "present", True, False)
+            continue
+        if name not in {s for s, _ in fold.values()}:
+            check.differ("links", name, "present", False, True)
+            continue
+        want = _link_props(expected.get(name, []))
+        got = _link_props([(np.eye(4), link.inertial)] if link.inertial is not None else [])
+        mass_scale = max(want.mass_kg, 1e-12)
+        check.numbers("links", name, "mass_kg", want.mass_kg, got.mass_kg, mass_scale)
+        check.numbers("links", name, "com_m", want.com_m, got.com_m, size_m)
+        inertia_scale = float(np.max(np.abs(want.inertia_kg_m2), initial=0.0)) or 1e-30
+        check.numbers("links", name, "inertia_kg_m2", want.inertia_kg_m2, got.inertia_kg_m2,
+                      inertia_scale)
+        if name in poses_original and name in poses_port:
+            check.numbers("links", name, "T_base_link", poses_original[name], poses_port[name],
+                          max(size_m, 1.0))
+    joints_port = port.joint_map
+    for joint in original.joints:
+        survivor_child = fold.get(joint.child, (None,))[0]
+        if survivor_child != joint.child:
+            continue  # folded: its child link is part of its parent in the port
+        other = joints_port.get(joint.name)
+        if other is None:
+            check.differ("joints", joint.name, "present", True, False)
+            continue
+        check.same("joints", joint.name, "type", joint.type, other.type)
+        check.same("joints", joint.name, "parent", fold.get(joint.parent, (joint.parent,))[0],
+                   other.parent)
+        check.same("joints", joint.name, "child", joint.child, other.child)
+        if joint.type != "fixed":
+            check.numbers("joints", joint.name, "axis", _unit(joint.axis), _unit(other.axis), 1.0)
+        if joint.type in ("revolute", "prismatic") and joint.limit and other.limit:
+            check.numbers("joints", joint.name, "limits",
+                          [joint.limit.lower or 0, joint.limit.upper or 0],
+                          [other.limit.lower or 0, other.limit.upper or 0], 1.0)
+    known = {j.name for j in original.joints}
+    for joint in port.joints:
+        if joint.name not in known:
+            check.differ("joints", joint.name, "present", False, True)
+
+
+def _unit(v) -> np.ndarray:
+    v = np.asarray(v, dtype=float)
+    n = float(np.linalg.norm(v))
+    return v / n if n > 0 else v
+
+
+def _size_m(robot: Robot) -> float:
+    """The vehicle's size: the largest link distance from the base (at least 1 cm)."""
+    from reedtool.physics.kinematics import link_poses
+
+    distances = [float(np.linalg.norm(T[:3, 3])) for T in link_poses(robot).values()]
+    return max([0.01, *[d for d in distances if math.isfinite(d)]])
+
+
+# ------------------------------------------------------------------ vehicle
+
+ROTOR_NUMBERS = ("motor_constant", "moment_constant", "max_rot_velocity_rad_s",
+                 "time_constant_up_s", "time_constant_down_s", "rotor_drag_coefficient",
+                 "rolling_moment_coefficient")
+
+
+def compare_vehicle(original: Robot, port: Robot, proof: Proof, config, fly: bool = True) -> None:
+    """Whole-robot mass properties, rotors, trim and the hover verdict, each side assembled
+    as hover-test assembles it (assembly.vehicle, assembly.flight)."""
+    from reedtool.assembly.vehicle import Vehicle
+
+    check = _Comparer(proof)
+    size_m = _size_m(original)
+    vehicles = {"original": Vehicle.of(original), "port": Vehicle.of(port)}
+    props = {side: v.props for side, v in vehicles.items()}
+    a, b = props["original"], props["port"]
+    check.numbers("mass", "robot", "mass_kg", a.mass_kg, b.mass_kg, a.mass_kg)
+    check.numbers("mass", "robot", "com_m", a.com_m, b.com_m, size_m)
+    check.numbers("mass", "robot", "inertia_kg_m2", a.inertia_kg_m2, b.inertia_kg_m2,
+                  float(np.max(np.abs(a.inertia_kg_m2))))
+    proof.side_by_side["mass"] = {side: {"mass_kg": p.mass_kg, "com_m": p.com_m,
+                                         "inertia_kg_m2": p.inertia_kg_m2}
+                                  for side, p in props.items()}
+
+    rotors = {side: v.every_rotor for side, v in vehicles.items()}
+    by_joint = {r.joint: r for r in rotors["port"]}
+    rows = []
+    for rotor in rotors["original"]:
+        other = by_joint.get(rotor.joint)
+        if other is None:
+            check.differ("rotors", rotor.name, "present", True, False)
+            continue
+        check.numbers("rotors", rotor.name, "position_m", rotor.position_m, other.position_m,
+                      size_m)
+        check.numbers("rotors", rotor.name, "axis", rotor.axis, other.axis, 1.0)
+        check.same("rotors", rotor.name, "direction", rotor.direction, other.direction)
+        check.same("rotors", rotor.name, "turning_sign", rotor.turning_sign, other.turning_sign)
+        check.same("rotors", rotor.name, "number", rotor.motor_number, other.motor_number)
+        check.same("rotors", rotor.name, "role", rotor.role, other.role)
+        check.same("rotors", rotor.name, "reversible", rotor.reversible, other.reversible)
+        values = {key: getattr(other, key) for key in ROTOR_NUMBERS}
+        if other.kind == "ardupilot" and rotor.kind != "ardupilot":
+            values.update(_ardupilot_values(port, other, rotor, proof))
+        for key in ROTOR_NUMBERS:
+            x, y = getattr(rotor, key), values[key]
+            if key in ARDUPILOT_APPROXIMATED and other.kind == "ardupilot" \
+                    and rotor.kind != "ardupilot":
+                continue  # declared in the notes by _ardupilot_values
+            check.numbers("rotors", rotor.name, key, x, y, abs(x) if math.isfinite(x) else 0.0)
+        rows.append({"rotor": rotor.name, "joint": rotor.joint,
+                     "number": [rotor.motor_number, other.motor_number],
+                     "number_from": [rotor.number_tag, other.number_tag],
+                     "direction": [rotor.direction, other.direction],
+                     "position_m": [rotor.position_m, other.position_m],
+                     **{key: [getattr(rotor, key), getattr(other, key)] for key in ROTOR_NUMBERS}})
+    for rotor in rotors["port"]:
+        if rotor.joint not in {r.joint for r in rotors["original"]}:
+            check.differ("rotors", rotor.name, "present", False, True)
+    proof.side_by_side["rotors"] = rows
+
+    trims = {side: v.trim for side, v in vehicles.items()}
+    t0, t1 = trims["original"], trims["port"]
+    check.same("trim", "robot", "feasible", t0.feasible, t1.feasible)
+    if len(t0.thrust_N) == len(t1.thrust_N):
+        weight = a.mass_kg * 9.80665
+        check.numbers("trim", "robot", "thrust_N", t0.thrust_N, t1.thrust_N, weight)
+        check.numbers("trim", "robot", "omega_rad_s", t0.omega_rad_s, t1.omega_rad_s,
+                      float(np.max(np.abs(np.nan_to_num(t0.omega_rad_s)), initial=0.0)))
+    proof.side_by_side["trim"] = {side: {"feasible": t.feasible, "message": t.message,
+                                         "thrust_N": t.thrust_N, "omega_rad_s": t.omega_rad_s}
+                                  for side, t in trims.items()}
+    if fly:
+        flights = {side: _fly(v, config) for side, v in vehicles.items()}
+        check.same("hover", "robot", "verdict", flights["original"]["status"],
+                   flights["port"]["status"])
+        proof.side_by_side["hover"] = flights
+
+
+# What ArduPilot's plugin cannot carry from a motor model: its joint PID has one time
+# constant (the port sets it to timeConstantUp), and LiftDrag blades have no rotor drag or
+# rolling moment coefficient.
+ARDUPILOT_APPROXIMATED = ("time_constant_down_s", "rotor_drag_coefficient",
+                          "rolling_moment_coefficient")
+
+
+def _ardupilot_values(port: Robot, rotor, original, proof: Proof) -> dict:
+    """A port rotor driven by ArduPilotPlugin: its time constant as hover-test derives it
+    from the joint PID, and a note for each number the plugin cannot carry."""
+    from reedtool.physics.rotors import ardupilot_time_constant
+
+    tau = ardupilot_time_constant(port, rotor).time_constant_s
+    proof.notes.append(
+        f"{original.name}: not carried by ArduPilotPlugin: time_constant_down_s "
+        f"{original.time_constant_down_s:g} (its joint PID has one time constant, set from "
+        f"timeConstantUp), rotor_drag_coefficient {original.rotor_drag_coefficient:g} and "
+        f"rolling_moment_coefficient {original.rolling_moment_coefficient:g} (LiftDrag "
+        "blades model neither)")
+    return {"time_constant_up_s": tau, "time_constant_down_s": tau}
+
+
+def _fly(vehicle, config) -> dict:
+    """hover-test's verdict on one vehicle (assembly.flight.hover_test), or why it cannot
+    fly (the same refusal hover-test makes, as a status)."""
+    from reedtool.assembly.flight import hover_test
+    from reedtool.errors import ReedtoolError
+
+    try:
+        report = hover_test(vehicle.robot, config, vehicle=vehicle)
+    except ReedtoolError as exc:
+        return {"status": "not flown", "message": exc.message, "passed": False}
+    sim = report.get("sim") or {}
+    return {"status": report.get("status"), "message": report.get("message"),
+            "passed": report["passed"],
+            **{key: sim[key] for key in ("settle_time_s", "max_position_error_m",
+                                         "final_position_error_m", "max_throttle") if key in sim}}
+
+
+# ------------------------------------------------------------------ findings
+
+def compare_findings(original: list, port: list, proof: Proof, dropped=()) -> None:
+    """Error and warning counts per code of validate on each side.
+
+    `dropped`: (file, line, macro) of source elements the port leaves out. A finding on one of
+    them (R312: the MAVLink interface's rotor count) goes with its element: it is listed
+    in the notes, not counted as hidden.
+    """
+    dropped = set(dropped)
+
+    def keys(findings, side):
+        out: dict[tuple[str, str], list] = {}
+        for f in findings:
+            if f.severity not in ("error", "warning"):
+                continue
+            if side == "original" and (f.file, f.line, f.macro) in dropped:
+                proof.notes.append(f"{f.code} ({f.severity}) on the original is about an "
+                                   f"element the port leaves out ({f.file}:{f.line}): "
+                                   f"{f.message}")
+                continue
+            out.setdefault((f.code, f.severity), []).append(f)
+        return out
+
+    a, b = keys(original, "original"), keys(port, "port")
+    for key in sorted(set(a) | set(b)):
+        n, m = len(a.get(key, [])), len(b.get(key, []))
+        proof.compared["findings"] = proof.compared.get("findings", 0) + 1
+        if n != m:
+            proof.differences.append(Difference("findings", key[0], key[1], n, m))
+    proof.side_by_side["findings"] = {
+        "original": [f"{f.code} {f.severity}: {f.message}" for f in original
+                     if f.severity in ("error", "warning")],
+        "port": [f"{f.code} {f.severity}: {f.message}" for f in port
+                 if f.severity in ("error", "warning")]}

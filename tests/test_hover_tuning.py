@@ -1,0 +1,322 @@
+"""hover-test judges the vehicle, not its own tuning (issue 20).
+
+Fixtures (tests/fixtures/hover_tuning/generate.py, our own files in the shapes of real
+models): a 7.3 kg hexacopter with arms and a pendulum, a racing quad with thrust-to-weight
+10, an aerostack2-style racing quad with 0.15 s motors, a 27 g quad hovering at 85 %,
+and the project's reversible omnidirectional frame.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from cli_helpers import run_cli
+from test_hover_test_cli import multirotor_urdf
+
+from reedtool.sim import ExitStatus, HoverConfig
+from reedtool.sim.controller import ControllerDesign, ControllerGains
+from reedtool.sim.params import VehicleParams, symmetric_multirotor
+from reedtool.sim.run import simulate_hover
+
+FIXTURES = Path(__file__).parent / "fixtures"
+TUNING = FIXTURES / "hover_tuning"
+G = 9.80665
+
+
+def hover_json(*args: str) -> tuple[int, dict]:
+    code, out = run_cli("hover-test", *map(str, args), "--format", "json")
+    return code, json.loads(out)
+
+
+def vehicle(path: Path) -> VehicleParams:
+    """The VehicleParams hover-test flies for a model file."""
+    from reedtool.io.loader import load_robot
+    from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
+    from reedtool.physics.rotors import discover_rotors, lift_rotors
+
+    robot = load_robot(path)
+    props = whole_robot_pinocchio(robot)
+    return VehicleParams.from_rotors(props.mass_kg, props.com_m, props.inertia_kg_m2,
+                                     lift_rotors(discover_rotors(robot)))
+
+
+# ------------------------------------------------------------------ acceptance
+
+@pytest.mark.parametrize("model,status", [
+    (TUNING / "hexa_manipulator.urdf", "flies"),
+    (TUNING / "racing_tw10.urdf", "flies"),
+    (TUNING / "racing_slow_motors.urdf", "flies"),
+    (TUNING / "crazyflie_like.urdf", "marginal"),
+    (FIXTURES / "omni" / "omni_reversible.sdf", "not-flown"),
+])
+def test_real_model_shapes_get_the_verdict_of_the_vehicle(model, status):
+    code, report = hover_json(model)
+    assert (code, report["status"], report["passed"]) == (0, status, True), report["message"]
+    assert report["verdict"]["status"] == status
+    if report["sim"] is not None:
+        assert report["sim"]["status"] != "crashed"
+
+
+def test_the_shapes_are_the_ones_the_issue_describes():
+    code, hexa = hover_json(TUNING / "hexa_manipulator.urdf")
+    assert hexa["model"]["mass_kg"] == pytest.approx(7.3, rel=1e-3)
+    assert hexa["model"]["inertia_kg_m2"][0][0] == pytest.approx(1.85, rel=0.02)
+    assert hexa["trim"]["torque_authority_N_m"]["roll"] == pytest.approx(14.0, rel=0.02)
+    # The fixed 12 rad/s loop would ask J w^2 0.2 = 1.84 * 144 * 0.2 = 53 N*m of it.
+    assert hexa["sim"]["gains"]["limited_by"] == "torque authority"
+    _, racing = hover_json(TUNING / "racing_tw10.urdf")
+    assert racing["trim"]["thrust_to_weight"] == pytest.approx(10.0, rel=1e-9)
+    _, slow = hover_json(TUNING / "racing_slow_motors.urdf")
+    assert slow["trim"]["thrust_to_weight"] == pytest.approx(5.0, abs=0.1)
+    speeds = [r["omega_rad_s"] for r in slow["trim"]["rotors"]]
+    assert min(speeds) == pytest.approx(485, abs=2) and max(speeds) == pytest.approx(529, abs=2)
+    _, cf = hover_json(TUNING / "crazyflie_like.urdf")
+    assert cf["model"]["mass_kg"] == pytest.approx(0.027, rel=1e-9)
+    assert cf["trim"]["hover_throttle_max"] == pytest.approx(0.85, rel=1e-9)
+
+
+def test_marginal_vehicle_reports_what_it_recovers_from():
+    code, report = hover_json(TUNING / "crazyflie_like.urdf")
+    v = report["verdict"]
+    start_tilt = math.degrees(0.2)
+    assert v["start_tilt_deg"] == pytest.approx(start_tilt, rel=1e-12)
+    # bisection on the start's scale: k / 2^6 of it, 0 < k < 64
+    scale = v["recoverable_tilt_deg"] / start_tilt
+    assert 0 < scale < 1 and (scale * 64) == pytest.approx(round(scale * 64), abs=1e-9)
+    assert v["recoverable_offset_m"] == pytest.approx(scale * 0.5, rel=1e-12)
+    assert f"{v['recoverable_tilt_deg']:.3g} deg" in report["message"]
+    # the flight from the full start: settled only with the rotors long at their limits
+    assert report["sim"]["longest_saturation_s"] >= 1.0
+
+
+def test_require_picks_how_strict_ci_is():
+    code, report = hover_json(TUNING / "crazyflie_like.urdf", "--require", "margin:3")
+    assert report["verdict"]["recoverable_tilt_deg"] >= 3 and code == 0
+    code, report = hover_json(TUNING / "crazyflie_like.urdf", "--require", "margin:10")
+    assert (code, report["passed"], report["require"]) == (1, False, "margin:10")
+    # a vehicle that flies its start meets a larger margin only by flying it
+    code, report = hover_json(TUNING / "racing_tw10.urdf", "--require", "margin:15")
+    assert code == 0 and report["verdict"]["recoverable_tilt_deg"] == pytest.approx(15)
+    code, out = run_cli("hover-test", str(TUNING / "racing_tw10.urdf"), "--require", "steady")
+    assert code == 2 and "--require" in out
+
+
+# ------------------------------------------------------------------ the racing quad
+
+def test_slow_motors_diagnosis_rolling_moment_against_a_lag_capped_loop():
+    """Why the aerostack2-style quad sank in a spiral with the throttle under 48 %.
+
+    Its 0.15 s motors capped the attitude loop at (1/3) / 0.1504 = 2.2 rad/s. Against
+    that soft loop the rotors' RotorS rolling moment (-omega c_r u_perp, all four
+    adding) tilts the body by c_r sum(omega) / (J w_a^2) ~ 0.1 rad per m/s about the
+    velocity: thrust pushes across the velocity, the position loop turns into a growing
+    spiral, and the tilted thrust no longer holds the altitude the slow z loop asks for.
+    Without the rolling moment the same soft loop only converges slowly; with the
+    speed command leading the lag the loop keeps its 12 rad/s and flies.
+    """
+    params = vehicle(TUNING / "racing_slow_motors.urdf")
+    bare = ControllerDesign(motor_lead=False)
+    gains = ControllerGains.from_params(params, bare)
+    assert gains.limited_by == "motor lag"
+    assert gains.attitude_bandwidth_rad_s == pytest.approx((1 / 3) / 0.1504, rel=1e-12)
+    run = simulate_hover(params, HoverConfig(), bare)
+    z, xy = run.series["z_m"], np.hypot(run.series["x_m"], run.series["y_m"])
+    assert not run.passed and run.max_throttle < 0.48
+    assert z[-1] < 1.5 and xy[-1] > 1.0 and xy[-1] > xy[200]      # sinking, spiralling out
+    calm = params.with_changes(rolling_moment_coefficient=np.zeros(4))
+    run = simulate_hover(calm, HoverConfig(), bare)
+    z, xy = run.series["z_m"], np.hypot(run.series["x_m"], run.series["y_m"])
+    assert abs(z[-1] - 2.0) < 0.1 and xy[-1] < 0.5                # slow, not diverging
+    led = simulate_hover(params, HoverConfig())
+    assert led.status is ExitStatus.PASSED and led.gains.has_motor_lead
+
+
+def test_motor_lead_steps_the_lag_as_the_led_one():
+    """One step of the plant's lag under the led command equals one step of the lag with
+    the led time constant (the factor's definition, by hand)."""
+    params = vehicle(TUNING / "racing_slow_motors.urdf")
+    gains = ControllerGains.from_params(params)
+    dt = 1e-3
+    up, down = gains.motor_lead_factors(dt)
+    omega, want = 500.0, 530.0
+    cmd = omega + (want - omega) * up[0]
+    plant = cmd + (omega - cmd) * math.exp(-dt / 0.1504)
+    led = want + (omega - want) * math.exp(-dt / gains.motor_lead_time_constant_up_s[0])
+    assert plant == pytest.approx(led, rel=1e-14)
+    assert gains.motor_lead_time_constant_up_s[0] == pytest.approx(1 / 36, rel=1e-12)
+    # the 1.5 kg RotorS quad's motors are fast enough: no lead, bit-identical flights
+    assert not ControllerGains.from_params(symmetric_multirotor(4)).has_motor_lead
+
+
+def test_engines_agree_with_the_motor_lead():
+    from reedtool.sim import compiled
+    from reedtool.sim.batch import simulate_batch
+
+    params = vehicle(TUNING / "racing_slow_motors.urdf")
+    config = HoverConfig(duration_s=2.5, offset_m=(0.3, -0.2, 0.25), roll_rad=0.15)
+    run = simulate_hover(params, config, record=False)
+    batch = simulate_batch(params, config)
+    # the same equations in two engines: rounding only (the sums' order differs)
+    np.testing.assert_allclose(run.final_omega_rad_s, batch.final_omega_rad_s[:, 0], rtol=1e-9)
+    assert run.max_position_error_m == pytest.approx(batch.max_position_error_m[0], rel=1e-9)
+    if compiled.available():
+        fast = simulate_hover(params, config, record=False, engine="numba")
+        np.testing.assert_allclose(fast.final_omega_rad_s, run.final_omega_rad_s, rtol=1e-9)
+        fast_batch = simulate_batch(params, config, engine="numba")
+        np.testing.assert_allclose(fast_batch.final_omega_rad_s, batch.final_omega_rad_s,
+                                   rtol=1e-9)
+        # several vehicles: the compiled block kernel's lead (_w_motors)
+        from reedtool.sim.batch import Spreads, perturbed_plant, sample_perturbations
+
+        plant = perturbed_plant(params, sample_perturbations(3, 4, Spreads(), 1))
+        ref = simulate_batch(params, config, plant)
+        got = simulate_batch(params, config, plant, engine="numba")
+        assert got.status_code.tolist() == ref.status_code.tolist()
+        np.testing.assert_allclose(got.final_omega_rad_s, ref.final_omega_rad_s, rtol=1e-9)
+        np.testing.assert_allclose(got.max_position_error_m, ref.max_position_error_m,
+                                   rtol=1e-9)
+
+
+# ------------------------------------------------------------------ passive joints
+
+def test_passive_joints_are_flown_locked_and_said_so():
+    code, report = hover_json(TUNING / "hexa_manipulator.urdf")
+    locked = {lj["joint"]: lj for lj in report["model"]["locked_joints"]}
+    assert set(locked) == {"arm_left_joint", "arm_right_joint", "pendulum_joint"}
+    # The pendulum: 1 kg at (0, 0, -0.12 - 1.0) in the base frame with its own
+    # diag(0.002, 0.002, 0.0005); about the whole COM c by the parallel-axis theorem.
+    c = np.array(report["model"]["com_m"])
+    d = np.array([0.0, 0.0, -1.12]) - c
+    expected = np.diag([0.002, 0.002, 0.0005]) + 1.0 * (d @ d * np.eye(3) - np.outer(d, d))
+    np.testing.assert_allclose(locked["pendulum_joint"]["inertia_about_com_kg_m2"], expected,
+                               rtol=1e-9, atol=1e-12)
+    assert locked["pendulum_joint"]["mass_kg"] == pytest.approx(1.0)
+    code, out = run_cli("hover-test", str(TUNING / "hexa_manipulator.urdf"))
+    assert "locked rigid: pendulum_joint (revolute, no plugin drives it" in out
+
+
+def test_rotor_joints_are_not_locked():
+    code, report = hover_json(TUNING / "racing_tw10.urdf")
+    assert report["model"]["locked_joints"] == []
+
+
+# ------------------------------------------------------------------ defects still fail
+
+def _variant(tmp_path: Path, xml: str) -> tuple[int, dict]:
+    path = tmp_path / "variant.urdf"
+    path.write_text(xml)
+    return hover_json(path, "--ignore-validation", "--duration", "3")
+
+
+@pytest.mark.parametrize("change,cause", [
+    # one rotor's spin flipped: yaw cannot cancel
+    (lambda xml: xml.replace("<turningDirection>cw</turningDirection>",
+                             "<turningDirection>ccw</turningDirection>", 1), "yaw-unbalanced"),
+    # all rotors one way
+    (lambda xml: xml.replace("<turningDirection>cw</turningDirection>",
+                             "<turningDirection>ccw</turningDirection>"), "yaw-unbalanced"),
+    # weak motors: a tenth of the motor constant, thrust-to-weight 0.17
+    (lambda xml: xml.replace("<motorConstant>8.54858e-06</motorConstant>",
+                             "<motorConstant>8.54858e-07</motorConstant>"),
+     "insufficient-thrust"),
+    # thrust-to-weight below 1: maximum speed 500 rad/s, 1.89 (500 / 838)^2 = 0.67
+    (lambda xml: xml.replace("<maxRotVelocity>838</maxRotVelocity>",
+                             "<maxRotVelocity>500</maxRotVelocity>"), "insufficient-thrust"),
+])
+def test_every_defect_caught_before_still_fails(tmp_path, change, cause):
+    code, report = _variant(tmp_path, change(multirotor_urdf(4)))
+    assert (code, report["status"], report["trim"]["cause"]) == (1, "cannot-hover", cause)
+    assert report["passed"] is False
+    code, report = hover_json(tmp_path / "variant.urdf", "--ignore-validation",
+                              "--require", "hover")
+    assert code == 1                    # no --require lets a vehicle that cannot hover pass
+
+
+def test_a_vehicle_no_controller_can_stabilise_is_said_so():
+    from reedtool.sim.failure import without_rotor
+    from reedtool.sim.verdict import Requirement, stabilisable, uncontrollable
+
+    # The alternating hexacopter without a rotor: the hover wrench lies on the boundary
+    # of what the rotors can make (ACAI 0, Du et al. 2015): no controller holds it.
+    ok, acai = stabilisable(without_rotor(symmetric_multirotor(6), 0))
+    assert not ok and acai == 0.0
+    assert stabilisable(symmetric_multirotor(6))[0]
+    verdict = uncontrollable(acai)
+    assert verdict.verdict.value == "cannot-stabilise"
+    assert not verdict.passes(Requirement()) and verdict.passes(Requirement.parse("hover"))
+
+
+# ------------------------------------------------------------------ batch
+
+def test_batch_flies_the_nominal_tuning_from_the_start_it_recovers_from():
+    code, report = hover_json(TUNING / "crazyflie_like.urdf", "--samples", "6", "--seed", "3")
+    v, batch = report["verdict"], report["batch"]
+    assert batch["start_scale"] == pytest.approx(v["recoverable_tilt_deg"]
+                                                 / v["start_tilt_deg"], rel=1e-12)
+    assert sum(batch["counts"].values()) == 6
+
+
+def test_tuning_is_printed_in_text_and_json():
+    code, out = run_cli("hover-test", str(TUNING / "racing_slow_motors.urdf"))
+    line = next(line for line in out.splitlines() if line.startswith("tuning: "))
+    assert re.search(r"attitude 12 rad/s, position 2 rad/s", line)
+    assert "led to 0.0278 s" in line
+    _, report = hover_json(TUNING / "hexa_manipulator.urdf")
+    gains = report["sim"]["gains"]
+    assert gains["kR_1_s2"] == pytest.approx(gains["attitude_bandwidth_rad_s"] ** 2, rel=1e-12)
+    assert gains["position_bandwidth_rad_s"] == pytest.approx(
+        gains["attitude_bandwidth_rad_s"] / 6, rel=1e-12)
+
+
+def test_a_slowly_tuned_vehicle_gets_the_time_to_settle():
+    from reedtool.sim.verdict import with_time_to_settle
+
+    # w_p = 0.5 rad/s: 1.5 * 5.3 / 0.5 + 1 s hold = 16.9 s -> 17 s
+    gains = ControllerGains.from_params(symmetric_multirotor(4))
+    slow = dataclasses.replace(gains, position_bandwidth_rad_s=0.5)
+    assert with_time_to_settle(HoverConfig(), slow).duration_s == 17.0
+    # the 1.5 kg quad (w_p = 2 rad/s) keeps its 10 s; a longer run asked for stays
+    assert with_time_to_settle(HoverConfig(), gains).duration_s == 10.0
+    assert with_time_to_settle(HoverConfig(duration_s=30.0), slow).duration_s == 30.0
+
+
+def test_margin_from_a_level_start_flies_the_required_tilt():
+    code, report = hover_json(TUNING / "racing_tw10.urdf", "--roll", "0", "--require",
+                              "margin:10", "--duration", "5")
+    assert code == 0 and report["verdict"]["recoverable_tilt_deg"] == pytest.approx(10)
+    assert report["verdict"]["flights"] == 1
+
+
+def test_a_tilt_rotor_frame_is_not_flown_and_says_why():
+    # Two rotors on servos a plugin drives: the fixed-axis allocation has rank 2, but the
+    # frame steers with the tilt. (validate's R305 still errors on it: --ignore-validation.)
+    code, report = hover_json(TUNING / "bicopter_servos.urdf", "--ignore-validation")
+    assert (code, report["status"], report["sim"]) == (0, "not-flown", None)
+    assert report["message"].startswith("tilt-rotor frame (rotor_0 on servo_0_joint, "
+                                         "rotor_1 on servo_1_joint")
+    assert report["trim"]["cause"] == "rank-deficient"
+    # rotors pointing forward at zero tilt: no thrust upward, but the servos tilt them up
+    # (their 2 x 6.0 N at full speed exceed the 9.4 N weight)
+    code, report = hover_json(TUNING / "bicopter_sideways.urdf", "--ignore-validation")
+    assert (code, report["status"], report["trim"]["cause"]) == (0, "not-flown",
+                                                                  "insufficient-thrust")
+    # the same frame with nothing driving the tilt cannot hover: still a failure
+    code, report = hover_json(TUNING / "bicopter_passive.urdf", "--ignore-validation")
+    assert (code, report["status"]) == (1, "cannot-hover")
+
+
+def test_a_tilt_rotor_frame_too_weak_for_its_weight_still_fails(tmp_path):
+    # A tenth of the motor constant: 2 x 0.60 N at full speed for 9.4 N of weight, however
+    # the servos point them.
+    text = (TUNING / "bicopter_sideways.urdf").read_text()
+    weak = tmp_path / "weak.urdf"
+    weak.write_text(text.replace("<motorConstant>8.54858e-06</motorConstant>",
+                                 "<motorConstant>8.54858e-07</motorConstant>"))
+    code, report = hover_json(weak, "--ignore-validation")
+    assert (code, report["status"]) == (1, "cannot-hover")
