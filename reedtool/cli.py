@@ -28,6 +28,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "authority": ("reedtool.commands.authority", "Control authority (ACAI) about hover, intact and after each single rotor failure."),
     "layout": ("reedtool.commands.layout", "Draw the rotor layout seen from above (SVG/PNG): numbers, spin, COM, arms."),
     "migrate": ("reedtool.commands.migrate", "Port a Gazebo Classic multirotor to Gazebo Sim and prove the port flies the same."),
+    "view": ("reedtool.commands.view", "Show a model in 3-D as Gazebo places it (GLB/PNG/HTML): rotor spins, COM, scale."),
 }
 
 

@@ -36,6 +36,7 @@ def test_allocation_has_full_rank(name):
 def test_equal_thrusts_hover_without_torque(name):
     """Yaw moments balance and the rotor centre is the origin (the body's COM)."""
     wrench = allocation(FRAMES[name]) @ np.ones(FRAMES[name].rotor_count)
+    # A sum of n unit axes' z components (1.0): exact; approx's default is a ceiling.
     assert wrench[0] == pytest.approx(FRAMES[name].rotor_count)
     assert np.allclose(wrench[1:], 0.0, atol=1e-12)
 
@@ -69,6 +70,7 @@ def test_quad_x_is_the_seeds_layout():
                 ("front_left", (L, L, 0.026), "cw"), ("back_right", (-L, -L, 0.026), "cw")]
     for slot, position, (suffix, xyz, direction) in zip(frame.rotors, positions, expected):
         assert (slot.suffix, slot.direction) == (suffix, direction)
+        # The same cos/sin formula: a few ulps of 0.3 m (< 1e-16).
         assert np.allclose(position, xyz, atol=1e-15)
 
 
@@ -89,6 +91,7 @@ def test_px4_motor_1_positions(name, first_suffix, bearing):
 @pytest.mark.parametrize("name", [n for n in MULTIROTOR_FRAMES if n != "quad-x"])
 def test_arm_length_is_centre_to_rotor(name):
     positions = FRAMES[name].rotor_positions_m(0.3, 0.0)
+    # hypot of cos/sin products: a few ulps; allclose's default rtol 1e-5 is a ceiling.
     assert np.allclose(np.hypot(positions[:, 0], positions[:, 1]), 0.3)
 
 

@@ -60,6 +60,8 @@ def test_paper_hexacopter_pnpnpn_loses_control_with_any_rotor():
     intact, failed = failure_cases(paper_hexacopter("PNPNPN"), [HEX_K_N] * 6, HEX_WEIGHT_N)
     assert intact.controllable
     G = [HEX_WEIGHT_N, 0, 0, 0]
+    # Facet enumeration (exact up to rounding) vs acai_support, an iterative descent of
+    # 400 subgradient steps: its convergence, not rounding, sets abs 1e-6 (in N and N*m).
     assert intact.acai == pytest.approx(acai_support(paper_hexacopter("PNPNPN"),
                                                      [HEX_K_N] * 6, G), abs=1e-6)
     assert [f.controllable for f in failed] == [False] * 6
@@ -116,6 +118,7 @@ def test_efficiency_is_a_scaled_maximum_thrust():
     eta = np.array([1.0, 0.4, 1.0, 1.0, 0.7, 1.0])
     a = authority(B, [HEX_K_N] * 6, HEX_WEIGHT_N, eta)
     b = authority(B, HEX_K_N * eta, HEX_WEIGHT_N)
+    # eta*K computed before or inside: a few ulps of ~10 N facet distances (~1e-14).
     assert a.acai == pytest.approx(b.acai, abs=1e-12)
 
 
@@ -272,6 +275,8 @@ def test_the_search_verdict_is_the_tables_verdict():
         assert [a is not None for a in fast] == [f.controllable for f in failed]
         for a, f in zip(fast, failed):
             if a is not None:
+                # Two algorithms (failure verdict alone vs the full table) over the same facets:
+                # rounding of 4x4 solves with cond ~1e2-1e4: < 1e-11 relative; 1e-9 holds, abs for 0.
                 assert a == pytest.approx(f.acai, rel=1e-9, abs=1e-12)
 
 

@@ -202,6 +202,7 @@ def test_arm_length_change_is_one_finding_naming_both_lines(tmp_path):
 def test_yaml_values_and_lines():
     table = parse_controller_yaml(YAML, "x3_rotors.yaml")
     assert table.mass_kg == 1.52 and table.locs["mass"].line == line_of(YAML, "\nmass:") + 1
+    # Exact: a decimal read by float() is the same double as the same literal.
     assert table.inertia_kg_m2[2, 2] == 0.056631
     assert [e.direction for e in table.rotors] == [1.0, 1.0, -1.0, -1.0]
     assert table.rotors[2].angle_rad == 1.037088 and table.rotors[2].arm_length_m == 0.255539
@@ -212,6 +213,7 @@ def test_ros2_parameter_file_layout_is_found():
     nested = "lee_position_controller:\n  ros__parameters:\n" + "".join(
         "    " + line + "\n" for line in YAML.splitlines())
     table = parse_controller_yaml(nested, "params.yaml")
+    # Exact: decimal text read by float() equals the literal.
     assert len(table.rotors) == 4 and table.mass_kg == 1.52
     assert table.rotors[0].loc.line == line_of(nested, "'0':")
 

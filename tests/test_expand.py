@@ -96,9 +96,12 @@ def test_seed_rotors_directions_constants_and_declared_count():
                 "front_left": ((A, A), "cw"), "back_right": ((-A, -A), "cw")}
     assert sorted(rotors) == sorted(expected)
     for name, ((x, y), direction) in expected.items():
+        # xacro arithmetic printed with Python's repr and read back: a few ulps of 0.2 m.
         np.testing.assert_allclose(rotors[name].position_m, [x, y, 0.026], atol=1e-12)
         np.testing.assert_allclose(rotors[name].axis, [0, 0, 1], atol=1e-12)
         assert rotors[name].direction == direction
+        # Decimal constants through xacro text: exact (repr round trip); default rel 1e-6 below
+        # is only a ceiling.
         assert rotors[name].motor_constant == pytest.approx(8.54858e-06, rel=1e-12)
         assert rotors[name].moment_constant == pytest.approx(0.016)
         assert rotors[name].max_rot_velocity_rad_s == pytest.approx(838)

@@ -64,6 +64,7 @@ def test_airframe_and_qgc_export_read_the_same_values():
     for name in ("CA_ROTOR_COUNT", "CA_ROTOR1_PY", "CA_ROTOR3_KM", "SIM_GZ_EC_MIN2",
                  "SIM_GZ_EC_FUNC4", "MPC_THR_HOVER"):
         assert script.get(name).value == qgc.get(name).value
+    # Exact: decimal text read by float() equals the literal.
     assert script.get("CA_ROTOR1_PY").value == -0.20
     assert script.get("CA_ROTOR1_PY").loc.line == line_of(AIRFRAME, "CA_ROTOR1_PY")
     assert [r.index for r in script.rotors()] == [0, 1, 2, 3]
@@ -73,6 +74,7 @@ def test_airframe_and_qgc_export_read_the_same_values():
 def test_param_set_beats_set_default_in_any_order():
     params = px4.parse_px4_params("param set MPC_THR_HOVER 0.4\n"
                                   "param set-default MPC_THR_HOVER 0.6\n", "a")
+    # Exact: decimal text read by float() equals the literal (defaults are literals).
     assert params.get("MPC_THR_HOVER").value == 0.4
     assert params.get("MPC_THR_HOVER").loc.line == 1
     # Unset values are PX4's documented defaults (CA_ROTORi_AZ -1: thrust up).
@@ -299,6 +301,7 @@ def test_match_frame_finds_quad_x_numbers():
     found = ardupilot.match_frame([45, -135, -45, 135], [1, 1, -1, -1])
     assert found == (1, 1, [1, 2, 3, 4])
     assert ardupilot.match_frame([45, -135, -45, 135], [1, 1, 1, -1]) is None
+    # Whole-degree differences: exact in binary; isclose's default is a ceiling.
     assert np.isclose(ardupilot.angle_gap_deg(170, -170), 20)
 
 

@@ -60,9 +60,14 @@ def test_seed_quadrotor_hovers_at_the_formula_speed(capsys):
     assert len(k) == 4 and len(set(k)) == 1
     hover = math.sqrt(mass * G / (4 * k[0]))
     trim = [r["omega_rad_s"] for r in report["trim"]["rotors"]]
+    # Symmetric quad, pseudo-inverse trim vs the closed form: O(10) ulps (see test_trim);
+    # the JSON keeps repr precision.
     np.testing.assert_allclose(trim, hover, rtol=1e-9)
     final = list(report["sim"]["final_omega_rad_s"].values())
+    # After the flight settles: measured ~1e-9 of the hover speed (test_sim's steady
+    # hover test); 1e-6 is a margin, a wrong k or mass is 1e-2.
     np.testing.assert_allclose(final, hover, rtol=1e-6)
+    # Products in another order: a few ulps; 1e-9 is margin.
     assert report["trim"]["thrust_to_weight"] == pytest.approx(
         4 * k[0] * 838.0 ** 2 / (mass * G), rel=1e-9)
 
@@ -176,10 +181,13 @@ def test_symmetric_frames_trim_and_hover_at_the_formula_speed(capsys, tmp_path, 
     code, report = run_json(capsys, str(path))
     assert code == 0, report["message"]
     mass, k = urdf_mass_and_motor_constants(xml)
+    # Decimal masses summed: a few roundings of ~1.3 kg; default rel 1e-6 is a ceiling.
     assert mass == pytest.approx(1.2 + 0.015 + n * 0.02)
     hover = math.sqrt(mass * G / (n * k[0]))
+    # Pseudo-inverse trim vs closed form: O(10) ulps; 1e-9 allows any LAPACK.
     np.testing.assert_allclose([r["omega_rad_s"] for r in report["trim"]["rotors"]], hover,
                                rtol=1e-9)
+    # Settled flight: ~1e-9 measured (test_sim); 1e-6 is a margin.
     np.testing.assert_allclose(list(report["sim"]["final_omega_rad_s"].values()), hover,
                                rtol=1e-6)
 

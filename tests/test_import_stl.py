@@ -57,6 +57,7 @@ def test_l_bracket_in_mm_ned_lands_in_metres_flu(package, capsys):
     com = (9312.5 / 425 / 1000, -0.020, -2937.5 / 425 / 1000)
     snippet = out[out.index("<!--"):]
     origin = snippet.split('<origin xyz="')[3].split('"')[0]
+    # The snippet prints the COM with ~10 significant digits: 1e-8 holds that rounding.
     np.testing.assert_allclose([float(v) for v in origin.split()], com, rtol=1e-8)
     assert 'filename="package://reed_gazebo/meshes/bracket.stl"' in snippet
     assert '<mass value="0.05"/>' in snippet

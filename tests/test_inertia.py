@@ -71,6 +71,8 @@ def test_meshed_box_matches_analytic_and_trimesh():
     props = solid_mass_properties(mesh.triangles, density_kg_m3=800.0)
     assert props.volume_m3 == pytest.approx(0.006, rel=1e-12)
     assert props.mass_kg == pytest.approx(4.8, rel=1e-12)
+    # Exact-in-decimal box far from the origin: the divergence-theorem sums cancel
+    # ~|12 m|/0.1 m, losing 2-3 digits of 16: ~1e-13 m; 1e-12 m holds, 1e-6 is a bug.
     np.testing.assert_allclose(props.com_m, (12.0, -7.0, 3.0), atol=1e-12)
     assert rel_close(props.inertia_kg_m2, box_inertia(4.8, (0.3, 0.2, 0.1)), 1e-3)
     # and agrees with trimesh's own integration of the same triangles
@@ -84,6 +86,7 @@ def test_finely_meshed_cylinder_matches_analytic():
     unit = solid_mass_properties(mesh.triangles)
     props = unit.scaled_to_mass(1.3)
     assert rel_close(props.inertia_kg_m2, cylinder_inertia(1.3, 0.05, 0.2, "z"), 1e-3)
+    # 256-gon vs circle: area ratio sin(2pi/256)*256/(2pi) = 1 - 1.0e-4; 1e-3 holds it.
     assert unit.volume_m3 == pytest.approx(np.pi * 0.05**2 * 0.2, rel=1e-3)
 
 
@@ -98,8 +101,12 @@ def test_l_bracket_equals_two_analytic_boxes_combined():
         parts.append(MassProperties(m, np.array(centre), box_inertia(m, size)))
     expected = combine(parts)
     props = solid_mass_properties(triangles, density)
+    # The bracket's coordinates are whole mm (exact in the STL's float32), divided by
+    # 1000: the volume is exact up to the sums' rounding (~1e-15); 1e-9 is margin.
     assert props.volume_m3 == pytest.approx(17000e-9, rel=1e-9)
     assert props.mass_kg == pytest.approx(expected.mass_kg, rel=1e-9)
+    # COM components down to 0.0025 m: rtol 1e-7 is 2.5e-10 m, well above the
+    # sums' rounding (~1e-16 m) and far below a misplaced part (mm).
     np.testing.assert_allclose(props.com_m, expected.com_m, rtol=1e-7)
     assert rel_close(props.inertia_kg_m2, expected.inertia_kg_m2, 1e-6)
     assert expected.inertia_kg_m2[0, 2] != 0.0                  # asymmetric: a real product term
@@ -113,6 +120,8 @@ def test_rotating_a_mesh_rotates_its_tensor(roll, pitch, yaw, shift):
     R = rpy_to_matrix((roll, pitch, yaw))
     base = solid_mass_properties(triangles, 1000.0)
     moved = solid_mass_properties(triangles @ R.T + np.array(shift), 1000.0)
+    # Rotation and shift change only rounding: coordinates up to 0.5 m + 0.06 m, sums
+    # over ~40 triangles cancel to ~1e-14 relative; 1e-9 holds any CPU's order of sums.
     assert moved.mass_kg == pytest.approx(base.mass_kg, rel=1e-9)
     np.testing.assert_allclose(moved.com_m, R @ base.com_m + shift, atol=1e-12)
     assert rel_close(moved.inertia_kg_m2, R @ base.inertia_kg_m2 @ R.T, 1e-8)
@@ -124,6 +133,7 @@ def test_open_mesh_uses_its_convex_hull():
     props = mesh_mass_properties(open_)
     assert props.from_hull
     hull_area_m2 = (60 * 5 + 5 * 25 + 0.5 * 55 * 25) * 1e-6
+    # Whole-mm hull of whole-mm points: rounding only (~1e-15); 1e-9 is margin.
     assert props.volume_m3 == pytest.approx(hull_area_m2 * 0.040, rel=1e-9)
     assert not mesh_mass_properties(closed).from_hull
 
@@ -131,6 +141,7 @@ def test_open_mesh_uses_its_convex_hull():
 def test_inside_out_mesh_is_flipped_not_negative():
     triangles = read_stl(EXAMPLES / "l_bracket_mm_ned.stl").triangles / 1000.0
     flipped = mesh_mass_properties(triangles[:, ::-1])
+    # As above: the same triangles reversed, rounding only.
     assert flipped.volume_m3 == pytest.approx(17000e-9, rel=1e-9)
     assert not flipped.from_hull
 
@@ -142,6 +153,7 @@ def test_transformed_moves_com_and_rotates_tensor():
     props = MassProperties(2.0, np.array([0.1, 0.0, 0.0]), I_b)
     T_a_b = make_T(rpy_to_matrix((0, 0, np.pi / 2)), (1.0, 2.0, 3.0))
     moved = props.transformed(T_a_b)
+    # cos(pi/2) = 6e-17 times 0.1 m: the COM is off by < 1e-17 m; 1e-15 holds it.
     np.testing.assert_allclose(moved.com_m, (1.0, 2.1, 3.0), atol=1e-15)
     # a 90 deg yaw swaps the x and y moments
     np.testing.assert_allclose(moved.inertia_kg_m2, np.diag([2.0, 1.0, 3.0]), atol=1e-15)
@@ -152,7 +164,9 @@ def test_combine_two_point_masses_by_hand():
     a = MassProperties(1.0, np.array([1.0, 0, 0]), np.zeros((3, 3)))
     b = MassProperties(1.0, np.array([-1.0, 0, 0]), np.zeros((3, 3)))
     total = combine([a, b])
+    # Exact: 1.0 + 1.0.
     assert total.mass_kg == 2.0
+    # Exact: +1 and -1 m at 1 kg sum to 0; Steiner terms of 0/1 values are exact.
     np.testing.assert_allclose(total.com_m, 0.0)
     np.testing.assert_allclose(total.inertia_kg_m2, np.diag([0.0, 2.0, 2.0]))
     assert MassProperties.combine([a, b]).mass_kg == 2.0
@@ -168,6 +182,7 @@ def test_combine_two_half_boxes_is_the_whole_box():
 
 def test_combine_nothing_is_massless():
     empty = combine([])
+    # Exact: nothing summed is 0.0.
     assert empty.mass_kg == 0.0 and empty.volume_m3 is None
 
 
@@ -176,6 +191,7 @@ def test_combine_nothing_is_massless():
 def test_geometry_primitives_in_the_link_frame():
     T = make_T(rpy_to_matrix((np.pi / 2, 0, 0)), (0.1, 0.2, 0.3))
     cyl = geometry_mass_properties(Cylinder(0.025, 0.02), T, 0.1)
+    # Exact: the COM of a centred primitive is the frame's translation, copied.
     np.testing.assert_allclose(cyl.com_m, (0.1, 0.2, 0.3))
     # roll 90 deg turns the cylinder's z axis onto y
     assert rel_close(cyl.inertia_kg_m2, cylinder_inertia(0.1, 0.025, 0.02, "y"), 1e-12)
@@ -183,6 +199,7 @@ def test_geometry_primitives_in_the_link_frame():
     assert rel_close(box.inertia_kg_m2, box_inertia(2.0, (0.3, 0.2, 0.1)), 1e-12)
     sph = geometry_mass_properties(Sphere(0.1), np.eye(4), 1.0)
     assert rel_close(sph.inertia_kg_m2, sphere_inertia(1.0, 0.1), 1e-12)
+    # One closed form each way: a few ulps; approx's default rel 1e-6 is a ceiling.
     assert sph.volume_m3 == pytest.approx(4 / 3 * np.pi * 0.001)
 
 
@@ -191,8 +208,10 @@ def test_geometry_mesh_is_scaled_and_given_the_mass():
     mesh = Mesh(uri="package://x/l.stl", path=path, scale=np.array([0.001, 0.001, 0.001]))
     props = geometry_mass_properties(mesh, np.eye(4), 0.05)
     reference = solid_mass_properties(read_stl(path).triangles / 1000.0).scaled_to_mass(0.05)
+    # Exact: the declared mass is passed through, not computed.
     assert props.mass_kg == 0.05
     assert rel_close(props.inertia_kg_m2, reference.inertia_kg_m2, 1e-9)
+    # Whole-mm triangles scaled by 0.001: rounding only; default rel 1e-6 is a ceiling.
     assert props.volume_m3 == pytest.approx(17000e-9)
 
 
@@ -208,7 +227,9 @@ def test_declared_properties_rotate_the_tensor_into_link_axes():
     R = rpy_to_matrix((0, 0, np.pi / 2))
     inertial = Inertial(2.0, make_T(R, (0.1, 0, 0)), np.diag([1.0, 2.0, 3.0]), LOC)
     props = declared_mass_properties(Link("l", LOC, inertial=inertial))
+    # R I R^T with cos(pi/2) = 6e-17: off-diagonal terms ~6e-17 * 3 kg m^2 < 1e-15.
     np.testing.assert_allclose(props.inertia_kg_m2, np.diag([2.0, 1.0, 3.0]), atol=1e-15)
+    # Exact: the inertial origin's translation, copied.
     np.testing.assert_allclose(props.com_m, (0.1, 0, 0))
     assert declared_mass_properties(Link("empty", LOC)) is None
 
@@ -231,8 +252,12 @@ def test_inertial_xml_is_parsed_back_by_yourdfpy():
     xml = f'<robot name="r"><link name="a">{inertial_xml(props)}</link></robot>'
     urdf = yourdfpy.URDF.load(io.BytesIO(xml.encode()))
     inertial = urdf.robot.links[0].inertial
+    # Exact: written with 10 digits and parsed: 0.05 round-trips.
     assert inertial.mass == 0.05
+    # Written with repr-precision numbers and parsed back by another library:
+    # at most one rounding each way (1e-16); 1e-9 is margin.
     np.testing.assert_allclose(inertial.inertia, props.inertia_kg_m2, rtol=1e-9)
+    # Written and parsed back: the default rtol 1e-7 is a ceiling over a 1-ulp round trip.
     np.testing.assert_allclose(inertial.origin[:3, 3], props.com_m)
 
 
@@ -280,6 +305,7 @@ def test_whole_robot_equals_pinocchio_on_multilink_fixture():
     robot = load_robot(FIXTURES / "inertia" / "multilink.urdf")
     own = whole_robot(robot)
     pin = whole_robot_pinocchio(robot)
+    # Four additions of decimal masses: 3 roundings of ~2 kg values, < 1e-15 kg.
     assert own.mass_kg == pytest.approx(1.5 + 0.35 + 0.07 + 0.2, abs=1e-15)
     assert abs(own.mass_kg - pin.mass_kg) <= 1e-12
     assert np.max(np.abs(own.com_m - pin.com_m)) <= 1e-12
@@ -300,7 +326,11 @@ def test_whole_robot_with_a_massless_world_root_matches_pinocchio():
     robot = parse_urdf(xml, Path("w.urdf"))
     own, pin = whole_robot(robot), whole_robot_pinocchio(robot)
     assert robot.base_link == "world"
+    # Pinocchio's and our sums of the same products in other orders: a few ulps of
+    # metre-sized values (~1e-15); 1e-12 allows any CPU's summation order.
     np.testing.assert_allclose(own.com_m, pin.com_m, atol=1e-12)
     expected_com = np.array([1, 2, 3]) + rpy_to_matrix((0.3, 0, 0)) @ [0, 0.1, 0]
+    # Hand formula vs the sum over links: a few ulps of 3 m (~1e-15).
     np.testing.assert_allclose(own.com_m, expected_com, atol=1e-12)
+    # Exact: one link's mass, no sum.
     assert pin.mass_kg == 2.0

@@ -33,18 +33,25 @@ def test_seed_wheel_declared_one_against_the_cylinders_1e_5(capsys):
     wheel = next(link for link in doc["links"] if link["link"] == "left_front_wheel")
     assert wheel["verdict"] == "way-off"
     assert wheel["geometry"] == "collision cylinder"
+    # Exact: the declared numbers, read and written through JSON (repr round trip).
     np.testing.assert_array_equal(np.diag(wheel["declared"]["inertia_kg_m2"]), [1.0, 1.0, 1.0])
     derived = np.array(wheel["derived"]["inertia_kg_m2"])
     # rpy (0, 1.57075, 1.57075) turns the cylinder axis onto the link's y axis
     np.testing.assert_allclose(np.diag(derived), [WHEEL_TRANSVERSE, WHEEL_AXIAL, WHEEL_TRANSVERSE],
                                rtol=1e-6)
+    # Eigenvalues of R I R^T equal I's: eigvalsh is backward stable, ~cond * ulps of
+    # the largest moment; the moments differ by < 10x, so ~1e-15; 1e-12 holds.
     np.testing.assert_allclose(np.linalg.eigvalsh(derived),
                                sorted([WHEEL_TRANSVERSE, WHEEL_TRANSVERSE, WHEEL_AXIAL]), rtol=1e-12)
+    # A centred cylinder: the offset is a difference of equal copies, exactly 0 up to
+    # an ulp of its 0.08 m position (1.4e-17).
     assert wheel["com_offset_m"] == pytest.approx(0.0, abs=1e-15)
     assert wheel["line"] == 24
     assert [link["verdict"] for link in doc["links"]] == ["way-off", "way-off"]
     whole = doc["whole_robot"]
+    # Pinocchio's sum of decimal masses: a few ulps (~1e-16 kg).
     assert whole["source"] == "pinocchio" and whole["mass_kg"] == pytest.approx(1.1, abs=1e-12)
+    # Two implementations of the same sums: a few ulps of ~0.1 m values.
     np.testing.assert_allclose(whole["com_m"], doc["own_sum"]["com_m"], atol=1e-12)
 
 
@@ -71,9 +78,13 @@ def test_fix_rewrites_a_urdf_with_backup(tmp_path, capsys):
     urdf = yourdfpy.URDF.load(io.BytesIO(model.read_bytes()), load_meshes=False)
     links = {link.name: link for link in urdf.robot.links}
     wheel = links["left_front_wheel"].inertial
+    # Exact: the declared decimal, written back unchanged and parsed.
     assert wheel.mass == 0.1
+    # Written with 10 significant digits (fmt_number: 5e-10 relative) and parsed by
+    # yourdfpy, then eigvalsh: 1e-8 holds that rounding.
     np.testing.assert_allclose(np.linalg.eigvalsh(wheel.inertia),
                                sorted([WHEEL_TRANSVERSE, WHEEL_TRANSVERSE, WHEEL_AXIAL]), rtol=1e-8)
+    # Exact decimals written and parsed: the default rtol 1e-7 is only a ceiling.
     np.testing.assert_allclose(wheel.origin[:3, 3], [0.08, 0.08, 0.025])
     base = links["base_link"].inertial
     np.testing.assert_allclose(np.diag(base.inertia),
@@ -156,8 +167,11 @@ def test_imported_mesh_snippet_is_consistent_with_inertia_check(tmp_path, capsys
     # the collision hull is not the L, so the tensors differ, but within the "ok" band
     assert link["geometry"] == "collision mesh l_bracket_mm_ned_collision.stl"
     assert link["verdict"] in ("ok", "com-off", "differs")
+    # Exact: the declared mass is carried through JSON (repr round trip).
     assert link["derived"]["mass_kg"] == 0.05
     hull_volume_m3 = (60 * 5 + 5 * 25 + 0.5 * 55 * 25) * 40 * 1e-9
+    # Hull of whole-mm points from a float32 STL, scaled: rounding only (~1e-15);
+    # 1e-6 allows qhull's own tolerance on which points are hull vertices.
     assert link["derived"]["volume_m3"] == pytest.approx(hull_volume_m3, rel=1e-6)
 
 

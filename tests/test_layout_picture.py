@@ -88,9 +88,14 @@ def test_every_rotor_drawn_where_the_model_puts_it(pictures, frame):
         number = slot.motor_number + 1            # PX4's MAIN number
         rotor = rotors[slot.motor_number]
         centre = picture.centre(f"rotor-{number}")
+        # Read back from the SVG's path coordinates, printed with 6 decimals of points
+        # (~1e-6 pt) and mapped by the anchor (1 pt ~ 1e-3 m here): 2e-3 m holds it; a
+        # misplaced rotor is >= 0.1 m off.
         np.testing.assert_allclose(centre, rotor.position_m[:2], atol=2e-3)
         # the airframe's bearing: clockwise from the nose seen from above
         bearing = math.degrees(math.atan2(-centre[1], centre[0]))
+        # The 2e-3 m centre bound above at the generated arms' >= 0.18 m: 0.011 rad =
+        # 0.64 deg; 1 deg holds it, a wrong slot is >= 30 deg off.
         assert (bearing - slot.bearing_deg + 180.0) % 360.0 - 180.0 == pytest.approx(0, abs=1)
         text, at = picture.text_at(f"label-{number}")
         assert text == str(number)

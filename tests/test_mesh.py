@@ -40,6 +40,7 @@ def test_binary_ascii_and_solid_header_variants_read_the_same_triangles():
     assert (binary.format, solid_header.format, ascii_.format) == ("binary", "binary", "ascii")
     assert (FIXTURES / "l_bracket_solid_header.stl").read_bytes()[:5] == b"solid"
     assert corners(binary.triangles) == L_CORNERS_MM
+    # Exact: the same float32 bytes read twice.
     np.testing.assert_array_equal(binary.triangles, solid_header.triangles)
     np.testing.assert_allclose(binary.triangles, ascii_.triangles, atol=1e-9)
     # trimesh, an independent reader, sees the same triangles
@@ -52,6 +53,7 @@ def test_binary_header_starting_with_solid_and_containing_facet_is_still_binary(
     data = binary_stl(tri, header=b"solid facet normal vertex endsolid")
     stl = parse_stl(data)
     assert stl.format == "binary"
+    # Exact: float32 values written and read back bit for bit.
     np.testing.assert_array_equal(stl.triangles, tri)
 
 
@@ -132,6 +134,7 @@ def test_unit_guess_and_its_reason():
     choice = guess_units(np.array([60.0, 40.0, 30.0]))
     assert choice.guessed and "60" in choice.reason and "mm" in choice.reason
     given = choose_units("in", np.ones(3))
+    # Exact: a table constant, not computed.
     assert given.metres_per_unit == 0.0254 and not given.guessed
     with pytest.raises(ReedtoolError, match="unknown unit"):
         choose_units("furlong", np.ones(3))
@@ -188,5 +191,6 @@ def test_merge_vertices_falls_back_when_hashes_collide(monkeypatch):
     monkeypatch.setattr(mesh_module, "_vertex_hash", lambda wide: np.zeros(len(wide), np.uint64))
     vertices, faces = mesh_module.merge_vertices(sphere.triangles)
     assert len(vertices) == len(sphere.vertices)
+    # Exact: indexing copies the vertices, no arithmetic.
     np.testing.assert_array_equal(vertices[faces], sphere.triangles)
     assert topology(sphere.triangles) == expected

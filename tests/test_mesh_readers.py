@@ -31,10 +31,14 @@ def test_dae_unit_and_node_transforms():
     dae = parse_dae(dae_text(box_triangles((1530, 200, 30)), meter=0.001,
                              node_xml="<translate>10 0 0</translate>"
                                       "<rotate>0 0 1 90</rotate>").encode())
+    # Exact: the <unit meter> attribute read by float().
     assert dae.unit_declared and dae.metres_per_unit == 0.001
+    # mm * 0.001 and a 90 deg turn (cos = 6e-17): a few ulps; default rel 1e-6 is a ceiling.
     assert extent(dae.triangles_m) == pytest.approx([0.2, 1.53, 0.03])
     centre = dae.triangles_m.reshape(-1, 3).mean(axis=0)
+    # Mean of 36 points of ~0.8 m: rounding ~1e-16 each; 1e-12 m holds.
     assert centre == pytest.approx([0.01, 0, 0], abs=1e-12)
+    # Divergence-theorem sum of 12 triangles: rounding only; default rel 1e-6 is a ceiling.
     assert mesh_mass_properties(dae.triangles_m).volume_m3 == pytest.approx(1.53 * 0.2 * 0.03)
 
 
@@ -43,6 +47,7 @@ def test_dae_matrix_scale_and_up_axis():
     dae = parse_dae(dae_text(box_triangles((1, 2, 3)), meter=None, up_axis="Y_UP",
                              node_xml=f"<matrix>{M}</matrix><scale>1 1 0.5</scale>",
                              polylist=True).encode())
+    # Exact: the default.
     assert not dae.unit_declared and dae.metres_per_unit == 1.0
     # x doubled, z halved; then Y up -> Z up swaps the y and z extents.
     assert extent(dae.triangles) == pytest.approx([2.0, 1.5, 2.0])
@@ -55,6 +60,8 @@ def test_dae_bounds_agree_with_trimesh(tmp_path):
                      node_xml="<translate>0.5 0 0</translate><rotate>1 0 0 30</rotate>")
     ours = read_mesh(path).triangles.reshape(-1, 3)
     theirs = trimesh.load(str(path), force="mesh").vertices
+    # Another reader applies the node transforms in its own order (and may hold
+    # float32): 6e-8 of ~3.5 m = 2e-7 m; abs 1e-6 m holds, a missed transform is 0.1 m.
     assert ours.min(axis=0) == pytest.approx(theirs.min(axis=0), abs=1e-6)
     assert ours.max(axis=0) == pytest.approx(theirs.max(axis=0), abs=1e-6)
 
@@ -64,6 +71,7 @@ def test_obj_faces_and_agreement_with_trimesh(tmp_path):
     path = write_obj(tmp_path / "part.obj", box_triangles((1, 2, 3)))
     triangles = read_mesh(path).triangles
     assert triangles.shape == (12, 3, 3)
+    # Whole-number box: exact up to rounding; default rel 1e-6 is a ceiling.
     assert mesh_mass_properties(triangles).volume_m3 == pytest.approx(6.0)
     theirs = trimesh.load(str(path), force="mesh", process=False)
     assert float(theirs.volume) == pytest.approx(6.0)
@@ -129,11 +137,13 @@ def test_import_honours_the_dae_unit_and_guesses_only_without_one(tmp_path):
     declared = import_mesh(write_dae(tmp_path / "cm.dae", box_triangles((300, 200, 100)),
                                      meter=0.01), units="auto")
     assert (declared.units.unit, declared.units.guessed) == ("cm", False)
+    # Unit scaling of whole numbers by 0.01: a few ulps; default rel 1e-6 is a ceiling.
     assert declared.size_m == pytest.approx([3.0, 2.0, 1.0])
     assert declared.mass.volume_m3 == pytest.approx(6.0)
     unitless = import_mesh(write_obj(tmp_path / "mm.obj", box_triangles((300, 200, 100))),
                            units="auto")
     assert (unitless.units.unit, unitless.units.guessed) == ("mm", True)
+    # Whole mm times 0.001: one rounding; default rel 1e-6 is a ceiling.
     assert unitless.size_m == pytest.approx([0.3, 0.2, 0.1])
 
 
@@ -152,4 +162,5 @@ def test_dae_nested_nodes_and_library_node_instances():
                                         library + "<library_visual_scenes>")
     dae = parse_dae(text.encode())
     assert len(dae.triangles) == 24
+    # Nested node transforms of whole numbers: a few ulps; default rel 1e-6 is a ceiling.
     assert extent(dae.triangles_m) == pytest.approx([5.0, 1.0, 1.0])

@@ -283,9 +283,13 @@ def test_reproduces_the_seed_quadrotor(tmp_path):
     assert sorted(rotors) == [0, 1, 2, 3]
     for number, (position, direction) in expected.items():
         rotor = rotors[number]
+        # Template-written decimals (repr precision) read back: a few ulps of 0.3 m.
         assert np.allclose(rotor.position_m, position, atol=1e-12)
         assert rotor.direction == direction
+        # Exact: '0 0 1' is written and read; allclose's defaults are only a ceiling.
         assert np.allclose(rotor.axis, [0, 0, 1])
+        # Written and read back as decimal text: exact (repr round trip); the
+        # approx tolerances below (default rel 1e-6) are only ceilings over that.
         assert rotor.motor_constant == pytest.approx(8.54858e-06, rel=1e-12)
         assert rotor.moment_constant == pytest.approx(0.016)
         assert rotor.max_rot_velocity_rad_s == pytest.approx(838)
@@ -299,6 +303,8 @@ def test_reproduces_the_seed_quadrotor(tmp_path):
     assert body.mass_kg == pytest.approx(1.5)
     # A solid 0.47 x 0.47 x 0.22 m box of 1.5 kg, by hand: m/12 (b^2 + c^2).
     m, w, h = 1.5, 0.47, 0.22
+    # Box formula in the package vs here: a few ulps, written with >= 10 significant
+    # digits (fmt_number or xacro's repr): 5e-10 relative at worst; 1e-9 holds.
     assert np.allclose(np.diag(body.inertia_kg_m2),
                        [m / 12 * (w * w + h * h), m / 12 * (w * w + h * h), m / 12 * 2 * w * w],
                        rtol=1e-9)
@@ -310,6 +316,8 @@ def test_reproduces_the_seed_quadrotor(tmp_path):
     mr = 0.005 * 10
     assert rotor_inertial.mass_kg == pytest.approx(0.005)
     assert np.allclose(np.diag(rotor_inertial.inertia_kg_m2),
+                       # Box formula in the package vs here: a few ulps, written with >= 10 significant
+    # digits (fmt_number or xacro's repr): 5e-10 relative at worst; 1e-9 holds.
                        [mr / 12 * (0.015 ** 2 + 0.003 ** 2), mr / 12 * (0.1 ** 2 + 0.003 ** 2),
                         mr / 12 * (0.1 ** 2 + 0.015 ** 2)], rtol=1e-9)
 
@@ -379,6 +387,8 @@ def test_body_mesh_gives_the_inertia(tmp_path):
     body = robot.link_map["meshy/base_link_inertia"]
     m, (a, b, c) = 1.2, (0.3, 0.2, 0.1)
     assert np.allclose(np.diag(body.inertial.inertia_kg_m2),
+                       # The body from a float32 STL (coordinates to 6e-8 relative): the tensor, a
+                       # square of lengths, to ~1.2e-7 and the mesh integral's rounding; 1e-5 holds.
                        [m / 12 * (b * b + c * c), m / 12 * (a * a + c * c),
                         m / 12 * (a * a + b * b)], rtol=1e-5)
     assert body.visuals[0].geometry.uri == "package://meshy/meshes/body.stl"

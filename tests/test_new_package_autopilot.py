@@ -56,6 +56,8 @@ def test_quad_x_airframe_values_by_hand(tmp_path):
     assert params.get("CA_ROTOR0_PX").value == pytest.approx(arm, abs=1e-6)
     assert params.get("CA_ROTOR0_PY").value == pytest.approx(arm, abs=1e-6)
     assert params.get("CA_ROTOR0_KM").value == pytest.approx(spec["moment_constant"])
+    # Written as decimal text and parsed: exact up to the printed digits; default rel
+    # 1e-6 covers a %g-style print.
     assert params.get("CA_ROTOR2_KM").value == pytest.approx(-spec["moment_constant"])
     assert params.get("SIM_GZ_EC_MAX1").value == pytest.approx(spec["max_rot_velocity"])
 

@@ -344,6 +344,8 @@ def test_rotor_configuration_equals_motor_geometry(expanded, frame):
         angle_rad, arm_m = math.atan2(y, x), math.hypot(x, y)
 
         expected_angle = -math.radians(bearings_deg[i])   # clockwise bearing -> from +x to +y
+        # Positions written with 10 significant digits (fmt_number): atan2 and hypot of
+        # them are within ~1e-10 of the layout's; 1e-9 holds, a wrong slot is >= 30 deg off.
         assert math.remainder(angle_rad - expected_angle, 2 * math.pi) == pytest.approx(0, abs=1e-9)
         assert arm_m == pytest.approx(ARM_LENGTH_M * radial, rel=1e-9)
         assert text(motor, "turningDirection") == spins[i]
@@ -358,6 +360,9 @@ def test_rotor_configuration_equals_motor_geometry(expanded, frame):
     assert np.linalg.matrix_rank(allocation, tol=1e-9 * np.abs(allocation).max()) == 4
     # Equal rotor speeds give thrust and no torque: the controller's hover is level.
     wrench = allocation @ np.ones(n)
+    # Mirrored rotors are written with the same digits (fmt_number of +-the same value),
+    # so their moments cancel in pairs up to the sum's rounding (~1e-16 of the terms);
+    # 1e-12 of the thrust holds that, a misplaced rotor is ~1e-1 of it.
     assert np.allclose(wrench[:3], 0, atol=1e-12 * wrench[3])
 
 
@@ -411,6 +416,8 @@ def test_controller_gains_follow_mass_and_inertia(expanded, frame):
     gains = {tag: np.array([float(v) for v in text(control, tag).split()])
              for tag in ("velocityGain", "attitudeGain", "angularRateGain")}
     firefly_I = np.array([0.0347563, 0.0458929, 0.0977])
+    # Gains are printed with 4 significant digits (5e-4 relative) and scaled with the
+    # spec's mass estimate; 2e-3 holds both, a gain not scaled with mass is 30 % off.
     assert gains["velocityGain"] / mass == pytest.approx(np.full(3, 4.7 / 1.56779), rel=2e-3)
     # The context estimates the inertia with the rotors' real mass, the links carry RotorS'
     # slowed-down rotor inertia: a few percent apart.

@@ -25,6 +25,8 @@ def test_spec_units_and_flag_precedence(tmp_path):
                          "max_rot_velocity: 9000 rpm\n")
     spec = build_spec("p", spec_file=spec_file, flags={"mass": "2.0"})
     assert spec.frame.name == "hex-x"
+    # Unit conversions of decimal text (300 mm, 1800 g, 9000 rpm): one or two roundings;
+    # approx's default rel 1e-6 is a ceiling, a wrong unit is a factor of 10 or more.
     assert spec["arm_length"] == pytest.approx(0.3)
     assert spec["mass"] == pytest.approx(2.0)                      # the flag wins
     assert spec["max_rot_velocity"] == pytest.approx(9000 * 2 * 3.141592653589793 / 60)
@@ -50,6 +52,7 @@ def test_bad_values_are_user_errors(tmp_path, text):
 
 def test_cannot_lift_is_refused():
     # Seed rotors: 4 x 8.54858e-06 x 838^2 = 24.0 N of thrust; 2 kg weighs 19.6 N.
+    # The same products in another order: a few ulps; default rel 1e-6 is a ceiling.
     assert thrust_to_weight(build_spec("p", frame="quad-x")) == pytest.approx(
         4 * 8.54858e-06 * 838 ** 2 / ((1.5 + 4 * 0.005 + 0.01503) * 9.80665))
     with pytest.raises(ReedtoolError, match="cannot lift"):

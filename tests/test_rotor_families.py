@@ -71,6 +71,7 @@ def test_ardupilot_iris_rotors():
     assert [r.direction for r in rotors] == ["ccw", "ccw", "cw", "cw"]
     expected_xy = [(0.13, -0.22), (-0.13, 0.22), (0.13, 0.22), (-0.13, -0.22)]
     for rotor, (x, y) in zip(rotors, expected_xy):
+        # SDF poses composed through frames: a few ulps of ~0.3 m (< 1e-15).
         np.testing.assert_allclose(rotor.position_m, [x, y, 0.023], atol=1e-12)
         np.testing.assert_allclose(rotor.axis, [0, 0, 1], atol=1e-12)
         assert rotor.kind == "ardupilot" and rotor.role == "lift"
@@ -93,6 +94,7 @@ def test_ardupilot_hover_trim_by_hand():
     mass = 1.5 + 4 * 0.005
     k_f = 2 * 0.5 * 1.2041 * 0.084 ** 2 * 0.002 * 4.25 * 0.3
     assert ctx.trim.feasible
+    # Pseudo-inverse trim vs closed form: O(10) ulps (see test_trim); 1e-9 holds.
     np.testing.assert_allclose(ctx.trim.omega_rad_s, math.sqrt(mass * 9.80665 / (4 * k_f)),
                                rtol=1e-9)
 
@@ -126,6 +128,7 @@ def test_ardupilot_zephyr_propeller_is_propulsion_spinning_with_its_blades():
     np.testing.assert_allclose(rotor.axis, [0, -1, 0], atol=1e-9)
     assert rotor.direction == "ccw" and rotor.blade_turning_sign == 1
     k_f = 2 * 0.5 * 1.2041 * 0.074205 ** 2 * 0.02 * 4.25 * 0.30
+    # The same LiftDrag formula evaluated in another order: a few ulps; 1e-9 is margin.
     assert rotor.motor_constant == pytest.approx(k_f, rel=1e-9)
 
 
@@ -211,6 +214,8 @@ def test_neo_tilts_are_five_degrees_alternating():
         expected = [math.cos(y) * math.sin(p) * math.cos(r) + math.sin(y) * math.sin(r),
                     math.sin(y) * math.sin(p) * math.cos(r) - math.cos(y) * math.sin(r),
                     math.cos(p) * math.cos(r)]
+        # SDF rpy in degrees -> radians -> matrix: a few ulps (~1e-16); 1e-9 is margin, a
+        # wrong rotation order moves the axis by ~1e-2 at these 5 deg tilts.
         np.testing.assert_allclose(rotor.axis, expected, atol=1e-9)
         assert rotor.tilt_deg == pytest.approx(5.0, abs=1e-6)
         # The lean is tangential (about the arm), its sign alternating around the frame.
@@ -232,6 +237,7 @@ def test_tailsitter_tilts_by_hand():
     assert sum(r.axis[0] for r in rotors) == pytest.approx(0, abs=1e-12)
     torques = [r.position_m[0] * r.axis[1] - r.position_m[1] * r.axis[0] for r in rotors]
     assert torques[0] == pytest.approx(-(0.145 * b + 0.23 * a))
+    # Pairs cancelling products of ~0.2 m and ~0.17: a few ulps (~1e-17) each.
     assert sum(torques) == pytest.approx(0, abs=1e-12)
 
 

@@ -45,6 +45,8 @@ def test_placeholder_hint_gives_the_cylinder_tensor():
     m, r, h = 0.5, 0.05, 0.3  # link1: solid cylinder along z
     expected = {"ixx": m * (3 * r * r + h * h) / 12, "iyy": m * (3 * r * r + h * h) / 12,
                 "izz": m * r * r / 2, "ixy": 0.0, "ixz": 0.0, "iyz": 0.0}
+    # The hint prints the tensor for a user to paste, rounded to its printed digits;
+    # 1e-5 holds that rounding (the zero products compare exactly).
     assert _attrs(finding.hint) == pytest.approx(expected, rel=1e-5)
 
 

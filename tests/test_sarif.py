@@ -150,3 +150,83 @@ def test_input_error_is_a_tool_notification(capsys, tmp_path):
     assert invocation["executionSuccessful"] is False
     (note,) = invocation["toolExecutionNotifications"]
     assert "file not found" in note["message"]["text"]
+
+
+# ------------------------------------------------------------------ links GitHub follows
+
+RULES_MD = Path(__file__).resolve().parents[1] / "docs" / "rules.md"
+
+
+def github_anchors(markdown: str) -> set[str]:
+    """The anchors GitHub gives a document's headings (github-slugger's rules: lower
+    case; every character but letters, digits, spaces, hyphens and underscores removed;
+    spaces to hyphens; a repeated slug gets -1, -2, ...)."""
+    import re
+
+    seen: dict[str, int] = {}
+    anchors = set()
+    for line in markdown.splitlines():
+        heading = re.match(r"^#{1,6}\s+(.*?)\s*#*\s*$", line)
+        if not heading:
+            continue
+        slug = re.sub(r"[^\w\- ]", "", heading.group(1).lower()).replace(" ", "-")
+        count = seen.get(slug, 0)
+        seen[slug] = count + 1
+        anchors.add(slug if count == 0 else f"{slug}-{count}")
+    return anchors
+
+
+def test_every_rule_help_uri_points_at_a_heading_of_rules_md():
+    from reedtool.checks.registry import all_rules
+    from reedtool.report.sarif import _rule_descriptor
+
+    anchors = github_anchors(RULES_MD.read_text(encoding="utf-8"))
+    for rule in all_rules():
+        uri = _rule_descriptor(rule.code)["helpUri"]
+        page, _, anchor = uri.partition("#")
+        assert page.endswith("/docs/rules.md")
+        assert anchor in anchors, (rule.code, anchor)
+    assert "r304-yaw-moment-imbalance" in anchors    # the issue's example, by hand
+
+
+def test_the_slugger_can_fail():
+    assert github_anchors("### R304 yaw-moment-imbalance\n## A, b\n## A, b") == {
+        "r304-yaw-moment-imbalance", "a-b", "a-b-1"}
+
+
+def test_a_model_outside_the_working_directory_gets_a_relative_uri(tmp_path, monkeypatch,
+                                                                    capsys):
+    import shutil
+    from urllib.parse import unquote
+
+    work, elsewhere = tmp_path / "ci job", tmp_path / "models dir"
+    work.mkdir()
+    elsewhere.mkdir()
+    model = elsewhere / "two errors.urdf"
+    shutil.copy(FIXTURES / "S105_bad_child_missing.urdf", model)
+    monkeypatch.chdir(work)
+    code, doc = sarif([model], capsys)
+    assert code == 1
+    validate_sarif(doc)
+    run = doc["runs"][0]
+    base = run["originalUriBaseIds"]["SRCROOT"]["uri"]
+    assert base.startswith("file:///") and base.endswith("/")
+    for result in run["results"]:
+        location = result["locations"][0]["physicalLocation"]["artifactLocation"]
+        assert location["uriBaseId"] == "SRCROOT"
+        uri = location["uri"]
+        assert not uri.startswith("/") and ".." not in uri.split("/") and ":" not in uri
+        # SRCROOT joined with the relative URI is the model itself.
+        assert Path(unquote(base[len("file://"):] + uri)) == model.resolve()
+
+
+def test_a_model_inside_the_working_directory_is_relative_to_it(tmp_path, monkeypatch, capsys):
+    import shutil
+
+    shutil.copy(FIXTURES / "S105_bad_child_missing.urdf", tmp_path / "m.urdf")
+    monkeypatch.chdir(tmp_path)
+    _, doc = sarif(["m.urdf"], capsys)
+    run = doc["runs"][0]
+    assert {r["locations"][0]["physicalLocation"]["artifactLocation"]["uri"]
+            for r in run["results"]} == {"m.urdf"}
+    assert run["originalUriBaseIds"]["SRCROOT"]["uri"] == tmp_path.resolve().as_uri() + "/"

@@ -55,11 +55,13 @@ def test_x500_include_merge_reads_the_four_rotors_gazebo_flies():
     assert sorted(r.name for r in rotors) == sorted(X500_ROTORS)
     for rotor in rotors:
         position, direction, number = X500_ROTORS[rotor.name]
+        # Include poses composed: a few ulps of ~0.2 m (< 1e-15).
         np.testing.assert_allclose(rotor.position_m, position, atol=1e-12)
         np.testing.assert_allclose(rotor.axis, [0, 0, 1], atol=1e-12)
         assert rotor.direction == direction
         assert rotor.motor_number == number
         assert rotor.motor_constant == X500_K
+        # Exact: plugin text read by float() equals the literal.
         assert rotor.moment_constant == 0.016
         assert rotor.joint == f"{rotor.name}_joint"
     # The plugins come from x500, the links from the included x500_base.
@@ -78,6 +80,7 @@ def test_good_px4_models_validate_clean(model):
 def test_model_directory_is_read_through_model_config(tmp_path):
     assert codes_of(load_robot(MODELS / "x500")) == []
     # model.config lists model_1_6.sdf (0.5 kg) and model.sdf (0.06 kg, version 1.9).
+    # Exact: <mass> text read by float() equals the literal.
     assert load_robot(MODELS / "depth_cam").links[0].inertial.mass_kg == 0.06
     only_old = tmp_path / "cam"
     only_old.mkdir()
@@ -145,6 +148,7 @@ def test_canonical_link_attribute_and_nested_scoping(tmp_path):
         ("body", "sensor::lens")
     assert (robot.joint_map["sensor::inner"].parent, robot.joint_map["sensor::inner"].child) == \
         ("sensor::lens", "sensor::housing")
+    # Two translations added, no rotation: exact to an ulp (default rtol 1e-7 is a ceiling).
     np.testing.assert_allclose(link_poses(robot)["sensor::lens"][:3, 3], [0.2, 0, 0.05])
     assert not {"S104", "S105"} & set(codes_of(robot))
 
@@ -161,6 +165,7 @@ def test_plugins_of_a_nested_include_name_scoped_joints(tmp_path):
     assert sorted(r.name for r in rotors) == [f"quad::rotor_{i}" for i in range(4)]
     for rotor in rotors:
         position, direction, _number = X500_ROTORS[rotor.name.removeprefix("quad::")]
+        # Include poses composed: a few ulps of ~0.2 m (< 1e-15).
         np.testing.assert_allclose(rotor.position_m, position, atol=1e-12)
         assert rotor.direction == direction
 
@@ -285,6 +290,7 @@ def test_inertia_and_hover_test_take_model_option():
     code, output = run_cli("inertia", WORLDS / "several_models.sdf", "--package-path", MODELS,
                            "--model", "x500_0", "--format", "json")
     assert code in (0, 1), output
+    # A sum of the model's decimal masses: a few ulps; default rel 1e-6 is a ceiling.
     assert json.loads(output)["whole_robot"]["mass_kg"] == pytest.approx(X500_MASS_KG)
 
 
@@ -371,6 +377,7 @@ def test_merged_model_frame_keeps_its_meaning_under_a_rotated_include(tmp_path, 
                      "<uri>model://hinge</uri><pose>0 0 0 0 0 1.5707963267948966</pose>"
                      "</include></model></sdf>")
     robot = load_robot(outer)
+    # An axis expressed in a rotated frame, rotated back: a few ulps.
     np.testing.assert_allclose(robot.joint_map["j"].axis, [1, 0, 0], atol=1e-12)
     np.testing.assert_allclose(link_poses(robot)["flap"][:3, 3], [0.1, 0, 0], atol=1e-12)
 

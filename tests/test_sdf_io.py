@@ -88,6 +88,8 @@ def test_rotor_from_model_plugin_in_sdf(frames):
     (rotor,) = discover_rotors(frames)
     assert (rotor.kind, rotor.joint, rotor.turning_sign, rotor.motor_number) == \
         ("gz", "rotor_t_joint", -1, 0)
+    # Frames composed through relative_to chains with 45/10 deg rotations: a few ulps
+    # (~1e-16 m); 1e-9 is margin, a frame applied twice is ~0.1 m off.
     np.testing.assert_allclose(rotor.position_m, [0.1 + 0.25 * S45, 0.25 * S45, 0.02], atol=1e-9)
     np.testing.assert_allclose(rotor.axis, [S10 * S45, S10 * S45, C10], atol=1e-9)
     assert rotor.loc.line == 82 and rotor.plugin.param_loc("turningDirection").line == 86
@@ -111,6 +113,7 @@ def test_x3_rotors_match_the_written_layout():
         ("X3/rotor_2_joint", -1, 2), ("X3/rotor_3_joint", -1, 3)]
     expected = [[0.13, -0.22, 0.023], [-0.13, 0.22, 0.023], [0.13, 0.22, 0.023],
                 [-0.13, -0.22, 0.023]]
+    # Composed poses: a few ulps of ~0.3 m (< 1e-15).
     np.testing.assert_allclose([r.position_m for r in rotors], expected, atol=1e-12)
     np.testing.assert_allclose([r.axis for r in rotors], [[0, 0, 1]] * 4, atol=1e-12)
     assert all(robot.joint_map[r.joint].type == "continuous" for r in rotors)
@@ -120,6 +123,7 @@ def test_sdf_and_urdf_variants_are_the_same_model():
     sdf, urdf = load_robot(GZ / "x3_quad.sdf"), load_robot(GZ / "x3_quad.urdf")
     assert [l.name for l in sdf.links] == [l.name for l in urdf.links]
     for name, T in link_poses(urdf).items():
+        # SDF and URDF readers compose the same transforms: a few ulps.
         np.testing.assert_allclose(link_poses(sdf)[name], T, atol=1e-12)
     for a, b in zip(discover_rotors(sdf), discover_rotors(urdf)):
         assert (a.joint, a.direction, a.motor_constant) == (b.joint, b.direction, b.motor_constant)
@@ -159,7 +163,9 @@ def test_missing_inertial_gets_sdformat_defaults_and_a_finding():
     from reedtool.checks.runner import Selection, run_checks
 
     robot = parse_sdf(_sdf('<model name="m"><link name="a"/></model>'), "m.sdf")
+    # Exact: <mass> text read by float().
     assert robot.link_map["a"].inertial.mass_kg == 1.0
+    # Exact: the declared numbers, read (default rtol 1e-7 is only a ceiling).
     np.testing.assert_allclose(robot.link_map["a"].inertial.inertia_kg_m2, np.eye(3))
     # Valid SDF that Gazebo loads with 1 kg: a warning (S120), not a parse error.
     codes = [f.code for f in run_checks(robot, Selection(select=("S1",)))]
@@ -195,6 +201,7 @@ def test_model_uri_resolves_through_resource_path(tmp_path, monkeypatch):
     robot = load_robot(GZ / "frames.sdf")
     geometry = robot.link_map["rotor_t"].visuals[0].geometry
     assert geometry.path == mesh
+    # Exact: the declared scale, read.
     np.testing.assert_allclose(geometry.scale, [0.001] * 3)
 
 

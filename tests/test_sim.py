@@ -84,6 +84,9 @@ def test_torque_free_tumbling_keeps_angular_momentum_and_energy():
         R = rot_matrices(state.q)
         step_rigid_body(plant, state, R, np.zeros((3, 1)), np.zeros((3, 1)), 5e-4)
     L1, E1 = momentum_world_and_energy()
+    # First-order integrator: step halving gives |dL|/|L| = 1.0e-3, 5.0e-4, 2.5e-4 and
+    # |dE|/E = 1.1e-3, 5.6e-4, 2.8e-4 at dt 1, 0.5, 0.25 ms (error ~ dt, as the order says);
+    # at 0.5 ms that is 5e-4, and 5e-3 is 10x it: a wrong gyroscopic term drifts by O(1).
     np.testing.assert_allclose(L1, L0, rtol=0, atol=5e-3 * np.linalg.norm(L0))
     assert E1 == pytest.approx(E0, rel=5e-3)
 
@@ -98,6 +101,8 @@ def test_thrust_and_yaw_reaction_follow_rotors_conventions():
     force, torque = body_wrench(Plant.from_params(params), one_vehicle_state(params, omega),
                                 rot_matrices(np.array([[1.0], [0], [0], [0]])))
     T = params.motor_constant[0] * 600.0 ** 2
+    # T ~ 3 N from a few products: rounding ~1e-15 N; 1e-12 leaves margin, a wrong
+    # sign or lever arm (0.2 m) is O(1) N.
     np.testing.assert_allclose(force[:, 0], [0, 0, T], atol=1e-12)
     np.testing.assert_allclose(torque[:, 0], [0, -0.2 * T, -params.moment_constant[0] * T],
                                atol=1e-12)
@@ -116,14 +121,20 @@ def test_rotor_drag_matrices_match_the_per_rotor_formula():
         force = -params.rotor_drag_coefficient[i] * u_perp
         expected = np.concatenate([force, np.cross(r, force),
                                    -params.rolling_moment_coefficient[i] * u_perp])
+        # Entries ~1e-4 (drag coefficients) times O(1) speeds: rounding ~1e-20; 1e-15 is
+        # far above it and far below the entries themselves.
         np.testing.assert_allclose(K[:, :, i] @ np.concatenate([v, w]), expected, atol=1e-15)
 
 
 def test_motor_response_and_command_limits():
     up, down = speed_filter_factors(1e-3, np.array([0.0125]), np.array([0.025]))
+    # Same formula in numpy and math: pytest.approx's default rel 1e-6 is only a ceiling
+    # (the values agree to an ulp); a wrong time constant moves them by ~1e-2.
     assert up[0] == pytest.approx(math.exp(-1e-3 / 0.0125))
     assert down[0] == pytest.approx(math.exp(-1e-3 / 0.025))
     cmd = speed_command(np.array([-1.0, 2.0, 1e9]), np.array([1e-5] * 3), np.array([800.0] * 3))
+    # Exact limits (0 and 800 are clamps) and one sqrt (correctly rounded): the default
+    # rtol 1e-7 is only a ceiling.
     np.testing.assert_allclose(cmd, [0.0, math.sqrt(2.0 / 1e-5), 800.0])
 
 
@@ -144,17 +155,74 @@ def test_allocation_desaturates_keeping_the_torque_direction():
 
 # ------------------------------------------------------------------ the two engines
 
+# Engines (plain floats, numpy arrays, numba) and batch widths compute the same steps with
+# other kernels and summation orders: a few ulps apart per step. Their results are held to
+# ENGINE_RTOL, which test_engine_tolerance_stands_far_above_the_ulp_floor keeps at least
+# 20x above what these flights make of a 1- or 16-ulp change of their inputs (measured:
+# up to 1.3e-10 relative, in the saturating spread batch, where a few ulps decide the step
+# at which the allocation switches), and below what a wrong equation does (a 1e-6 change
+# of the mass moves the results by more than 10x ENGINE_RTOL).
+ENGINE_RTOL = 1e-8
+ENGINE_CONFIG = HoverConfig(duration_s=2.5, offset_m=(0.3, -0.2, 0.25), roll_rad=0.15,
+                            pitch_rad=-0.1, yaw_rad=0.3)
+
+
+def relative_change(a, b) -> float:
+    """Largest change of the compared outcome fields, relative to each field's scale."""
+    worst = 0.0
+    for name in ("final_omega_rad_s", "max_position_error_m", "max_attitude_error_deg",
+                 "longest_saturation_s"):
+        x, y = np.asarray(getattr(a, name), float), np.asarray(getattr(b, name), float)
+        scale = float(np.nanmax(np.abs(x))) if np.isfinite(x).any() else 0.0
+        if scale > 0:
+            worst = max(worst, float(np.nanmax(np.abs(x - y))) / scale)
+    return worst
+
+
+def batch_with_mass_scaled(params, config, plant_perturbation, scale):
+    changed = replace(plant_perturbation, mass_scale=plant_perturbation.mass_scale * scale)
+    return simulate_batch(params, config, perturbed_plant(params, changed))
+
+
+@pytest.mark.parametrize("case", ["quad", "tilted-hex", "spread-batch"])
+def test_engine_tolerance_stands_far_above_the_ulp_floor(case):
+    eps = np.finfo(float).eps
+    if case == "spread-batch":   # test_compiled's batch: crashes, saturation and recovery
+        params, config = symmetric_multirotor(4), HoverConfig(duration_s=3.0)
+        perturbation = sample_perturbations(150, 4, Spreads(mass_rel=0.3, com_m=0.03,
+                                                            inertia_rel=0.2,
+                                                            motor_constant_rel=0.15), 3)
+    else:
+        params = symmetric_multirotor(4) if case == "quad" else tilted_hex()
+        config = ENGINE_CONFIG
+        perturbation = sample_perturbations(1, params.n_rotors, Spreads(0, 0, 0, 0), seed=1)
+    ref = batch_with_mass_scaled(params, config, perturbation, 1.0)
+    floor = max(relative_change(ref, batch_with_mass_scaled(params, config, perturbation,
+                                                            1.0 + k * eps))
+                for k in (1, 16, -16))
+    assert floor * 20 <= ENGINE_RTOL
+    # ... and a real change (1e-6 of the mass) is far above the tolerance: it can fail.
+    assert relative_change(ref, batch_with_mass_scaled(params, config, perturbation,
+                                                       1.0 + 1e-6)) > 10 * ENGINE_RTOL
+
+
 @pytest.mark.parametrize("make", [lambda: symmetric_multirotor(4), tilted_hex])
 def test_plain_float_engine_matches_the_array_engine(make):
     params = make()
-    config = HoverConfig(duration_s=2.5, offset_m=(0.3, -0.2, 0.25), roll_rad=0.15,
-                         pitch_rad=-0.1, yaw_rad=0.3)
+    config = ENGINE_CONFIG
     run = simulate_hover(params, config, record=False)
     out = simulate_batch(params, config)
     assert out.status(0) is run.status
-    np.testing.assert_allclose(run.final_omega_rad_s, out.final_omega_rad_s[:, 0], rtol=1e-9)
-    assert run.max_position_error_m == pytest.approx(out.max_position_error_m[0], rel=1e-9)
-    assert run.max_attitude_error_deg == pytest.approx(out.max_attitude_error_deg[0], rel=1e-9)
+    # Two engines: ENGINE_RTOL (>= 20x this flight's measured ulp floor, see above).
+    np.testing.assert_allclose(run.final_omega_rad_s, out.final_omega_rad_s[:, 0],
+                               rtol=ENGINE_RTOL)
+    assert run.max_position_error_m == pytest.approx(out.max_position_error_m[0],
+                                                     rel=ENGINE_RTOL)
+    assert run.max_attitude_error_deg == pytest.approx(out.max_attitude_error_deg[0],
+                                                       rel=ENGINE_RTOL)
+    # A final error of ~1e-5 m is the difference of two ~2 m coordinates: one ulp of 2 m
+    # (4.4e-16 m) is 4e-11 of it before the flight amplifies it, so it keeps fewer digits
+    # than ENGINE_RTOL: rel 1e-6 (100x ENGINE_RTOL), abs 1e-12 m for a settled 0.
     assert run.final_position_error_m == pytest.approx(out.final_position_error_m[0],
                                                        rel=1e-6, abs=1e-12)
 
@@ -167,6 +235,8 @@ def test_steady_hover_speed_equals_the_trim(n):
     run = simulate_hover(params, HoverConfig(duration_s=12.0), record=False)
     assert run.status is ExitStatus.PASSED
     expected = math.sqrt(params.mass_kg * G / (n * params.motor_constant[0]))
+    # Settled for ~9 s, the remaining error decays with the closed loop: measured 1.3e-9
+    # of the hover speed for n = 4, 6, 8; 1e-6 is a margin over that, far below a wrong k.
     np.testing.assert_allclose(run.final_omega_rad_s, expected, rtol=1e-6)
 
 
@@ -174,7 +244,11 @@ def test_undisturbed_hover_stays_exactly_at_trim():
     params = symmetric_multirotor(6).with_changes(inertia_kg_m2=tilted_hex().inertia_kg_m2)
     config = HoverConfig(duration_s=2.0, offset_m=(0.0, 0.0, 0.0), roll_rad=0.0)
     run = simulate_hover(params, config)
+    # Settled at the first sample (0.01 s at 100 Hz): exact up to approx's default
+    # rel 1e-6 for the float product of steps and dt.
     assert run.status is ExitStatus.PASSED and run.settle_time_s == pytest.approx(0.01)
+    # Undisturbed: the state moves only by rounding of the trim (measured 1.3e-15, a few
+    # ulps) through a stable loop; 1e-9 is a wide margin, a drifting trim is 1e-3.
     np.testing.assert_allclose(run.final_omega_rad_s, run.initial_omega_rad_s, rtol=1e-9)
     assert run.max_position_error_m < 1e-3
 
@@ -183,6 +257,8 @@ def test_disturbed_awkward_vehicle_settles():
     run = simulate_hover(tilted_hex(), HoverConfig(duration_s=6.0))
     assert run.status is ExitStatus.PASSED
     assert 0.5 < run.settle_time_s < 5.0
+    # The start offset is 0.5 m and the controller only shrinks it; 0.05 m allows the
+    # overshoot of the tilted start (a controller design figure, not rounding).
     assert run.max_position_error_m == pytest.approx(0.5, abs=0.05)
 
 
@@ -237,8 +313,9 @@ def test_batch_without_spread_reproduces_the_single_vehicle():
     run = simulate_hover(params, config, record=False)
     for i in range(5):
         assert out.status(i) is run.status
+        # Batch of 5 against the plain-float engine: ENGINE_RTOL (see above).
         np.testing.assert_allclose(out.final_omega_rad_s[:, i], run.final_omega_rad_s,
-                                   rtol=1e-9)
+                                   rtol=ENGINE_RTOL)
 
 
 def ulp_sensitivity_m(params: VehicleParams, config: HoverConfig, alone) -> float:
@@ -357,4 +434,5 @@ def test_initial_attitude_is_the_urdf_rpy_convention():
 
     q = quat_from_rpy(0.3, -0.2, 1.1)
     R = rot_matrices(q.reshape(4, 1))[:, :, 0]
+    # Quaternion products vs Euler products of unit entries: a few ulps (~1e-15).
     np.testing.assert_allclose(R, rpy_to_matrix((0.3, -0.2, 1.1)), atol=1e-12)

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from reedtool.model import SourceLoc
 from reedtool.physics.allocation import allocation_matrix
 from reedtool.physics.rotors import Rotor
-from reedtool.physics.trim import TrimCause, solve_trim
+from reedtool.physics.trim import BOUND_MARGIN, TrimCause, solve_trim
 from reedtool.sim.params import VehicleParams
 
 G = 9.80665
@@ -50,11 +50,15 @@ def test_symmetric_frames_hover_at_sqrt_mg_over_nk(n, mass_kg):
     trim = solve_trim(mass_kg, np.array([0.0, 0.0, 0.01]), ring(n))
     assert trim.feasible and trim.cause is None
     expected = math.sqrt(mass_kg * G / (n * K))
+    # The pseudo-inverse (SVD) solution of a symmetric frame: ~cond(A) = O(10) ulps
+    # from the closed form, ~1e-15; 1e-9 allows any LAPACK's SVD, a wrong k is 1e-1.
     np.testing.assert_allclose(trim.omega_rad_s, expected, rtol=1e-9, atol=0)
     np.testing.assert_allclose(trim.throttle, expected / OMEGA_MAX, rtol=1e-9)
+    # A sum of n equal products vs n times one: n roundings, ~1e-15; rel 1e-12 holds.
     assert trim.thrust_to_weight == pytest.approx(n * K * OMEGA_MAX ** 2 / (mass_kg * G),
                                                   rel=1e-12)
     assert trim.rank == 4
+    # A @ pinv(A) @ w - w: cond(A) ulps of the weight (~1e-14 of it); 1e-9 of it holds.
     np.testing.assert_allclose(trim.residual_wrench, 0.0, atol=1e-9 * mass_kg * G)
 
 
@@ -68,6 +72,7 @@ def test_quad_torque_authority_matches_the_closed_form():
     hover, t_max = mass_kg * G / 4, K * OMEGA_MAX ** 2
     roll_pitch = 4 * a * min(hover, t_max - hover)
     yaw = 4 * C_M * min(hover, t_max - hover)
+    # Closed form vs the pseudo-inverse's columns: O(10) ulps; 1e-9 allows any LAPACK.
     np.testing.assert_allclose(trim.torque_authority_N_m, [roll_pitch, roll_pitch, yaw],
                                rtol=1e-9)
 
@@ -91,6 +96,7 @@ def test_motor_constant_divided_by_ten_lacks_thrust():
     trim = solve_trim(1.535, np.zeros(3), ring(4, k=K / 10))
     assert not trim.feasible
     assert trim.cause is TrimCause.INSUFFICIENT_THRUST
+    # The same products in another order: a few ulps; default rel 1e-6 is a ceiling.
     assert trim.thrust_to_weight == pytest.approx(4 * K / 10 * OMEGA_MAX ** 2 / (1.535 * G))
 
 
@@ -99,7 +105,8 @@ def test_com_outside_the_rotor_polygon_cannot_be_balanced(com_m):
     trim = solve_trim(1.5, np.array(com_m), ring(4, arm_m=0.25))
     assert not trim.feasible
     assert trim.cause is TrimCause.COM_UNBALANCED
-    assert np.min(trim.thrust_N) < 0.0   # the least-squares demand pulls a rotor down
+    assert np.min(trim.demand_N) < 0.0   # the least-squares demand pulls a rotor down
+    assert "min" in trim.limits()        # ... and that rotor is shown at 0, not below
 
 
 def test_com_inside_the_polygon_is_balanced_by_uneven_thrust():
@@ -140,6 +147,8 @@ def test_hexacopter_redistributes_when_the_minimum_norm_split_does_not_fit():
     assert trim.feasible
     t_max = K * OMEGA_MAX ** 2
     assert np.all(trim.thrust_N > 0) and np.all(trim.thrust_N < t_max)
+    # A redistributed (LP-like) solution: a few ulps times cond(A) ~ 1e2 of ~10 N,
+    # ~1e-13 N; 1e-8 N holds any solver's rounding, a wrong split is O(1) N.
     np.testing.assert_allclose(A @ trim.thrust_N, [1.0 * G, 0, 0, 0], atol=1e-8)
 
 
@@ -149,6 +158,8 @@ def test_sim_allocation_matches_the_lead_allocation_for_tilted_rotors():
                     axis=rng.normal(size=3) * [0.3, 0.3, 1] + [0, 0, 2]) for i in range(6)]
     com = rng.uniform(-0.02, 0.02, 3)
     params = VehicleParams.from_rotors(2.0, com, np.diag([0.03, 0.03, 0.05]), rotors)
+    # Two implementations of the same cross products (entries <= 0.3 m): a few ulps,
+    # < 1e-16; 1e-15 holds.
     np.testing.assert_allclose(params.allocation(), allocation_matrix(rotors, com),
                                atol=1e-15)
 
@@ -166,12 +177,48 @@ def test_a_feasible_trim_always_holds_the_weight_within_limits(n, com, k, mass, 
     t_max = k * OMEGA_MAX ** 2
     if trim.feasible:
         A = allocation_matrix(rotors, np.array(com))
+        # Random layouts: cond(A) up to ~1e4 near infeasibility times ulps of the weight,
+        # ~1e-12 of it; 1e-7 of the weight holds them, a wrong split is O(1).
         np.testing.assert_allclose(A @ trim.thrust_N, [mass * G, 0, 0, 0],
                                    atol=1e-7 * mass * G)
         assert np.all(trim.thrust_N > 0) and np.all(trim.thrust_N < t_max)
+        # sqrt then square: 2-3 roundings (~7e-16); 1e-12 holds.
         np.testing.assert_allclose(k * trim.omega_rad_s ** 2, trim.thrust_N, rtol=1e-12)
     else:
         assert trim.cause in (TrimCause.INSUFFICIENT_THRUST, TrimCause.COM_UNBALANCED,
                               TrimCause.YAW_UNBALANCED)
         if trim.cause is TrimCause.INSUFFICIENT_THRUST:
             assert n * t_max < mass * G
+
+
+@pytest.mark.parametrize("case", ["heavy", "com", "yaw"])
+def test_an_infeasible_trim_shows_each_rotor_at_what_it_can_give(case):
+    # Issue 19: the table listed 12.57 N at 1000 rad/s for a rotor whose maximum is
+    # k*w_max^2 = 8.55 N, and -1.07 N at 0 rad/s. Each row must be a thrust the rotor can
+    # make, k*w^2 of the speed beside it; the demand beyond a limit is kept beside it.
+    rotors = ring(4)
+    if case == "yaw":
+        rotors[1] = rotor(1, rotors[1].position_m, "ccw")          # three ccw, one cw
+    mass, com = {"heavy": (3.2, np.zeros(3)), "com": (1.5, np.array([0.3, 0.0, 0.0])),
+                 "yaw": (1.5, np.zeros(3))}[case]
+    trim = solve_trim(mass, com, rotors)
+    assert not trim.feasible
+    t_max = K * OMEGA_MAX ** 2
+    assert np.all(trim.thrust_N >= 0.0) and np.all(trim.thrust_N <= t_max)
+    assert not np.any(np.signbit(trim.thrust_N))                     # no "-0.0000 N"
+    # One multiplication and a square root apart: a few ulps (rtol 1e-12 is ~4500).
+    np.testing.assert_allclose(K * trim.omega_rad_s ** 2, trim.thrust_N, rtol=1e-12, atol=0)
+    limits = trim.limits()
+    for want, got, limit in zip(trim.demand_N, trim.thrust_N, limits):
+        if limit == "max":
+            assert want > t_max and got == t_max                     # clipped: exact
+        elif limit == "min":
+            assert want < 0.0 and got == 0.0
+        else:   # within round-off of its range (BOUND_MARGIN) of where it is shown
+            assert abs(got - want) <= BOUND_MARGIN * t_max
+    assert any(limits)
+    rows = trim.to_dict()["rotors"]
+    assert [r["limit"] for r in rows] == limits
+    assert trim.cause is {"heavy": TrimCause.INSUFFICIENT_THRUST,
+                          "com": TrimCause.COM_UNBALANCED,
+                          "yaw": TrimCause.YAW_UNBALANCED}[case]

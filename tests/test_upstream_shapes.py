@@ -111,6 +111,8 @@ def test_tiltrotor_servos_are_not_rotors_and_trim_by_hand():
     t_back = weight / 2 - t_front
     expected = np.sqrt(np.array([t_front, t_back, t_front, t_back]) / k)
     assert trim.feasible
+    # Hand pitch balance vs the pseudo-inverse: both exact in exact arithmetic (the yaw
+    # row is balanced by the symmetric pairs); measured 4.4e-16 apart, 1e-6 is margin.
     np.testing.assert_allclose(trim.omega_rad_s, expected, rtol=1e-6)
 
 
@@ -134,6 +136,7 @@ def test_ardupilot_time_constant_pd_and_offset_inertial(tmp_path):
     robot, rotor = _iris_rotor(tmp_path, edit)
     found = ardupilot_time_constant(robot, rotor)
     inertia = 2.5e-05 + 0.005 * 0.01 ** 2
+    # The same sum and division in the code: a few ulps (~1e-15); 1e-12 holds.
     assert found.time_constant_s == pytest.approx((inertia + 0.0001) / 0.20, rel=1e-12)
 
 
@@ -154,10 +157,12 @@ def test_rotors_plus_quad_through_the_bundled_macros_by_hand():
     assert [r.direction for r in rotors] == ["cw", "ccw", "cw", "ccw"]
     expected_xy = [(0.17, 0), (0, 0.17), (-0.17, 0), (0, -0.17)]
     for rotor, (x, y) in zip(rotors, expected_xy):
+        # Poses composed through frames: a few ulps of ~0.3 m (< 1e-15).
         np.testing.assert_allclose(rotor.position_m, [x, y, 0.01], atol=1e-12)
     from reedtool.checks.context import CheckContext
 
     mass, k = 0.68 + 4 * 0.009, 8.54858e-06
+    # Pseudo-inverse trim vs closed form: O(10) ulps (see test_trim); 1e-9 holds.
     np.testing.assert_allclose(CheckContext(robot).trim.omega_rad_s,
                                math.sqrt(mass * 9.80665 / (4 * k)), rtol=1e-9)
 
@@ -172,6 +177,7 @@ def test_quad_tailsitter_tilts_and_trim_by_hand():
     cz = math.cos(0.17) ** 2
     for rotor in rotors:
         assert rotor.role == "lift"
+        # rpy -> matrix: products of cos/sin, a few ulps (~1e-16); 1e-12 holds.
         assert rotor.axis[2] == pytest.approx(cz, rel=1e-12)
         assert abs(rotor.axis[0]) == pytest.approx(math.cos(0.17) * math.sin(0.17), rel=1e-12)
         assert abs(rotor.axis[1]) == pytest.approx(math.sin(0.17), rel=1e-12)
@@ -179,6 +185,7 @@ def test_quad_tailsitter_tilts_and_trim_by_hand():
 
     trim = CheckContext(robot).trim
     thrust = (1.6 + 4 * 0.005) * 9.80665 / (4 * cz)
+    # Pseudo-inverse of a tilted symmetric frame vs closed form: O(10) ulps; 1e-9 holds.
     np.testing.assert_allclose(trim.thrust_N, thrust, rtol=1e-9)
 
 
@@ -223,6 +230,7 @@ def test_px4vision_rotors_and_hover_by_hand():
     from reedtool.checks.context import CheckContext
 
     mass, k = 1.5 + 4 * 0.005, 8.54858e-06
+    # Pseudo-inverse trim vs closed form: O(10) ulps (see test_trim); 1e-9 holds.
     np.testing.assert_allclose(CheckContext(robot).trim.omega_rad_s,
                                math.sqrt(mass * 9.80665 / (4 * k)), rtol=1e-9)
 

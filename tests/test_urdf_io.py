@@ -17,7 +17,9 @@ def test_quad_values_and_lines():
     assert robot.name == "quad"
     assert [link.name for link in robot.links][:2] == ["base_link", "rotor_0"]
     base = robot.link_map["base_link"]
+    # Exact: <mass value> read by float() equals the literal.
     assert base.inertial.mass_kg == 1.5
+    # Exact: decimal text parsed by float() twice gives the same double.
     np.testing.assert_array_equal(np.diag(base.inertial.inertia_kg_m2), [0.0347563, 0.0458929, 0.0799])
     np.testing.assert_array_equal(base.collisions[0].geometry.size_m, [0.47, 0.47, 0.11])
     # Lines of the fixture file, counted by hand: <link name="base_link"> is line 3.
@@ -25,6 +27,7 @@ def test_quad_values_and_lines():
     assert text[base.loc.line - 1].strip() == '<link name="base_link">'
     joint = robot.joint_map["rotor_2_joint"]
     assert text[joint.loc.line - 1].strip() == '<joint name="rotor_2_joint" type="continuous">'
+    # Exact: the origin's numbers copied into T (default rtol 1e-7 is only a ceiling).
     np.testing.assert_allclose(joint.T_parent_joint[:3, 3], [0.18738, 0.18738, 0.026])
     assert robot.parse_issues == []
 

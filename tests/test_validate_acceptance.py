@@ -62,6 +62,7 @@ def test_smartcar_missing_reference_and_wheel_inertia():
         assert "0.1 kg cylinder of radius 0.025 m" in finding.message
         values = sorted(float(v) for k, v in re.findall(r'(i[xyz]{2})="([^"]+)"', finding.hint)
                         if k in ("ixx", "iyy", "izz"))
+        # The hint prints 4 significant digits (:.4g): 5e-5 relative rounding; rel 1e-4 holds.
         assert values == pytest.approx(sorted([transverse, transverse, axial]), rel=1e-4)
 
 
@@ -95,5 +96,7 @@ def test_clean_quad_whole_robot_mass_matches_pinocchio():
     model = pinocchio.buildModelFromUrdf(str(path), pinocchio.JointModelFreeFlyer())
     data = model.createData()
     q = pinocchio.neutral(model)
+    # Two sums of the same decimal masses: a few ulps; default rel 1e-6 is a ceiling.
     assert ctx.whole_robot.mass_kg == pytest.approx(pinocchio.computeTotalMass(model))
+    # Two implementations of the same weighted sum: a few ulps of ~0.1 m; 1e-9 is margin.
     assert np.allclose(ctx.whole_robot.com_m, pinocchio.centerOfMass(model, data, q), atol=1e-9)

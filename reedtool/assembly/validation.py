@@ -149,15 +149,22 @@ class Verdict:
         return [*self.refusing, *self.reported]
 
 
-def judge(model: Path, robot, request: ModelRequest, command: str) -> Verdict:
-    """validate's errors on `robot` (its configuration, then the request's --select and
-    --ignore), split into those `command` refuses on and those it reports."""
+def validation_findings(model: Path, robot, request: ModelRequest) -> list:
+    """validate's findings on `robot`, every severity (its configuration, then the
+    request's --select and --ignore, then the suppressions)."""
     from reedtool.checks.runner import apply_suppressions, run_checks
     from reedtool.config import load_config
 
     config = load_config(model)
     findings = run_checks(robot, selection_for(config, request.select, request.ignore))
     kept, _ = apply_suppressions(findings, _ignores_for(config, model))
+    return kept
+
+
+def judge(model: Path, robot, request: ModelRequest, command: str) -> Verdict:
+    """validate's errors on `robot` (its configuration, then the request's --select and
+    --ignore), split into those `command` refuses on and those it reports."""
+    kept = validation_findings(model, robot, request)
     needs = COMMAND_NEEDS[command]
     verdict = Verdict()
     for f in kept:

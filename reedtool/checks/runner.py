@@ -4,23 +4,52 @@ Selection follows ruff: `select` and `ignore` are code prefixes (or rule names, 
 stand for their code) and, for each rule, the longest prefix that matches it decides (an
 ignore wins a tie). Severity overrides are prefixes too, longest match wins.
 
+Each rule runs on its own: an exception in one becomes one error finding of that rule
+("internal error in this rule: ..."), the other rules' findings are kept, and `validate`
+exits 3 (`has_internal_errors`). REEDTOOL_DEBUG=1 lets the exception through instead.
+
 After the rules ran, `apply_suppressions` drops findings silenced by an inline XML comment
 (reedtool.checks.suppressions) or by a per-file ignore of the configuration.
 """
 
 from __future__ import annotations
 
+import os
 import re
 from dataclasses import dataclass, field
 from typing import Iterable, Mapping, Sequence
 
 from reedtool.checks.context import CheckContext
-from reedtool.checks.finding import SEVERITIES, Finding
+from reedtool.checks.finding import SEVERITIES, Finding, Issue
 from reedtool.checks.registry import Rule, all_rules, suggest_selector
 from reedtool.errors import ReedtoolError, shorten, shorten_names
 from reedtool.model import Robot
 
 _SELECTOR = re.compile(r"^[A-Z]\d{0,3}$")
+INTERNAL_ERROR = "internal error in this rule: "
+
+
+def has_internal_errors(findings: Iterable[Finding]) -> bool:
+    """Whether a rule crashed (a reedtool bug): the report is then incomplete."""
+    return any(f.message.startswith(INTERNAL_ERROR) for f in findings)
+
+
+def _issues_of(rule: Rule, ctx: CheckContext) -> tuple[list[Issue], bool]:
+    """The rule's issues, and whether it crashed: then its issues so far plus one naming
+    the exception, so one rule's bug cannot take the rest of the report with it."""
+    issues: list[Issue] = []
+    try:
+        for issue in rule.check(ctx):
+            issues.append(issue)
+    except Exception as exc:  # noqa: BLE001 - isolates a bug to its own rule
+        if os.environ.get("REEDTOOL_DEBUG"):
+            raise
+        detail = " ".join(str(exc).split()) or "no message"
+        issues.append(Issue(f"{INTERNAL_ERROR}{type(exc).__name__}: {detail}",
+                            hint="this is a reedtool bug, not a finding about the model: "
+                                 "rerun with REEDTOOL_DEBUG=1 for the traceback and report it"))
+        return issues, True
+    return issues, False
 
 
 def _longest(prefixes: Iterable[str], code: str) -> int:
@@ -101,7 +130,10 @@ def run_checks(robot: Robot, selection: Selection | None = None, *,
         if not selection.enabled(rule.code):
             continue
         severity = selection.severity_of(rule)
-        for issue in rule.check(ctx):
+        issues, crashed = _issues_of(rule, ctx)
+        for issue in issues:
+            if crashed and issue is issues[-1]:
+                severity = "error"  # whatever the rule's severity: the report is incomplete
             loc = issue.loc or robot.loc
             # Names the user wrote are shown at most ~80 characters long (a 1 MB link name
             # would otherwise be echoed whole); errors.shorten is the one place for that.
@@ -126,6 +158,9 @@ def apply_suppressions(findings: Sequence[Finding], ignores_for=None
 
     kept: list[Finding] = []
     for finding in findings:
+        if finding.message.startswith(INTERNAL_ERROR):
+            kept.append(finding)    # a crashed rule is a reedtool bug, not the user's to silence
+            continue
         if is_suppressed(finding.code, finding.slug, finding.file, finding.line):
             continue
         if ignores_for is not None:

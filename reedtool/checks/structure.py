@@ -256,7 +256,8 @@ def joint_limit_inverted(ctx: CheckContext) -> Iterator[Issue]:
     for joint in ctx.robot.joints:
         limit = joint.limit
         if joint.type in _LIMITED_JOINTS and limit is not None and limit.lower is not None \
-                and limit.upper is not None and limit.lower > limit.upper:
+                and limit.upper is not None and limit.lower > limit.upper \
+                and math.isfinite(limit.lower) and math.isfinite(limit.upper):  # else S102
             yield Issue(f"joint '{joint.name}': lower limit {limit.lower:g} > upper limit "
                         f"{limit.upper:g}", limit.loc, joint.name, hint="swap lower and upper")
 

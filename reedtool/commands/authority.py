@@ -87,13 +87,54 @@ def _ttw(value: float | None) -> str:
     return "never" if value is None else f"{value:.3g}"
 
 
+# The validate rules whose errors explain an intact vehicle that cannot be controlled.
+CAUSE_RULES = ("R303", "R304", "R305", "R307", "R308")
+
+
+def uncontrollable_causes(robot) -> list[dict]:
+    """The findings behind "not controllable" (e.g. R304), as validate reports them."""
+    from reedtool.checks.runner import Selection, run_checks
+
+    return [{"code": f.code, "slug": f.slug, "message": f.message}
+            for f in run_checks(robot, Selection(select=CAUSE_RULES)) if f.severity == "error"]
+
+
+def _intact_line(intact: dict) -> str:
+    need = intact["min_thrust_to_weight"]
+    if intact["controllable"]:
+        return (f"intact: ACAI {intact['acai']:.4g} (controllable), needs thrust-to-weight > "
+                f"{_ttw(need)}")
+    if need is None:
+        return (f"intact: ACAI {intact['acai']:.4g}: not controllable about hover at any "
+                "thrust-to-weight")
+    return (f"intact: ACAI {intact['acai']:.4g}: not controllable about hover; it would be "
+            f"with thrust-to-weight > {need:.3g}")
+
+
+def _verdict(report: dict, policy: str) -> str:
+    """The --require line: what was required and, when it failed, what is not so."""
+    if meets(report, policy):
+        return f"PASSED --require {policy}: {POLICIES[policy]}"
+    causes = report["intact"].get("causes") or []
+    because = f" ({', '.join(c['code'] for c in causes)})" if causes else ""
+    if not report["intact"]["controllable"]:
+        what = f"the intact vehicle is not controllable about hover{because}"
+    else:
+        key = "controllable" if policy == "any-single" else "controllable_without_yaw"
+        lost = [f["rotor"] for f in report["failures"] if not f[key]]
+        what = f"losing {', '.join(lost)} leaves " + (
+            "less than full control" if policy == "any-single"
+            else "no thrust, roll and pitch control")
+    return f"FAILED --require {policy}: {what} (required: {POLICIES[policy]})"
+
+
 def render_text(name: str, report: dict, policy: str) -> str:
     intact = report["intact"]
-    verdict = "controllable" if intact["controllable"] else "NOT controllable"
     lines = [(f"authority {name}: {len(report['failures'])} rotors, mass "
               f"{report['mass_kg']:.4g} kg, thrust-to-weight {report['thrust_to_weight']:.3g}"),
-             (f"intact: ACAI {intact['acai']:.4g} ({verdict}), "
-              f"needs thrust-to-weight > {_ttw(intact['min_thrust_to_weight'])}")]
+             _intact_line(intact)]
+    for cause in intact.get("causes") or ():
+        lines.append(f"  because {cause['code']} ({cause['slug']}): {cause['message']}")
     degraded = {k: v for k, v in report["efficiency"].items() if v != 1.0}
     if degraded:
         lines.append("efficiency: " + ", ".join(f"{k} {v:g}" for k, v in degraded.items()))
@@ -121,8 +162,7 @@ def render_text(name: str, report: dict, policy: str) -> str:
     lines.append(f"single failures: {full}/{len(report['failures'])} keep full control, "
                  f"{no_yaw}/{len(report['failures'])} keep thrust, roll and pitch "
                  f"(ACAI in mixed units: N and N*m)")
-    ok = meets(report, policy)
-    lines.append(("PASSED" if ok else "FAILED") + f" --require {policy}: {POLICIES[policy]}")
+    lines.append(_verdict(report, policy))
     return "\n".join(lines)
 
 
@@ -227,6 +267,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
 
     report = analyse(rotors, props.mass_kg, props.com_m,
                      _efficiency(efficiency_items, [r.name for r in rotors]), degrade)
+    if not report["intact"]["controllable"]:
+        report["intact"]["causes"] = uncontrollable_causes(robot)
     if fly:
         chosen, params, config = fly_failures(rotors, props, report, fail_at_s=fail_at_s,
                                               duration_s=duration_s,

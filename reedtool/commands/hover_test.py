@@ -319,8 +319,11 @@ def render_text(report: dict) -> str:
         width = max(len(r["name"]) for r in trim["rotors"])
         lines.append(f"  {'rotor':<{width}}  {'thrust N':>9}  {'omega rad/s':>11}  {'throttle':>8}")
         for r in trim["rotors"]:
+            # A saturated rotor shows what it can give, and what the allocation asked.
+            limit = {"max": "  at max, needs {:.4g} N", "min": "  at 0, needs {:.4g} N"
+                     }.get(r.get("limit") or "", "").format(r.get("demand_N"))
             lines.append(f"  {r['name']:<{width}}  {_num(r['thrust_N'], '9.4f')}  "
-                         f"{_num(r['omega_rad_s'], '11.2f')}  {_pct(r['throttle']):>8}")
+                         f"{_num(r['omega_rad_s'], '11.2f')}  {_pct(r['throttle']):>8}{limit}")
     if trim["feasible"]:
         a = trim["torque_authority_N_m"]
         lines.append(f"  thrust-to-weight {trim['thrust_to_weight']:.3f}; torque authority at "

@@ -2,7 +2,8 @@
 
 Many models per run (files, directories, globs, ROS packages, every multirotor of a
 world), one report, one exit code over all: 0 clean, 1 findings at a failing severity,
-2 when an input could not be read (the other models are still checked and reported).
+2 when an input could not be read (the other models are still checked and reported), 3
+when a rule failed internally (its finding says so; every other finding is reported).
 """
 
 from __future__ import annotations
@@ -214,7 +215,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
     model.
 
     Exit 0 when there is no error, 1 when there are errors (or warnings with --strict),
-    2 on bad usage or when a model could not be read.
+    2 on bad usage or when a model could not be read, 3 when a rule failed internally (a
+    reedtool bug: that rule's finding says so, the rest of the report is complete).
     """
     if explain_code:
         return explain(explain_code)
@@ -314,6 +316,10 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
         click.echo(note, err=fmt != "text" or output_file is not None)
     if any(r.error is not None for r in results):
         return 2
+    from reedtool.checks.runner import has_internal_errors
+
+    if has_internal_errors(f for r in results for f in r.findings):
+        return 3        # even with --exit-zero: the report misses what that rule checks
     if exit_zero:
         return 0
     return 1 if failed else 0

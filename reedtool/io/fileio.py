@@ -76,6 +76,10 @@ MAX_MESH_BYTES = 512 * 1024 * 1024
 # Coordinates beyond 1e9 file units (1000 km in mm) are a damaged file, not a part:
 # 6e37 (a float32 bit pattern read as a coordinate) gives a 1e106 kg inertial.
 MAX_MESH_COORDINATE = 1e9
+# A model number beyond 1e100 in SI units (the observable universe is 1e27 m across and
+# weighs 1e53 kg) is a typo or a broken expression, and squaring it (inertia, k*w^2)
+# overflows: the readers report it as S102 and read it as infinite.
+MAX_MAGNITUDE = 1e100
 
 
 def check_mesh_coordinates(triangles, source) -> None:

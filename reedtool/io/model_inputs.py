@@ -204,6 +204,18 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
         xacro = path.is_file() and path.suffix.lower() in XACRO_SUFFIXES
         includers = _includers(path, include_tree, include_globs) if xacro else []
         library = xacro and is_macro_library(path)
+        if library:
+            # A library that includes itself breaks every model that includes it: an
+            # error with the chain, not a skip.
+            from reedtool.io.xacro_expand import include_cycle
+
+            cycle = include_cycle(path)
+            if cycle is not None:
+                chain = " -> ".join(p.name for p in cycle)
+                out.append(Target(display(path), None,
+                                  error=f"include cycle: {chain} (remove one of the "
+                                        "includes; a file cannot include itself)"))
+                return
         if library and not includers:
             # pre-commit passes every changed file: a macro library has no robot of its
             # own; the models that include it are where its mistakes show.

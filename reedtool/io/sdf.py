@@ -61,6 +61,7 @@ import numpy as np
 from lxml import etree
 
 from reedtool.errors import ReedtoolError
+from reedtool.io.fileio import MAX_MAGNITUDE
 from reedtool.frames import make_T, matrix_to_rpy, rpy_to_matrix
 from reedtool.io.resources import resolve_model_file_uri
 from reedtool.io.sdf_include import SourceFile, SourceMap, expand_includes
@@ -270,14 +271,20 @@ class _ModelReader:
         except ValueError:
             self._issue("bad-number", f"<{el.tag}>{raw}</{el.tag}> is not a list of numbers",
                         el, subject)
-            return np.array(default, dtype=float)
+            return np.full(len(default), math.nan)    # unknown, not sdformat's default
         if len(values) not in counts:
             expected = " or ".join(str(c) for c in counts)
             self._issue("bad-number", f"<{el.tag}>{raw}</{el.tag}> has {len(values)} number(s), "
                         f"expected {expected}", el, subject)
-            return np.array(default, dtype=float)
+            return np.full(len(default), math.nan)
         if not all(math.isfinite(v) for v in values):
             self._issue("non-finite", f"<{el.tag}>{raw}</{el.tag}> is not finite", el, subject)
+        elif not all(abs(v) <= MAX_MAGNITUDE for v in values):
+            self._issue("non-finite", f"<{el.tag}>{raw}</{el.tag}> is beyond any physical "
+                        f"quantity (|value| > {MAX_MAGNITUDE:g}): effectively infinite",
+                        el, subject)
+            values = [v if abs(v) <= MAX_MAGNITUDE else math.copysign(math.inf, v)
+                      for v in values]
         return np.array(values, dtype=float)
 
     def _number(self, parent: etree._Element | None, tag: str, default: float,
@@ -526,6 +533,13 @@ class _ModelReader:
                         inertia_loc=self.loc(inertia_el) if inertia_el is not None else None)
 
     def _geometry(self, el: etree._Element | None, link: str):
+        """The shape, or None when it is absent or any of its numbers could not be read
+        (the reader's finding speaks; no rule measures a box of NaN metres)."""
+        start = len(self.issues)
+        geometry = self._shape(el, link)
+        return geometry if len(self.issues) == start else None
+
+    def _shape(self, el: etree._Element | None, link: str):
         if el is None:
             return None
         shape = next((c for c in el if isinstance(c.tag, str)), None)

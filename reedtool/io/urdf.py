@@ -16,6 +16,7 @@ import numpy as np
 from lxml import etree
 
 from reedtool.errors import ReedtoolError
+from reedtool.io.fileio import MAX_MAGNITUDE
 from reedtool.frames import make_T, rpy_to_matrix
 from reedtool.io.xml_lines import start_line
 from reedtool.model import (
@@ -118,7 +119,11 @@ class _RobotReader:
 
     def _floats(self, el: etree._Element | None, attr: str, count: int, default: Sequence[float],
                 subject: str | None) -> np.ndarray:
-        """Read `count` numbers from an attribute; problems become ParseIssues."""
+        """Read `count` numbers from an attribute; problems become ParseIssues.
+
+        `default` stands in for an absent attribute. An unreadable one reads as NaN, not
+        as the default: its finding speaks, and what is computed from it stays unknown
+        (a 0 there would be a silent guess that other rules then judge)."""
         if el is None or el.get(attr) is None:
             return np.array(default, dtype=float)
         raw = el.get(attr)
@@ -128,13 +133,19 @@ class _RobotReader:
         except ValueError:
             self._issue("bad-number", f"<{el.tag} {attr}=\"{raw}\"> is not {count} number(s)",
                         el, subject)
-            return np.array(default, dtype=float)
+            return np.full(count, math.nan)
         if len(values) != count:
             self._issue("bad-number", f"<{el.tag} {attr}=\"{raw}\"> has {len(values)} "
                         f"number(s), expected {count}", el, subject)
-            return np.array(default, dtype=float)
+            return np.full(count, math.nan)
         if not all(math.isfinite(v) for v in values):
             self._issue("non-finite", f"<{el.tag} {attr}=\"{raw}\"> is not finite", el, subject)
+        elif not all(abs(v) <= MAX_MAGNITUDE for v in values):
+            self._issue("non-finite", f"<{el.tag} {attr}=\"{raw}\"> is beyond any physical "
+                        f"quantity (|value| > {MAX_MAGNITUDE:g}): effectively infinite",
+                        el, subject)
+            values = [v if abs(v) <= MAX_MAGNITUDE else math.copysign(math.inf, v)
+                      for v in values]
         return np.array(values, dtype=float)
 
     def _float(self, el: etree._Element | None, attr: str, default: float | None,
@@ -217,6 +228,13 @@ class _RobotReader:
                         inertia_loc=self.locate(inertia_el) if inertia_el is not None else None)
 
     def _geometry(self, el: etree._Element | None, link: str):
+        """The shape, or None when it is absent or any of its numbers could not be read
+        (the reader's finding speaks; no rule measures a box of NaN metres)."""
+        start = len(self.issues)
+        geometry = self._shape(el, link)
+        return geometry if len(self.issues) == start else None
+
+    def _shape(self, el: etree._Element | None, link: str):
         if el is None:
             return None
         shape = next((c for c in el if isinstance(c.tag, str)), None)

@@ -702,6 +702,38 @@ def include_texts(path: Path, mappings: dict[str, str] | None = None,
     return follow_includes(Path(path), _static_include_resolver(resolver, dict(mappings or {})))
 
 
+def include_cycle(path: Path, mappings: dict[str, str] | None = None,
+                  package_paths: Sequence[Path] = ()) -> list[Path] | None:
+    """A chain of static includes leading from `path` back to itself, or None.
+
+    For a file that is not expanded (a macro library named alone): a file that includes
+    itself, directly or through others, cannot be used by any model either.
+    """
+    from reedtool.io.legacy_xacro import include_specs
+
+    resolve = _static_include_resolver(PackageResolver(package_paths, model_path=path),
+                                       dict(mappings or {}))
+    start = Path(path).resolve()
+    pending, seen = [[start]], {start}
+    while pending:
+        chain = pending.pop()
+        try:
+            text = chain[-1].read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError):
+            continue
+        for spec in include_specs(text):
+            target = resolve(spec, chain[-1])
+            if target is None:
+                continue
+            target = target.resolve()
+            if target == start:
+                return chain + [start]
+            if target not in seen and target.is_file():
+                seen.add(target)
+                pending.append(chain + [target])
+    return None
+
+
 def scan_legacy(path: Path, mappings: dict[str, str] | None = None,
                 package_paths: Sequence[Path] = ()) -> LegacyScan:
     """Legacy xacro tags in `path` and the files it includes (see reedtool.io.legacy_xacro)."""

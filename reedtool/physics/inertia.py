@@ -278,6 +278,9 @@ def whole_robot(robot: Robot) -> MassProperties:
     """reedtool's own sum over links, in the root link's frame, at zero joint positions.
 
     Links not reachable from the root (a broken tree) are left out, as a simulator would.
+    A number that could not be read (NaN/inf in a reached link's pose, mass, COM or
+    inertia; S101/S102 report it) makes the sum unknown: NaN mass, COM and tensor, so
+    nothing downstream judges a robot without that link.
     """
     from reedtool.physics.kinematics import link_poses
 
@@ -286,7 +289,16 @@ def whole_robot(robot: Robot) -> MassProperties:
         declared = declared_mass_properties(robot.link_map[name])
         if declared is not None:
             parts.append(declared.transformed(T_base_link))
-    return combine(parts)
+
+    def finite(p: MassProperties) -> bool:
+        return bool(np.isfinite(p.mass_kg) and np.all(np.isfinite(p.com_m))
+                    and np.all(np.isfinite(p.inertia_kg_m2)))
+
+    if all(finite(p) for p in parts):
+        total = combine(parts)
+        if finite(total):           # 1e300 kg parts overflow the sum: unknown as well
+            return total
+    return MassProperties(math.nan, np.full(3, math.nan), np.full((3, 3), math.nan))
 
 
 # --------------------------------------------------------------- checks

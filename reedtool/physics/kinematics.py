@@ -12,15 +12,18 @@ from reedtool.model import Robot
 def link_poses(robot: Robot) -> dict[str, np.ndarray]:
     """T_base_link for every link reachable from the root through the joint tree.
 
-    Unreachable links (a second root, or a cycle) are absent; structure checks report
-    those, and everything downstream simply does not see them.
+    Unreachable links (a second root, or a cycle) are absent, and so is a joint's child
+    that is not a link (S105): every key is a link of `robot`. Structure checks report
+    those, and everything downstream simply does not see them. A non-finite origin (S102)
+    gives non-finite poses below it; callers that need numbers check them.
     """
     roots = robot.root_links()
     if not roots:
         return {}
+    links = robot.link_map
     children: dict[str, list] = {}
     for joint in robot.joints:
-        if joint.parent is not None and joint.child is not None:
+        if joint.parent in links and joint.child in links:
             children.setdefault(joint.parent, []).append(joint)
     T_base = {roots[0]: np.eye(4)}
     queue = deque([roots[0]])

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from reedtool.io.fileio import MAX_MAGNITUDE
 from reedtool.model import Plugin, Robot, SourceLoc, XmlNode
 from reedtool.physics.kinematics import link_poses
 
@@ -158,10 +159,13 @@ def is_lift_drag_plugin(plugin: Plugin) -> bool:
 
 
 def _float(text: str | None) -> float:
+    """The number, NaN when absent or unreadable, inf beyond any physical quantity
+    (MAX_MAGNITUDE: 1e300 squared overflows); R316 names what is not a usable constant."""
     try:
-        return float(text) if text is not None else math.nan
+        value = float(text) if text is not None else math.nan
     except ValueError:
         return math.nan
+    return value if not abs(value) > MAX_MAGNITUDE else math.copysign(math.inf, value)
 
 
 def _int(text: str | None) -> int | None:
@@ -178,7 +182,9 @@ def _vector(text: str | None, default: tuple[float, float, float]) -> np.ndarray
         values = [float(v) for v in text.split()]
     except ValueError:
         return np.full(3, math.nan)
-    return np.array(values, dtype=float) if len(values) == 3 else np.full(3, math.nan)
+    if len(values) != 3 or not all(abs(v) <= MAX_MAGNITUDE for v in values):
+        return np.full(3, math.nan)
+    return np.array(values, dtype=float)
 
 
 def _bool(text: str | None) -> bool:

@@ -47,9 +47,9 @@ class TrimResult:
     feasible: bool
     cause: TrimCause | None
     message: str
-    thrust_N: np.ndarray            # (n,) trim thrusts; when infeasible, the unbounded
-                                    # least-squares demand (may be < 0 or above max)
-    omega_rad_s: np.ndarray         # (n,) speeds of the thrusts clipped to [0, max]
+    thrust_N: np.ndarray            # (n,) trim thrusts; when infeasible, the demand clipped
+                                    # to what each rotor can give: k*omega_rad_s^2 always
+    omega_rad_s: np.ndarray         # (n,) speeds of those thrusts
     throttle: np.ndarray            # (n,) omega / omega_max
     thrust_to_weight: float         # maximum upward thrust / weight
     hover_throttle_max: float       # max(throttle)
@@ -60,6 +60,16 @@ class TrimResult:
     condition_number: float
     weight_N: float = float("nan")
     rotor_names: tuple[str, ...] = ()
+    # (n,) the unbounded least-squares thrusts the allocation asks for (may be < 0 or
+    # above the maximum when infeasible; equal to thrust_N when feasible).
+    demand_N: np.ndarray | None = None
+    # (n,) per rotor "max" or "min" when the demand is beyond that limit (by more than
+    # round-off, BOUND_MARGIN of its range) and the rotor is shown saturated there, else
+    # None: the table says which rotors cannot comply.
+    limit: tuple[str | None, ...] = ()
+
+    def limits(self) -> list[str | None]:
+        return list(self.limit) or [None] * len(self.thrust_N)
 
     def to_dict(self) -> dict:
         return {
@@ -71,9 +81,11 @@ class TrimResult:
             "hover_throttle_max": self.hover_throttle_max,
             "rotors": [
                 {"name": name, "thrust_N": float(t), "omega_rad_s": float(w),
-                 "throttle": float(u)}
-                for name, t, w, u in zip(self.rotor_names, self.thrust_N, self.omega_rad_s,
-                                         self.throttle)],
+                 "throttle": float(u), "demand_N": float(d), "limit": limit}
+                for name, t, w, u, d, limit in zip(
+                    self.rotor_names, self.thrust_N, self.omega_rad_s, self.throttle,
+                    self.thrust_N if self.demand_N is None else self.demand_N,
+                    self.limits())],
             "residual_wrench": [float(v) for v in self.residual_wrench],
             "torque_authority_N_m": dict(zip(("roll", "pitch", "yaw"),
                                              (float(v) for v in self.torque_authority_N_m))),
@@ -122,13 +134,16 @@ def trim_from_allocation(A: np.ndarray, motor_constant: np.ndarray, omega_max_ra
 
     def result(feasible: bool, cause: TrimCause | None, message: str,
                thrust: np.ndarray) -> TrimResult:
-        clipped = np.clip(thrust, 0.0, thrust_max)
+        # Infeasible: each rotor shown at what it can give (saturated at 0 or k*w_max^2),
+        # the demand beside it; never a thrust the speed beside it cannot make.
+        clipped = np.clip(thrust, 0.0, thrust_max) + 0.0    # + 0.0: no "-0.0000 N"
         omega = np.sqrt(clipped / k)
         throttle = omega / omega_max
         authority = _authority(A_pinv, clipped, thrust_max) if feasible else np.zeros(3)
-        return TrimResult(feasible, cause, message, thrust, omega, throttle, thrust_to_weight,
+        return TrimResult(feasible, cause, message, clipped, omega, throttle, thrust_to_weight,
                           float(throttle.max()), A @ clipped - wrench, authority, A, rank, cond,
-                          weight_N, names)
+                          weight_N, names, demand_N=np.asarray(thrust, dtype=float),
+                          limit=_limits(thrust, 0.0, thrust_max))
 
     if thrust_to_weight < 1.0:
         return result(False, TrimCause.INSUFFICIENT_THRUST,
@@ -211,7 +226,7 @@ def solve_trim_6dof(mass_kg: float, com_m: np.ndarray, rotors: Sequence,
             thrust = _feasible_point(A, wrench, thrust_min + margin * span,
                                      thrust_max - margin * span, demand)
     shown = thrust if thrust is not None else demand
-    clipped = np.clip(shown, thrust_min, thrust_max)
+    clipped = np.clip(shown, thrust_min, thrust_max) + 0.0      # + 0.0: no "-0.0000 N"
     omega = np.sign(clipped) * np.sqrt(np.abs(clipped) / k)
     throttle = np.abs(omega) / omega_max
     if thrust is not None:
@@ -226,12 +241,21 @@ def solve_trim_6dof(mass_kg: float, com_m: np.ndarray, rotors: Sequence,
         cause = TrimCause.RANK_DEFICIENT if rank < 6 else TrimCause.COM_UNBALANCED
         message = (f"no thrusts within the rotors' limits give force m*g up and no torque "
                    f"(6-DoF allocation rank {rank})")
-    return TrimResult(thrust is not None, cause, message, shown, omega, throttle,
+    return TrimResult(thrust is not None, cause, message, clipped, omega, throttle,
                       thrust_to_weight, float(throttle.max()), A @ clipped - wrench,
-                      np.zeros(3), A, rank, cond, weight_N, names)
+                      np.zeros(3), A, rank, cond, weight_N, names, demand_N=shown,
+                      limit=_limits(shown, thrust_min, thrust_max))
 
 
 # ------------------------------------------------------------------- helpers
+
+def _limits(demand: np.ndarray, lo, hi: np.ndarray) -> tuple[str | None, ...]:
+    """Which limit each rotor's demand passes by more than round-off (see TrimResult.limit)."""
+    lo = np.broadcast_to(np.asarray(lo, dtype=float), np.shape(hi))
+    tol = BOUND_MARGIN * (hi - lo)
+    return tuple("max" if d > h + t else "min" if d < l - t else None
+                 for d, l, h, t in zip(demand, lo, hi, tol))
+
 
 def _inside(thrust: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:
     return bool(np.all(thrust >= lo) and np.all(thrust <= hi))

@@ -143,6 +143,7 @@ def render_layout(robot, rotors, com_m, fmt: str, title: str = "",
         shared = {}
         for m in marks:
             shared.setdefault((round(m.x_m, 4), round(m.y_m, 4)), []).append(m)
+        arm_labels: list = []       # placed last, where they overlap no other text
         for m in marks:
             X, Y = page(m.x_m, m.y_m)
             colour = "#c0392b" if m.marked else ("#1f77b4" if m.turning_sign > 0 else
@@ -155,12 +156,9 @@ def render_layout(robot, rotors, com_m, fmt: str, title: str = "",
             ax.plot([arm_from[0], arm_to[0]], [arm_from[1], arm_to[1]], color="#555555",
                     linewidth=3, zorder=2, solid_capstyle="round", gid=f"arm-{m.number}")
             arm_m = math.hypot(m.x_m - cx, m.y_m - cy)
-            ax.text((arm_from[0] + arm_to[0]) / 2, (arm_from[1] + arm_to[1]) / 2,
-                    f"{arm_m:.3g} m",
-                    fontsize=7, color="#333333", ha="center", va="center", zorder=6,
-                    bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none",
-                          "alpha": 0.8}, gid=f"armlen-{m.number}")
             group = sorted(shared[(round(m.x_m, 4), round(m.y_m, 4))], key=lambda k: -k.z_m)
+            if group[0] is m:       # coaxial rotors share one arm and one length label
+                arm_labels.append((m.number, arm_from, arm_to, f"{arm_m:.3g} m"))
             level = group.index(m)
             coax = len(group) > 1
             ax.add_patch(Circle((X, Y), m.radius_m * (1.0 + 0.12 * level), facecolor=colour,
@@ -209,11 +207,49 @@ def render_layout(robot, rotors, com_m, fmt: str, title: str = "",
         ax.set_title(title or f"{robot.name}: {len(marks)} rotors, top view "
                      f"(x forward up, y left)", fontsize=10)
         fig.tight_layout()
+        _place_arm_labels(ax, arm_labels)
         buffer = io.BytesIO()
         fig.savefig(buffer, format=fmt, dpi=110, metadata={"Date": None} if fmt == "svg"
                     else None)
         plt.close(fig)
     return buffer.getvalue()
+
+
+def _place_arm_labels(ax, arms: list) -> None:
+    """Each arm's length on its arm where it overlaps no text drawn so far: mid-arm, else
+    further out or in. Neighbouring arms of a small octocopter meet near the centre, and
+    their mid-arm labels ran into each other ("0.246 r0.246 m"). A label that fits nowhere
+    is left out when another arm shows the same length, else drawn mid-arm anyway."""
+    renderer = ax.figure.canvas.get_renderer()
+    # Text extents grown by half an em: the label's white box (pad 0.15 em) and a gap.
+    gap_px = 0.5 * 7 * ax.figure.dpi / 72
+
+    def extent(text):
+        return text.get_window_extent(renderer).padded(gap_px)
+
+    taken = [extent(t) for t in ax.texts]
+    shown: set[str] = set()
+    for number, start, end, text in arms:
+        for fraction in (0.5, 0.65, 0.8, 0.35, 0.9):
+            label = ax.text(start[0] + fraction * (end[0] - start[0]),
+                            start[1] + fraction * (end[1] - start[1]), text,
+                            fontsize=7, color="#333333", ha="center", va="center", zorder=6,
+                            bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none",
+                                  "alpha": 0.8}, gid=f"armlen-{number}")
+            box = extent(label)
+            if not any(box.overlaps(other) for other in taken):
+                break
+            label.remove()
+        else:
+            if text in shown:
+                continue
+            label = ax.text((start[0] + end[0]) / 2, (start[1] + end[1]) / 2, text,
+                            fontsize=7, color="#333333", ha="center", va="center", zorder=6,
+                            bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none",
+                                  "alpha": 0.8}, gid=f"armlen-{number}")
+            box = extent(label)
+        taken.append(box)
+        shown.add(text)
 
 
 def _spin_arrow(ax, X: float, Y: float, r: float, sign: int, colour: str, number: int) -> None:

@@ -1,0 +1,77 @@
+"""A model path -> what `view` draws: the robot with its arguments, reedtool's link poses,
+its rotors, centre of mass and (on request) the links validate's findings name, handed to
+the scene builder in report/scene.py.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from reedtool.assembly.models import ModelRequest
+from reedtool.errors import ReedtoolError
+
+SEVERITY_RANK = {"error": 0, "warning": 1, "info": 2}
+
+
+def link_severities(robot, findings) -> dict[str, str]:
+    """link -> the worst severity of the findings that name it: the link itself, a joint
+    whose child it is, or a rotor on it."""
+    from reedtool.physics.rotors import discover_rotors
+
+    names = {link.name: link.name for link in robot.links}
+    names.update({j.name: j.child for j in robot.joints if j.child in robot.link_map})
+    for rotor in discover_rotors(robot):
+        if rotor.link in robot.link_map:
+            names.setdefault(rotor.name, rotor.link)
+    worst: dict[str, str] = {}
+    for finding in findings:
+        link = names.get(finding.subject or "")
+        if link is not None and (link not in worst or
+                                 SEVERITY_RANK[finding.severity] < SEVERITY_RANK[worst[link]]):
+            worst[link] = finding.severity
+    return worst
+
+
+def com_m(robot) -> np.ndarray | None:
+    """The whole robot's centre of mass in the base frame (reedtool's sum of the declared
+    inertials), None without mass or on a broken tree (validate says why)."""
+    from reedtool.physics.inertia import whole_robot
+
+    try:
+        props = whole_robot(robot)
+    except (ValueError, KeyError, ZeroDivisionError):
+        return None
+    com = np.asarray(props.com_m, dtype=float)
+    return com if props.mass_kg > 0 and np.all(np.isfinite(com)) else None
+
+
+def view_robot(robot, *, collision: bool = False, findings=None):
+    """A loaded robot as a ViewScene (report/scene.py)."""
+    from reedtool.physics.kinematics import link_poses
+    from reedtool.physics.rotors import discover_rotors
+    from reedtool.report.scene import build_scene
+
+    if not robot.links:
+        raise ReedtoolError("the model has no links: nothing to show", file=robot.source_file,
+                            hint="pass the top-level model, not a file of macros it includes")
+    if not robot.root_links():
+        raise ReedtoolError("no root link: every link is some joint's child, so nothing "
+                            "says where the robot is", file=robot.source_file,
+                            hint="run `reedtool validate` on the model; it names the loop")
+    return build_scene(robot, link_poses(robot), discover_rotors(robot), com_m=com_m(robot),
+                       collision=collision,
+                       link_severity=link_severities(robot, findings) if findings else None)
+
+
+def view_model(model: Path, request: ModelRequest, *, collision: bool = False,
+               with_findings: bool = False):
+    """`model` with its arguments (configuration, --launch, name:=value) -> (ViewScene,
+    validate's findings on it, or None without `with_findings`)."""
+    from reedtool.assembly.assemble import load_robot_for
+    from reedtool.assembly.validation import validation_findings
+
+    robot, _ = load_robot_for(model, request, require_sound=False)
+    findings = validation_findings(model, robot, request) if with_findings else None
+    return view_robot(robot, collision=collision, findings=findings), findings
