@@ -103,7 +103,10 @@ def test_glb_is_for_gz_sim_only(tmp_path):
 def test_uri_leaving_its_package_or_into_system_files(tmp_path, uri):
     path = write_model(tmp_path, body_urdf([f'<mesh filename="{uri}"/>']))
     assert codes(path) == ["S131"]
-    assert exits(path) == (1, 1)
+    # Gazebo follows such a path on this machine: a warning (reedtool does not open it),
+    # so the run passes unless --strict.
+    assert exits(path) == (0, 0)
+    assert run_cli("validate", path, "--strict")[0] == 1
 
 
 def test_dots_inside_the_package_are_fine(tmp_path):

@@ -149,3 +149,23 @@ def test_two_packages_with_one_name_are_reported(tmp_path, copies, expected):
     assert [f.code for f in findings] == expected
     if expected:
         assert "twin_0" in findings[0].message and "twin_1" in findings[0].message
+
+
+def test_one_package_reached_through_a_symlink_is_one_package(tmp_path):
+    """S150 good: an install space whose share/twin links to the sources (colcon
+    --symlink-install, catkin's devel space) holds one package, reached twice."""
+    from reedtool.checks.runner import Selection, run_checks
+    from reedtool.io.loader import load_robot
+
+    model = _twin_workspace(tmp_path, 1)
+    share = tmp_path / "src" / "install" / "share"
+    share.mkdir(parents=True)
+    (share / "twin").symlink_to(tmp_path / "src" / "twin_0", target_is_directory=True)
+    robot = load_robot(model, {}, [tmp_path / "src"])
+    assert [f.code for f in run_checks(robot, Selection(select=("S",)))] == []
+    # Control: a real copy in the same place is still two packages.
+    (share / "twin").unlink()
+    import shutil
+    shutil.copytree(tmp_path / "src" / "twin_0", share / "twin")
+    robot = load_robot(model, {}, [tmp_path / "src"])
+    assert [f.code for f in run_checks(robot, Selection(select=("S",)))] == ["S150"]

@@ -76,3 +76,30 @@ def test_uneven_trim_with_one_long_arm(tmp_path, extra_m, fires):
         sum_x, sum_y = x - 0.174, 0.174 - y
         shift = [s * (1 / 4 - rotor_kg / total_kg) for s in (sum_x, sum_y)]
         assert f"({shift[0]:+.4g}, {shift[1]:+.4g})" in findings[0].hint
+
+
+@pytest.mark.parametrize("ratio", [9.1, 15.0, 24.0])
+def test_racing_thrust_to_weight_is_not_suspicious(tmp_path, ratio):
+    """R340 good: thrust-to-weight 9.1 (PX4's omnicopter), 15 (a racing quad), 24. The
+    ratio grows with speed squared, so the x500's speed times sqrt(ratio / its ratio)."""
+    mass = 2.0 + 4 * 0.0160769
+    base = 4 * 8.54858e-06 * 1000.0 ** 2 / (mass * G)          # 1.69 at 1000 rad/s
+    omega_rad_s = 1000.0 * math.sqrt(ratio / base)
+    text = SDF.replace("<maxRotVelocity>1000.0", f"<maxRotVelocity>{omega_rad_s:.3f}")
+    assert codes(findings_of(tmp_path, text)) == []
+    # ... and just above the bound it warns (the same model, ratio 26).
+    text = SDF.replace("<maxRotVelocity>1000.0",
+                       f"<maxRotVelocity>{1000.0 * math.sqrt(26.0 / base):.3f}")
+    assert codes(findings_of(tmp_path, text)) == ["R340"]
+
+
+def test_coaxial_rotors_have_no_span_to_judge(tmp_path):
+    """Every rotor within 5 mm of the body's vertical (a coaxial helicopter, the Sikorsky
+    X2's shape): 2.06 kg over a 10 mm span cube would be 2e6 kg/m³; I220 stays quiet."""
+    text = SDF
+    for x, y in (("0.174", "-0.174"), ("-0.174", "0.174"), ("0.174", "0.174"),
+                 ("-0.174", "-0.174")):
+        sx, sy = ("" if x[0] != "-" else "-"), ("" if y[0] != "-" else "-")
+        text = text.replace(f"{x} {y} 0.06", f"{sx}0.0035 {sy}0.0035 0.06")
+    assert text.count("0.0035") == 8
+    assert "I220" not in codes(findings_of(tmp_path, text))

@@ -31,7 +31,8 @@ CASES = [
     ("../vtol/R311_bad_single_tilt.sdf", ["R311", "R319"]),
     ("../vtol/vtol_motor_number_alias.sdf", ["R319"]),
     ("../rotors_neo/neo_balanced_tilt.sdf", ["R320"]),
-    ("../rotors_neo/omav_tilt_servos.sdf", []),
+    # Its rotors ride on the tilt servos: not judged at the zero pose (R319, information).
+    ("../rotors_neo/omav_tilt_servos.sdf", ["R319"]),
     ("../vtol/tailsitter_tangential_tilt.sdf", ["R320"]),
     ("../omni/omni_reversible.sdf", ["R319"]),
     # The R319/R320 pair: a pusher and a balanced tilt are information (their bad fixtures).
@@ -386,3 +387,19 @@ def test_hover_test_refuses_ardupilot_pid_with_integral_term(tmp_path, capsys):
     assert info.value.code == 2
     assert "integral term (i_gain 0.5)" in err and "second order" in err
     assert "Traceback" not in err and len(err.strip().splitlines()) <= 2
+
+
+def test_ardupilot_rotor_spun_about_another_axis_is_r341_not_r318(tmp_path):
+    """SITL_Models' alti_transition_quad's shape: the forward motor's joint turns about the
+    vertical while its blades face forward. With the joint 90° from the thrust axis there is
+    no spin direction about the thrust axis to compare: R341 (warning) says what is wrong,
+    R318 says nothing. The R318 bad fixture's flipped rotor 2, its joint turned to x:"""
+    text = (FIXTURES / "ardupilot/R318_bad_multiplier_sign.sdf").read_text()
+    at = text.index('<joint name="rotor_2_joint"')
+    at = text.index("<xyz>0 0 1</xyz>", at)
+    text = text[:at] + "<xyz>1 0 0</xyz>" + text[at + len("<xyz>0 0 1</xyz>"):]
+    path = tmp_path / "model.sdf"
+    path.write_text(text)
+    found = [(f.code, f.subject) for f in run_checks(load_robot(path))
+             if f.code in ("R318", "R341")]
+    assert found == [("R341", "rotor_2_joint")]

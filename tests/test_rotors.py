@@ -61,8 +61,12 @@ def test_three_plugin_families_and_tilt():
     assert rotors["rotor_c"].direction == "sideways"
     # Exact: the same expression, k * w_max ** 2, evaluated the same way.
     assert rotors["rotor_b"].max_thrust_N == 2e-5 * 900 ** 2
-    # PX4 interface: two rotor channels, the gimbal channel is not a rotor.
-    assert [d.rotor_count for d in declared_rotor_counts(robot)] == [2]
+    # PX4 classic's interface declares no rotor count (its channels are outputs, R302
+    # checks the motors' numbers against them); only RotorS's <rotor_count> does.
+    assert [d.rotor_count for d in declared_rotor_counts(robot)] == []
+    from reedtool.physics.rotors import command_vector
+    vector = command_vector(robot)
+    assert vector is not None and 0 in vector.indices
     # Tilted rotor's column: force along the axis, torque = r x a - s c_m a.
     B = allocation_matrix([a], np.zeros(3))
     axis = np.array([np.sin(0.3), 0, np.cos(0.3)])

@@ -27,3 +27,25 @@ def test_every_rule_is_documented_once():
         assert text.count(f"\n### {rule.code} {rule.slug}\n") == 1
         assert len(rule.explanation) > 80, f"{rule.code} needs a real explanation"
         assert "\n" not in rule.summary
+
+
+def test_every_rule_states_its_severity_clause():
+    """The severity policy (docs/validate.md): each rule names the clause that gives its
+    default severity, the clause allows that severity, and docs/rules.md shows it."""
+    from reedtool.checks.registry import POLICY_CLAUSES
+
+    text = render()
+    for rule in all_rules():
+        allowed, wording = POLICY_CLAUSES[rule.clause]
+        assert rule.severity in allowed, rule.code
+        # ... and its docstring says why, in its own words.
+        assert f"Severity ({rule.severity}" in rule.explanation, rule.code
+        assert f"| {rule.severity} | {rule.clause} |" in text
+        assert f"*Default severity: {rule.severity}* ({rule.clause}: {wording})" in text
+    # The policy's error clauses are few on purpose; every warning-or-softer rule that can
+    # meet a convention says so in words.
+    assert {r.clause for r in all_rules()} == set(POLICY_CLAUSES)
+    validate_md = (DOCS_RULES_MD.parent / "validate.md").read_text(encoding="utf-8")
+    assert "## Severity policy" in validate_md
+    for key in POLICY_CLAUSES:
+        assert f"**{key}**" in validate_md

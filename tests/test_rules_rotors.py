@@ -108,3 +108,25 @@ def test_every_sir_rule_has_a_bad_and_a_good_fixture():
         own = [expected for name, expected in tables if Path(name).name.startswith(rule.code + "_bad")]
         assert own and all(rule.code in e for e in own), rule.code
     assert any(not expected for _name, expected in tables)  # good fixtures exist
+
+
+@pytest.mark.parametrize("lower, upper, fires", [
+    ("-1e-16", "1e+16", False),    # mini_talon_vtail's typo: open on the side it turns
+    ("-1e+16", "1e-16", True),     # open only the other way: it stops at once
+    ("-1", "1", True),             # a limited revolute joint
+    ("-1e+12", "1e+12", False),    # SwiftGust's Sikorsky X2 blades: never reached
+])
+def test_revolute_rotor_joint_open_in_its_direction(tmp_path, lower, upper, fires):
+    """x500's rotor 0 turns ccw: the motor model drives its joint at +omega, so only the
+    upper limit matters."""
+    x500 = Path(__file__).parent / "fixtures" / "flightstack" / "x500_flat.sdf"
+    text = x500.read_text()
+    at = text.index('<joint name="rotor_0_joint"')
+    old = "<limit><lower>-1e+16</lower><upper>1e+16</upper></limit>"
+    at = text.index(old, at)
+    text = text[:at] + f"<limit><lower>{lower}</lower><upper>{upper}</upper></limit>" + \
+        text[at + len(old):]
+    path = tmp_path / "x500.sdf"
+    path.write_text(text)
+    found = [f.subject for f in run_checks(load_robot(path)) if f.code == "R313"]
+    assert found == (["rotor_0_joint"] if fires else [])

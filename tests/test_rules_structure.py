@@ -39,12 +39,29 @@ CASES = [
     ("S131_bad_traversal.urdf", ["S131"]),
     ("S116_bad_zero_size.urdf", ["S116"]),
     ("S117_bad_no_inertial.urdf", ["S117"]),
-    # 1e-7 kg with the 0.5 kg link's inertia is also implausible for its geometry.
-    ("S117_bad_tiny_mass.urdf", ["I209", "S117"]),
+    # 1e-7 kg with the 0.5 kg link's inertia is also implausible for its geometry (a
+    # warning: the arm's tensor does not decide the robot's inertia).
+    ("S117_bad_tiny_mass.urdf", ["I204", "S117"]),
     ("S118_bad_merged_link.urdf", ["S118"]),
     ("S118_good_body_name_lumped.urdf", []),
     ("S119_bad_tinyxml_only.sdf", ["S119"]),
     ("S119_good_strict.sdf", []),
+    # URDF is read through sdformat's URDF parser, TinyXML2 as well.
+    ("S119_bad_tinyxml_only.urdf", ["S119"]),
+    # SDF models are held to SDFormat's joint types (ball, screw, universal, ...).
+    ("S110_good_sdf_ball_joint.sdf", []),
+    # An SDF link without <inertial> is 1 kg to sdformat: a warning, not a parse error.
+    ("S120_bad_no_inertial.sdf", ["S120"]),
+    # A negative mesh scale mirrors: the convention for a visual (information), a warning
+    # on a collision (faces inside out); only a zero scale is S116.
+    ("S121_bad_mirrored_visual.urdf", ["S121"]),
+    ("S122_bad_mirrored_collision.urdf", ["S122"]),
+    # 1.6's <use_parent_model_frame> in a 1.7 file: ignored, as libsdformat does.
+    ("S123_bad_parent_frame_in_1_7.sdf", ["S123"]),
+    # A comment before the XML declaration: read (S119), and gz-sim would refuse it (S124).
+    ("S124_bad_comment_before_declaration.sdf", ["S119", "S124"]),
+    # A 3-number <pose>: libsdformat 9 reads a position, 12+ refuses (S125, not S101).
+    ("S125_bad_short_pose.sdf", ["S125", "S125"]),
     # Good fixtures: the arm has a zero-mass fixed tool frame (fine), a plugin on a fixed
     # link kept by preserveFixedJoint, a limited revolute joint; the car a mesh in metres.
     ("clean_arm.urdf", []),

@@ -22,6 +22,7 @@ from reedtool.physics.kinematics import link_poses
 from reedtool.physics.rotors import discover_rotors
 
 GZ = Path(__file__).parent / "fixtures" / "gz"
+FIXTURES_VALIDATE = Path(__file__).parent / "fixtures" / "validate"
 S45 = math.sin(math.radians(45))
 S10, C10 = math.sin(math.radians(10)), math.cos(math.radians(10))
 
@@ -166,8 +167,9 @@ def test_missing_inertial_gets_sdformat_defaults_and_a_finding():
     assert robot.link_map["a"].inertial.mass_kg == 1.0
     # Exact: the declared numbers, read (default rtol 1e-7 is only a ceiling).
     np.testing.assert_allclose(robot.link_map["a"].inertial.inertia_kg_m2, np.eye(3))
+    # Valid SDF that Gazebo loads with 1 kg: a warning (S120), not a parse error.
     codes = [f.code for f in run_checks(robot, Selection(select=("S1",)))]
-    assert codes == ["S101"]
+    assert codes == ["S120"]
 
 
 def test_world_picks_the_non_static_model(tmp_path):
@@ -247,3 +249,37 @@ def test_hover_test_and_inertia_work_on_gz_models_unchanged(model):
     assert len(omegas) == 4 and np.allclose(omegas, omega, rtol=1e-9)
     inertia = CliRunner().invoke(cli, ["inertia", path, "--format", "json"])
     assert inertia.exit_code == 0, inertia.output
+
+
+@pytest.mark.parametrize("version, axis_in_base", [("1.7", [-1, 0, 0]), ("1.6", [0, 0, 1])])
+def test_use_parent_model_frame_counts_only_where_the_version_defines_it(version, axis_in_base):
+    """In 1.6 it puts the axis in the model frame (body z); a 1.7 file's is ignored, so the
+    axis stays in the joint frame: the wheel link's z, pitched -90° onto body -x."""
+    from reedtool.physics.kinematics import link_poses
+
+    text = (FIXTURES_VALIDATE / "S123_bad_parent_frame_in_1_7.sdf").read_text().replace(
+        '<sdf version="1.7">', f'<sdf version="{version}">')
+    robot = parse_sdf(text, "m.sdf")
+    joint = robot.joint_map["wheel_joint"]
+    axis = link_poses(robot)["wheel"][:3, :3] @ joint.axis
+    np.testing.assert_allclose(axis, axis_in_base, atol=1e-9)
+    kinds = [i.kind for i in robot.parse_issues]
+    assert kinds == (["sdf-undefined-element"] if version == "1.7" else [])
+
+
+def test_three_number_pose_is_a_position_as_libsdformat_9_reads_it(tmp_path):
+    """GymFC's nf1 shape: "0 0 0.007083" and "0 0 0.0185" place the links 7.1 and 18.5 mm
+    up, no rotation: the battery sits 11.417 mm above the frame. With a Gazebo classic
+    plugin (the model's target) nothing is reported."""
+    from reedtool.checks.runner import run_checks
+    from reedtool.physics.kinematics import link_poses
+
+    text = (FIXTURES_VALIDATE / "S125_bad_short_pose.sdf").read_text()
+    robot = parse_sdf(text, tmp_path / "m.sdf")
+    np.testing.assert_allclose(link_poses(robot)["battery"], np.array(
+        [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0.0185 - 0.007083], [0, 0, 0, 1]]), atol=1e-15)
+    classic = text.replace("  </model>", '    <plugin name="imu" filename="libgazebo_imu_plugin.so"/>\n  </model>')
+    path = tmp_path / "classic.sdf"
+    path.write_text(classic)
+    from reedtool.io.loader import load_robot
+    assert [f.code for f in run_checks(load_robot(path))] == []

@@ -25,8 +25,9 @@ SHAPES = Path(__file__).parent / "fixtures" / "upstream_shapes"
 CASES = [
     ("fixed_wing_puller", ["R319"]),
     ("R316_bad_fixed_wing_negative_k", ["R316", "R319"]),
-    ("tiltrotor", []),
-    ("I209_bad_tiltrotor_motor_inertia", ["I209", "I209"]),
+    # Rotors 0 and 2 ride on tilt motors: no hover judgement at the zero pose (R319 says so).
+    ("tiltrotor", ["R319"]),
+    ("I204_bad_tiltrotor_motor_inertia", ["I204", "I204", "R319"]),
     ("rotors_plus_quad", []),
     ("R304_bad_rotors_plus_quad_flipped", ["R304"]),
     ("quad_tailsitter", ["R320"]),
@@ -258,3 +259,48 @@ def test_fixed_wing_with_classic_lift_drag_wing_is_also_propulsion(tmp_path):
     model = tmp_path / "cessna_like.sdf"
     model.write_text(text[:start] + wing + text[end:])
     assert sorted(f.code for f in run_checks(load_robot(model))) == ["R319"]
+
+
+# ------------------------------------------------- rotors on actuated joints
+
+def _legged_quad(joint_type: str) -> str:
+    """SITL_Models' hexapod_copter shape, as a quad: each rotor on a leg link whose joint
+    (revolute, driven by a servo in flight) holds it sideways at the zero pose."""
+    links, plugins = [], []
+    for i, (x, y) in enumerate([(0.2, -0.2), (-0.2, 0.2), (0.2, 0.2), (-0.2, -0.2)]):
+        links.append(f"""
+    <link name="leg_{i}"><pose>{x} {y} 0 0 0 0</pose>
+      <inertial><mass>0.05</mass><inertia><ixx>1e-5</ixx><ixy>0</ixy><ixz>0</ixz><iyy>1e-5</iyy><iyz>0</iyz><izz>1e-5</izz></inertia></inertial>
+      <collision name="c"><geometry><box><size>0.03 0.03 0.03</size></box></geometry></collision></link>
+    <joint name="leg_{i}_joint" type="{joint_type}"><parent>base_link</parent><child>leg_{i}</child>
+      <axis><xyz>1 0 0</xyz><limit><lower>-1.6</lower><upper>1.6</upper></limit></axis></joint>
+    <link name="rotor_{i}"><pose>{x} {y} 0.05 0 1.5707963 0</pose>
+      <inertial><mass>0.005</mass><inertia><ixx>1e-6</ixx><ixy>0</ixy><ixz>0</ixz><iyy>1e-6</iyy><iyz>0</iyz><izz>2e-6</izz></inertia></inertial>
+      <collision name="c"><geometry><cylinder><length>0.005</length><radius>0.03</radius></cylinder></geometry></collision></link>
+    <joint name="rotor_{i}_joint" type="revolute"><parent>leg_{i}</parent><child>rotor_{i}</child>
+      <axis><xyz>0 0 1</xyz><limit><lower>-1e16</lower><upper>1e16</upper></limit></axis></joint>""")
+        plugins.append(f"""
+    <plugin filename="gz-sim-multicopter-motor-model-system" name="gz::sim::systems::MulticopterMotorModel">
+      <jointName>rotor_{i}_joint</jointName><linkName>rotor_{i}</linkName>
+      <turningDirection>{'ccw' if i < 2 else 'cw'}</turningDirection><maxRotVelocity>1000</maxRotVelocity>
+      <motorConstant>8.54858e-06</motorConstant><momentConstant>0.016</momentConstant>
+      <actuator_number>{i}</actuator_number></plugin>""")
+    return f"""<?xml version="1.0"?>
+<sdf version="1.9"><model name="legged">
+    <link name="base_link">
+      <inertial><mass>1.5</mass><inertia><ixx>0.01</ixx><ixy>0</ixy><ixz>0</ixz><iyy>0.01</iyy><iyz>0</iyz><izz>0.02</izz></inertia></inertial>
+      <collision name="c"><geometry><box><size>0.3 0.3 0.1</size></box></geometry></collision></link>{''.join(links)}{''.join(plugins)}
+</model></sdf>
+"""
+
+
+def test_rotors_on_actuated_legs_are_not_judged_at_the_zero_pose(tmp_path):
+    path = tmp_path / "legged.sdf"
+    path.write_text(_legged_quad("revolute"))
+    findings = run_checks(load_robot(path))
+    assert [(f.code, f.severity) for f in findings] == [("R319", "info")]
+    assert "leg_0_joint" in findings[0].message
+    # Control: with the legs welded (fixed joints) the same sideways rotors cannot lift.
+    path.write_text(_legged_quad("fixed"))
+    errors = {f.code for f in run_checks(load_robot(path)) if f.severity == "error"}
+    assert errors & {"R305", "R307", "R308"}

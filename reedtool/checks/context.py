@@ -155,6 +155,28 @@ class CheckContext:
         return [r for r in self.rotors if r.role == "lift"]
 
     @cached_property
+    def articulated_rotors(self) -> dict[str, str]:
+        """Lift rotor name -> the first moving joint between it and the base other than its
+        own spin joint (a tilt servo, a folding arm, a leg). Such a rotor's flight pose is
+        set by that joint; the zero pose the hover rules would judge is not the vehicle's."""
+        out: dict[str, str] = {}
+        for rotor in self.lift_rotors:
+            spin = self.robot.joint_map.get(rotor.joint or "")
+            link = spin.parent if spin is not None else None
+            seen = set()
+            while link is not None and link not in seen:
+                seen.add(link)
+                joint = self.parent_joint(link)
+                if joint is None:
+                    break
+                if joint.moves and joint.limit is not None \
+                        and joint.limit.upper - joint.limit.lower > 1e-9:
+                    out[rotor.name] = joint.name
+                    break
+                link = joint.parent
+        return out
+
+    @cached_property
     def omnidirectional(self) -> bool:
         """Reversible or every-direction rotors: hover uses the 6-DoF allocation."""
         from reedtool.physics.rotors import is_omnidirectional
@@ -225,6 +247,44 @@ class CheckContext:
         from reedtool.physics.inertia import compare_links
 
         return compare_links(self.robot)
+
+    @cached_property
+    def lumped_links(self) -> set[str]:
+        """URDF links Gazebo merges into their parent (physics.inertia.lumped_urdf_links)."""
+        from reedtool.physics.inertia import lumped_urdf_links
+
+        return lumped_urdf_links(self.robot)
+
+    def lumped_tensor(self, link_name: str):
+        """Inertia tensor (about its COM) of the body Gazebo makes of `link_name` and the
+        links merged with it (fixed joints lumped into their parent); None without poses."""
+        from reedtool.physics.inertia import combine, declared_mass_properties
+
+        poses = self.link_poses
+        if link_name not in poses:
+            return None
+
+        def group_root(name: str) -> str:
+            while name in self.lumped_links:
+                name = self.parent_joint(name).parent
+            return name
+
+        root = group_root(link_name)
+        T_root_base = np.linalg.inv(poses[root])
+        parts = []
+        for link in self.robot.links:
+            declared = declared_mass_properties(link)
+            if declared is None or link.name not in poses or group_root(link.name) != root:
+                continue
+            parts.append(declared.transformed(T_root_base @ poses[link.name]))
+        return combine(parts).inertia_kg_m2 if parts else None
+
+    @cached_property
+    def placeholder_links(self) -> set[str]:
+        """Links too light to change how the robot flies (physics.inertia.placeholder_links)."""
+        from reedtool.physics.inertia import placeholder_links
+
+        return placeholder_links(self.robot) if self.tree_ok else set()
 
     def geometry_mass_properties(self, link: Link):
         """Mass properties of the link's own geometry at its declared mass, in the link frame.

@@ -108,12 +108,15 @@ def _relative_gap(a: float, b: float) -> float:
 # --------------------------------------------------------------- table shape
 
 @rule("C401", "controller-rotor-count", "error",
-      "A controller rotor table has a different number of rotors than the model.")
+      "A controller rotor table has a different number of rotors than the model.", clause="flight-stack")
 def controller_rotor_count(ctx: CheckContext) -> Iterator[Issue]:
     """The controller's allocation matrix has one column per table entry and it sends that
     many motor speeds. With fewer entries than motors, some motors never receive a
     command; with more, the controller allocates thrust to rotors that do not exist.
     Either way the vehicle cannot hover level.
+
+    Severity (error, flight-stack): the controller commands another number of rotors
+    than the model has.
     """
     rotors = ctx.rotors
     for table in _tables(ctx):
@@ -125,12 +128,15 @@ def controller_rotor_count(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C402", "controller-rotor-joint-unknown", "error",
-      "A velocity-control rotor names a joint that has no motor plugin.")
+      "A velocity-control rotor names a joint that has no motor plugin.", clause="flight-stack")
 def controller_rotor_joint_unknown(ctx: CheckContext) -> Iterator[Issue]:
     """gz-sim's MulticopterVelocityControl finds each rotor by `<jointName>` and computes
     its arm from that joint's pose. A joint that does not exist makes gz-sim skip the
     rotor (and the allocation loses a column); a joint without a MulticopterMotorModel
     gets commands no motor turns into thrust.
+
+    Severity (error, flight-stack): the controller commands a motor the model does not
+    have.
     """
     motor_joints = {r.joint for r in ctx.rotors if r.joint}
     for table in _tables(ctx):
@@ -156,11 +162,13 @@ def controller_rotor_joint_unknown(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C403", "controller-rotor-order", "error",
-      "A velocity-control rotor's position in the table is not its motor number.")
+      "A velocity-control rotor's position in the table is not its motor number.", clause="flight-stack")
 def controller_rotor_order(ctx: CheckContext) -> Iterator[Issue]:
     """The controller publishes one speed per table entry, in table order; the motor plugin
     with `<motorNumber>k` spins at speed k. Entry i must therefore name the joint of the
     motor whose motorNumber is i, or every speed goes to the wrong rotor.
+
+    Severity (error, flight-stack): the controller commands the wrong motor.
     """
     for table in _tables(ctx):
         if table.source != "velocity-control":
@@ -175,13 +183,15 @@ def controller_rotor_order(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C411", "controller-entry-invalid", "error",
-      "A controller table entry is missing a value or cannot be read.")
+      "A controller table entry is missing a value or cannot be read.", clause="refused")
 def controller_entry_invalid(ctx: CheckContext) -> Iterator[Issue]:
     """Every entry needs all of its values: jointName, forceConstant, momentConstant and
     direction for gz-sim (which skips an incomplete rotor), and angle, arm_length,
     rotor_force_constant, rotor_moment_constant and direction for RotorS (which keeps its
     default for a missing one). RotorS reads rotor_configuration '0', '1', ... and stops at
     the first missing index, so entries after a gap are never read. Directions are +1 or -1.
+
+    Severity (error, refused): the controller cannot read its table and does not start.
     """
     for table in ctx.controller_tables:
         for message, loc in table.problems:
@@ -194,11 +204,13 @@ def controller_entry_invalid(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C412", "controller-com-link-missing", "error",
-      "MulticopterVelocityControl's comLinkName is missing or names no link.")
+      "MulticopterVelocityControl's comLinkName is missing or names no link.", clause="refused")
 def controller_com_link_missing(ctx: CheckContext) -> Iterator[Issue]:
     """`<comLinkName>` is the body frame gz-sim measures rotor arms in and reads the
     vehicle state from, almost always the base link. Without it, or when it names no
     link, the controller does not start.
+
+    Severity (error, refused): the velocity-control system does not load.
     """
     for table in ctx.controller_tables:
         if table.source != "velocity-control":
@@ -216,13 +228,16 @@ def controller_com_link_missing(ctx: CheckContext) -> Iterator[Issue]:
 # --------------------------------------------------------------- per rotor
 
 @rule("C404", "controller-direction-mismatch", "error",
-      "A controller entry's direction disagrees with the motor's turningDirection.")
+      "A controller entry's direction disagrees with the motor's turningDirection.", clause="flight-stack")
 def controller_direction_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     """direction +1 means counter-clockwise seen from above (turningDirection `ccw`), -1
     clockwise; this is the convention of both RotorS (rotor_configuration `direction`)
     and gz-sim (`<direction>`), whose allocation matrices use -direction * k_F * k_M for
     the yaw row. A flipped sign makes the controller push yaw the wrong way with that
     rotor: the vehicle spins up in yaw on take-off.
+
+    Severity (error, flight-stack): the controller spins the motor's torque the other
+    way in its yaw allocation.
     """
     for table in _tables(ctx):
         for entry, rotor in _pairs(ctx, table):
@@ -259,13 +274,16 @@ def _angle_hint(ctx: CheckContext, entry: "ControllerRotor", model_rad: float,
 
 
 @rule("C405", "controller-angle-mismatch", "error",
-      "A controller entry's rotor angle disagrees with where the rotor is.")
+      "A controller entry's rotor angle disagrees with where the rotor is.", clause="flight-stack")
 def controller_angle_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     """RotorS's rotor_configuration `angle` [rad] is the rotor's bearing in the body
     xy-plane, measured from +x (forward) towards +y (left), i.e. counter-clockwise seen
     from above. The controller's roll and pitch columns are sin(angle) and -cos(angle)
     times the arm: a wrong angle commands roll when pitch is wanted, and the vehicle
     drifts or flips. Compared in the base frame with a tolerance of 0.5°.
+
+    Severity (error, flight-stack): the controller gives the rotor roll and pitch torque
+    of the wrong sign.
     """
     for table in _tables(ctx):
         for entry, rotor in _pairs(ctx, table):
@@ -283,13 +301,16 @@ def controller_angle_mismatch(ctx: CheckContext) -> Iterator[Issue]:
                     hint=_angle_hint(ctx, entry, model_rad, entry.angle_rad))
 
 
-@rule("C406", "controller-arm-length-mismatch", "error",
-      "A controller entry's arm length disagrees with where the rotor is.")
+@rule("C406", "controller-arm-length-mismatch", "warning",
+      "A controller entry's arm length disagrees with where the rotor is.", clause="suspicious")
 def controller_arm_length_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     """`arm_length` [m] is the rotor's distance from the body frame origin in the body
     xy-plane (the height of the rotor above the frame does not count). The controller
     scales roll and pitch torque with it: a wrong arm gives a wrong attitude gain on that
     axis. Tolerance: 1 mm or 1 %, whichever is larger.
+
+    Severity (warning): the torque keeps its sign, only its gain changes, so the vehicle
+    flies (C405 is the error: a rotor at another angle gets torque of the wrong sign).
     """
     for table in _tables(ctx):
         for entry, rotor in _pairs(ctx, table):
@@ -325,12 +346,15 @@ def _constant_issues(ctx: CheckContext, attr: str, rotor_attr: str, param: str,
 
 
 @rule("C407", "controller-force-constant-mismatch", "warning",
-      "A controller entry's force constant differs from the motor's motorConstant.")
+      "A controller entry's force constant differs from the motor's motorConstant.", clause="suspicious")
 def controller_force_constant_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     """The controller turns wanted thrust into rotor speed with its force constant; the
     motor turns speed into thrust with `motorConstant` [N/(rad/s)²]. If they differ by
     more than 1 %, the vehicle hovers off its commanded height and its attitude gains are
     scaled.
+
+    Severity (warning, suspicious): a force constant scales the controller's gains, it
+    does not flip a sign.
     """
     yield from _constant_issues(ctx, "force_constant", "motor_constant", "motorConstant",
                                 {"yaml": "rotor_force_constant",
@@ -338,11 +362,14 @@ def controller_force_constant_mismatch(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C408", "controller-moment-constant-mismatch", "warning",
-      "A controller entry's moment constant differs from the motor's momentConstant.")
+      "A controller entry's moment constant differs from the motor's momentConstant.", clause="suspicious")
 def controller_moment_constant_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     """The yaw drag torque is momentConstant [m] times thrust. A controller that assumes
     another value gets the wrong yaw authority: sluggish or oscillating heading.
     Tolerance 1 %.
+
+    Severity (warning, suspicious): a moment constant scales the yaw gain, it does not
+    flip a sign.
     """
     yield from _constant_issues(ctx, "moment_constant", "moment_constant", "momentConstant",
                                 {"yaml": "rotor_moment_constant",
@@ -352,12 +379,15 @@ def controller_moment_constant_mismatch(ctx: CheckContext) -> Iterator[Issue]:
 # --------------------------------------------------------------- vehicle
 
 @rule("C409", "controller-mass-mismatch", "warning",
-      "A controller's vehicle mass differs from the model's total mass.")
+      "A controller's vehicle mass differs from the model's total mass.", clause="suspicious")
 def controller_mass_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     """The controller's feed-forward thrust is mass x g. When its mass differs from the sum
     of the model's link masses by more than 1 %, the vehicle sinks or climbs until an
     integrator (if any) catches up, and position gains are scaled. RotorS ships parameter
     files with the base link's mass only; the model's total includes rotors and sensors.
+
+    Severity (warning, suspicious): a mass scales the controller's feed-forward;
+    integrators absorb it.
     """
     for table in _tables(ctx):
         if table.mass_kg is None or not math.isfinite(table.mass_kg):
@@ -371,12 +401,15 @@ def controller_mass_mismatch(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C410", "controller-inertia-mismatch", "warning",
-      "A controller's inertia differs from the model's whole-robot inertia.")
+      "A controller's inertia differs from the model's whole-robot inertia.", clause="suspicious")
 def controller_inertia_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     """The controller's `inertia` is the whole vehicle's tensor about its centre of mass in
     body axes [kg·m²]; attitude control feeds forward with it. Each element is compared
     with the model's (all links at zero joint positions), within 10 % of that diagonal
     moment (off-diagonal: of the largest one).
+
+    Severity (warning, suspicious): an inertia scales the attitude gains; it does not
+    flip a sign.
     """
     for table in _tables(ctx):
         I_c = table.inertia_kg_m2

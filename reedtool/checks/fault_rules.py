@@ -56,7 +56,7 @@ def _order(rotors, signs) -> str:
 
 
 @rule("R350", "spin-order-not-fault-tolerant", "info",
-      "No single rotor failure leaves full control, but another spin order would.")
+      "No single rotor failure leaves full control, but another spin order would.", clause="explains")
 def spin_order_not_fault_tolerant(ctx: CheckContext) -> Iterator[Issue]:
     """A multirotor with six or more rotors has spare actuators, yet with the common
     alternating spin order (ccw, cw, ccw, ...) of a hexacopter, losing any one rotor
@@ -72,6 +72,9 @@ def spin_order_not_fault_tolerant(ctx: CheckContext) -> Iterator[Issue]:
     assignment (up to eight rotors), ranked by how many failures it survives and then by
     its worst ACAI. Changing the spin order means changing the propellers and the
     flight stack's mixer together.
+
+    Severity (info, explains): a spin order is a choice; it says which one would survive
+    a motor failure.
     """
     rotors = _rotors(ctx)
     if not MIN_ROTORS <= len(rotors) <= MAX_ROTORS_SEARCHED or not _physics_ready(ctx):

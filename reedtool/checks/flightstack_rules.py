@@ -41,6 +41,7 @@ if TYPE_CHECKING:
 BEARING_TOL_DEG = 20.0          # allocation signs survive a bearing error up to this
 POSITION_INFO_M = 0.005          # smaller position differences are not worth a line
 AXIS_TOL_DEG = 10.0
+AXIS_ERROR_DEG = 60.0           # beyond: less than half the thrust goes where PX4 expects
 RANGE_REL_TOL = 1e-3
 KM_REL_TOL = 0.01
 HOVER_THROTTLE_TOL = 0.15
@@ -109,9 +110,20 @@ def _ardupilot(ctx: CheckContext) -> list["ArduPilotParams"]:
     return [p for p in ctx.flight_params if p.kind == "ardupilot"] if ctx.tree_ok else []
 
 
+def _px4_kind(params: "Px4Params"):
+    """The effectiveness class CA_AIRFRAME selects, when it reads a rotor table."""
+    from reedtool.flightstack.px4 import effectiveness
+
+    kind = effectiveness(params)
+    return kind if kind is not None and kind.rotor_table else None
+
+
 def _px4_pairs(ctx: CheckContext, params: "Px4Params"
                ) -> list[tuple["Px4Rotor", int, "Rotor"]]:
-    """(CA rotor, gz output k, model rotor on actuator k-1) for every connected pair."""
+    """(CA rotor, gz output k, model rotor on actuator k-1) for every connected pair; none
+    when CA_AIRFRAME selects no rotor table (rovers, helicopters)."""
+    if _px4_kind(params) is None:
+        return []
     by_actuator = {_actuator(r): r for r in _all_rotors(ctx) if _actuator(r) is not None}
     pairs = []
     for ca in params.rotors():
@@ -125,33 +137,38 @@ def _px4_pairs(ctx: CheckContext, params: "Px4Params"
 # --------------------------------------------------------------- PX4: table shape
 
 @rule("C413", "px4-rotor-count", "error",
-      "CA_ROTOR_COUNT differs from the number of rotors in the model.")
+      "CA_ROTOR_COUNT differs from the number of rotors in the model.", clause="flight-stack")
 def px4_rotor_count(ctx: CheckContext) -> Iterator[Issue]:
     """PX4's control allocation builds one effectiveness column per CA rotor. With fewer
     CA rotors than motors in the model, some motors are never commanded; with more, PX4
     allocates thrust to rotors that do not exist. Either way the vehicle cannot hover.
     A missing CA_ROTOR_COUNT is PX4's default 0. Pushers and pullers count: PX4 lists
     every rotor (a standard VTOL has five).
+
+    Severity (error, flight-stack): PX4 allocates thrust to rotors the model does not
+    have, or leaves some unused.
     """
     rotors = _all_rotors(ctx)
     for params in _px4(ctx):
         count = params.get("CA_ROTOR_COUNT")
-        if not rotors or count.value == len(rotors):
+        if not rotors or count.value == len(rotors) or _px4_kind(params) is None:
             continue
         where = ", ".join(str(r.loc) for r in rotors[:4]) + (", ..." if len(rotors) > 4 else "")
-        written = f"({count.loc})" if count.explicit else "(not set: PX4's default)"
-        yield Issue(f"CA_ROTOR_COUNT {count.value:g} {written}, but the model has "
+        yield Issue(f"{count.describe()}, but the model has "
                     f"{len(rotors)} rotor(s) ({where})", count.loc, "CA_ROTOR_COUNT",
                     hint=f"param set-default CA_ROTOR_COUNT {len(rotors)}")
 
 
 @rule("C414", "px4-output-mapping", "error",
-      "A CA rotor and the model's motors are not connected one to one through SIM_GZ_EC_FUNC.")
+      "A CA rotor and the model's motors are not connected one to one through SIM_GZ_EC_FUNC.", clause="flight-stack")
 def px4_output_mapping(ctx: CheckContext) -> Iterator[Issue]:
     """For Gazebo SITL, PX4 sends the command of ESC output k to the model's motor with
     actuator number k-1, and output k carries CA rotor i when SIM_GZ_EC_FUNCk is 101 + i
     ("Motor i+1"). A CA rotor on no output is never spun; an output whose motor does not
     exist in the model spins nothing; a model motor on no motor output never turns.
+
+    Severity (error, flight-stack): PX4 commands a motor the model does not have, or
+    never commands one it has.
     """
     from reedtool.flightstack.px4 import MAX_GZ_OUTPUTS, MOTOR_FUNCTION_BASE
 
@@ -209,7 +226,7 @@ def _describes_other(ctx: CheckContext, ca: "Px4Rotor", rotor: "Rotor") -> str:
 
 
 @rule("C415", "px4-rotor-position", "error",
-      "A CA rotor sits in another quadrant, or more than 20° of bearing away, than its motor.")
+      "A CA rotor sits in another quadrant, or more than 20° of bearing away, than its motor.", clause="flight-stack")
 def px4_rotor_position(ctx: CheckContext) -> Iterator[Issue]:
     """CA_ROTORi_PX/PY are the rotor's position in FRD (x forward, y right) about the
     centre of gravity. PX4 derives each rotor's roll and pitch effectiveness from them;
@@ -217,10 +234,28 @@ def px4_rotor_position(ctx: CheckContext) -> Iterator[Issue]:
     wrong sign and the first take-off flips. The model's rotor is taken about the
     whole-robot centre of mass, with y and z negated (FLU to FRD). Two swapped CA_ROTOR
     entries show up here, one finding per entry.
+
+    Severity (error, flight-stack): PX4 commands the wrong motor for a roll or pitch.
     """
     for params in _px4(ctx):
         for ca, k, rotor in _px4_pairs(ctx, params):
             model = _frd_about_com(ctx, rotor)
+            axis = _ca_axis(params, ca)
+            if axis is None:
+                continue
+            if not _upward(axis):
+                conflict = _moment_conflict(ca, axis.axis_frd, model, rotor)
+                if conflict:
+                    yield Issue(f"{ca.where('PX', 'PY', 'PZ')} with thrust axis "
+                                f"({_vec(axis.axis_frd)}) ({axis.text}) gives a {conflict} "
+                                f"torque of the other sign than {_rotor_label(rotor)} on "
+                                f"output {k}, at ({_vec(model)}) m thrusting along "
+                                f"({_vec(_model_axis(rotor))}) (FRD about the COM)",
+                                ca.loc_of("PX"), f"CA_ROTOR{ca.index}",
+                                hint=f"param set-default CA_ROTOR{ca.index}_PX {model[0]:.4g}; "
+                                     f"CA_ROTOR{ca.index}_PY {model[1]:.4g}; "
+                                     f"CA_ROTOR{ca.index}_PZ {model[2]:.4g}")
+                continue
             ca_bearing, model_bearing = _bearing(ca.position_frd_m), _bearing(model)
             gap = _gap(ca_bearing, model_bearing)
             if gap <= BEARING_TOL_DEG and _same_quadrant(ca.position_frd_m, model):
@@ -236,16 +271,21 @@ def px4_rotor_position(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C423", "px4-rotor-position-offset", "info",
-      "A CA rotor's position differs from its motor's, without changing allocation signs.")
+      "A CA rotor's position differs from its motor's, without changing allocation signs.", clause="explains")
 def px4_rotor_position_offset(ctx: CheckContext) -> Iterator[Issue]:
     """A CA position in the right quadrant and within 20° of the model rotor's bearing
     allocates roll and pitch with the right signs, only with slightly different gains.
     That is common and often deliberate: PX4's own x500 airframe describes the real
     frame's rotor positions while the x500 Gazebo model places its rotors on a 45° square.
     Reported so the numbers can be compared; differences under 5 mm are not reported.
+
+    Severity (info, explains): the allocation keeps its signs; only the gains differ.
     """
     for params in _px4(ctx):
         for ca, k, rotor in _px4_pairs(ctx, params):
+            axis = _ca_axis(params, ca)
+            if axis is None or not _upward(axis):
+                continue
             model = _frd_about_com(ctx, rotor)
             gap = _gap(_bearing(ca.position_frd_m), _bearing(model))
             if gap > BEARING_TOL_DEG or not _same_quadrant(ca.position_frd_m, model):
@@ -260,17 +300,25 @@ def px4_rotor_position_offset(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C416", "px4-rotor-spin", "error",
-      "The sign of CA_ROTORi_KM disagrees with its motor's turning direction.")
+      "The sign of CA_ROTORi_KM disagrees with its motor's turning direction.", clause="flight-stack")
 def px4_rotor_spin(ctx: CheckContext) -> Iterator[Issue]:
     """CA_ROTORi_KM is the yaw moment per thrust, positive for a rotor turning
     counter-clockwise seen from above and negative for clockwise (PX4 parameter reference,
     control_allocator module.yaml). A sign that disagrees with the model's
     turningDirection makes PX4 yaw the wrong way with that rotor: on take-off the vehicle
-    spins up in yaw.
+    spins up in yaw. An unset KM is PX4's default 0.05 (counter-clockwise).
+
+    Only where PX4 uses KM: not on a fixed-wing (CA_AIRFRAME 1 disables propeller torque),
+    not for a standard VTOL's pusher (CA_AIRFRAME 2 drops the
+    propeller torque of rotors that are not upward), a tailsitter with 3 rotors or fewer, or
+    a tiltrotor whose tilt servos control yaw (CA_SV_TLk_CT 1 or 3).
+
+    Severity (error, flight-stack): PX4 yaws with the motor the other way.
     """
     for params in _px4(ctx):
         for ca, k, rotor in _px4_pairs(ctx, params):
-            if rotor.turning_sign == 0 or ca.km == 0 or not math.isfinite(ca.km):
+            if rotor.turning_sign == 0 or ca.km == 0 or not math.isfinite(ca.km) \
+                    or not _uses_km(params, ca):
                 continue
             if int(np.sign(ca.km)) != rotor.turning_sign:
                 yield Issue(f"{ca.where('KM')} says {SPIN_NAME[int(np.sign(ca.km))]}, but "
@@ -283,17 +331,20 @@ def px4_rotor_spin(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C417", "px4-moment-ratio", "info",
-      "|CA_ROTORi_KM| differs from the motor's momentConstant.")
+      "|CA_ROTORi_KM| differs from the motor's momentConstant.", clause="explains")
 def px4_moment_ratio(ctx: CheckContext) -> Iterator[Issue]:
     """|KM| is PX4's yaw moment per thrust, the same quantity as the motor model's
     momentConstant. A different value scales PX4's yaw effectiveness, which the yaw
     rate controller's gains absorb: PX4's own gz airframes use 0.05 against models with
     0.016. Reported with both numbers, as information.
+
+    Severity (info, explains): a yaw gain that the rate controller's tuning absorbs.
     """
     for params in _px4(ctx):
         for ca, k, rotor in _px4_pairs(ctx, params):
             model = rotor.moment_constant
-            if not (math.isfinite(model) and model > 0 and math.isfinite(ca.km)):
+            if not (math.isfinite(model) and model > 0 and math.isfinite(ca.km)) \
+                    or not _uses_km(params, ca):
                 continue
             if abs(abs(ca.km) - model) > KM_REL_TOL * model:
                 yield Issue(f"{ca.where('KM')} vs momentConstant {model:g} of "
@@ -302,42 +353,165 @@ def px4_moment_ratio(ctx: CheckContext) -> Iterator[Issue]:
                             ca.loc_of("KM"), f"CA_ROTOR{ca.index}")
 
 
-@rule("C418", "px4-thrust-axis", "error",
-      "A CA rotor's thrust axis is more than 10° from its motor's.")
-def px4_thrust_axis(ctx: CheckContext) -> Iterator[Issue]:
-    """CA_ROTORi_AX/AY/AZ is the thrust direction in FRD (default 0, 0, -1: up). The model's
-    rotor thrusts along its link's z axis, which in FRD is (x, -y, -z). A tilt PX4 does
-    not know about (or a tilt PX4 assumes that the model does not have) puts a force and
-    a torque into the allocation that the vehicle does not produce.
-    """
+def _ca_axis(params: "Px4Params", ca: "Px4Rotor"):
+    """PX4's hover thrust axis for CA rotor i (reedtool.flightstack.px4.rotor_axis)."""
+    from reedtool.flightstack.px4 import rotor_axis
+
+    kind = _px4_kind(params)
+    return rotor_axis(params, ca, kind) if kind is not None else None
+
+
+def _upward(axis) -> bool:
+    from reedtool.flightstack.px4 import is_upward
+
+    return is_upward(axis.axis_frd)
+
+
+def _uses_km(params: "Px4Params", ca: "Px4Rotor") -> bool:
+    from reedtool.flightstack.px4 import uses_yaw_moment
+
+    axis, kind = _ca_axis(params, ca), _px4_kind(params)
+    return axis is not None and uses_yaw_moment(params, kind, axis)
+
+
+def _model_axis(rotor: "Rotor") -> np.ndarray:
     from reedtool.flightstack.px4 import frd_from_flu
 
+    axis = frd_from_flu(rotor.axis)
+    norm = float(np.linalg.norm(axis))
+    return axis / norm if norm > 0 and math.isfinite(norm) else axis
+
+
+def _vec(v) -> str:
+    return ", ".join(f"{x:.3g}" for x in np.asarray(v, dtype=float) + 0.0)
+
+
+def _moment_conflict(ca: "Px4Rotor", ca_axis: np.ndarray, model_p: np.ndarray,
+                     rotor: "Rotor") -> str:
+    """'roll', 'pitch' or 'yaw' when PX4's torque per thrust (position x axis) and the
+    model's have a component of opposite sign, both beyond 20 % of the longer arm."""
+    ours = np.cross(ca.position_frd_m, ca_axis)
+    theirs = np.cross(model_p, _model_axis(rotor))
+    scale = 0.2 * max(float(np.linalg.norm(ca.position_frd_m)), float(np.linalg.norm(model_p)))
+    for i, name in enumerate(("roll", "pitch", "yaw")):
+        if abs(ours[i]) > scale and abs(theirs[i]) > scale and ours[i] * theirs[i] < 0:
+            return name
+    return ""
+
+
+def _axis_angles(ctx: CheckContext):
+    """(params, CA rotor, output, model rotor, PX4 axis, angle in degrees) per pair."""
     for params in _px4(ctx):
         for ca, k, rotor in _px4_pairs(ctx, params):
-            norm = float(np.linalg.norm(ca.axis_frd))
-            model = frd_from_flu(rotor.axis)
-            if norm == 0 or not np.all(np.isfinite(model)):
+            axis = _ca_axis(params, ca)
+            model = _model_axis(rotor)
+            if axis is None or not np.all(np.isfinite(model)) or np.linalg.norm(model) == 0:
                 continue
-            cos = float(np.dot(ca.axis_frd / norm, model / np.linalg.norm(model)))
-            angle = math.degrees(math.acos(max(-1.0, min(1.0, cos))))
-            if angle > AXIS_TOL_DEG:
-                yield Issue(f"{ca.where('AX', 'AY', 'AZ')}: thrust axis {angle:.1f}° from "
-                            f"{_rotor_label(rotor)}'s ({model[0]:.3g}, {model[1]:.3g}, "
-                            f"{model[2]:.3g} in FRD)", ca.loc_of("AZ"), f"CA_ROTOR{ca.index}",
-                            hint=f"CA_ROTOR{ca.index}_AX {model[0]:.3g}, _AY {model[1]:.3g}, "
-                                 f"_AZ {model[2]:.3g}")
+            cos = float(np.dot(axis.axis_frd, model))
+            yield params, ca, k, rotor, axis, math.degrees(math.acos(max(-1.0, min(1.0, cos))))
+
+
+def _axis_message(ca: "Px4Rotor", rotor: "Rotor", axis, angle: float) -> str:
+    return (f"PX4 allocates CA rotor {ca.index} along ({_vec(axis.axis_frd)}) in FRD "
+            f"({axis.text}): {angle:.1f}° from {_rotor_label(rotor)}'s thrust axis "
+            f"({_vec(_model_axis(rotor))})")
+
+
+def _axis_hint(ca: "Px4Rotor", rotor: "Rotor", axis) -> str | None:
+    model = _model_axis(rotor)
+    if axis.source != "parameters":
+        return "CA_AIRFRAME fixes this axis: choose the CA_AIRFRAME of the vehicle, or turn " \
+               "the rotor in the model"
+    return (f"CA_ROTOR{ca.index}_AX {model[0]:.3g}, _AY {model[1]:.3g}, _AZ {model[2]:.3g}")
+
+
+@rule("C418", "px4-thrust-axis", "error",
+      "PX4 allocates a rotor along an axis more than 60° from the model's.",
+      clause="flight-stack")
+def px4_thrust_axis(ctx: CheckContext) -> Iterator[Issue]:
+    """The thrust axis PX4 allocates CA rotor i with depends on CA_AIRFRAME
+    (ActuatorEffectivenessRotors' axis configuration): multirotor, standard VTOL,
+    tailsitter and custom airframes read CA_ROTORi_AX/AY/AZ (default 0, 0, -1: up);
+    fixed-wing fixes every rotor forward (1, 0, 0) and ignores the parameters; a tiltrotor's
+    rotor with CA_ROTORi_TILT follows its tilt servo (hover: the servo's minimum angle
+    CA_SV_TLk_MINA in direction CA_SV_TLk_TD). The model's rotor thrusts along its link's z
+    axis, in FRD (x, -y, -z).
+
+    Severity (error, flight-stack): more than 60° apart, less than half of the thrust PX4
+    counts on goes where it expects (cos 60° = 0.5): PX4 uses the rotor for an axis it
+    does not serve (a pusher for lift, a lift rotor for forward thrust) and the vehicle
+    cannot hover or fly as commanded. 10°-60° is C426 (warning) or C427 (information).
+    """
+    for params, ca, k, rotor, axis, angle in _axis_angles(ctx):
+        if angle > AXIS_ERROR_DEG:
+            yield Issue(_axis_message(ca, rotor, axis, angle), _axis_loc(params, ca, axis),
+                        f"CA_ROTOR{ca.index}", hint=_axis_hint(ca, rotor, axis))
+
+
+def _axis_loc(params: "Px4Params", ca: "Px4Rotor", axis):
+    if axis.source == "parameters":
+        return ca.loc_of("AZ")
+    return params.get("CA_AIRFRAME").loc
+
+
+def _axis_ignored(ctx: CheckContext, axis) -> bool:
+    """PX4 cannot be told the tilt (a fixed axis), or the model's tilt is a balanced
+    pattern (R320) whose side forces cancel: leaving it out of PX4's table is the
+    convention (PX4's quadtailsitter)."""
+    from reedtool.checks.rotor_rules import balanced_tilt
+
+    return axis.source != "parameters" or balanced_tilt(ctx) is not None
+
+
+@rule("C426", "px4-thrust-axis-offset", "warning",
+      "A CA rotor's configured thrust axis is 10°-60° from its motor's.", clause="suspicious")
+def px4_thrust_axis_offset(ctx: CheckContext) -> Iterator[Issue]:
+    """As C418, for an axis PX4 reads from CA_ROTORi_AX/AY/AZ that is 10°-60° from the
+    model rotor's, where the model's tilt is not a balanced pattern: PX4 puts a force and a
+    torque into its allocation that the vehicle does not produce, so attitude and position
+    control fight a steady error.
+
+    Severity (warning: suspicious, but the vehicle loads and flies): most of the thrust
+    still goes where PX4 expects it. The hint gives the axis to write.
+    """
+    for params, ca, k, rotor, axis, angle in _axis_angles(ctx):
+        if AXIS_TOL_DEG < angle <= AXIS_ERROR_DEG and not _axis_ignored(ctx, axis):
+            yield Issue(_axis_message(ca, rotor, axis, angle), _axis_loc(params, ca, axis),
+                        f"CA_ROTOR{ca.index}", hint=_axis_hint(ca, rotor, axis))
+
+
+@rule("C427", "px4-thrust-axis-fixed", "info",
+      "A rotor is tilted 10°-60° from the axis PX4 fixes or assumes for it, by convention.",
+      clause="ambiguous")
+def px4_thrust_axis_fixed(ctx: CheckContext) -> Iterator[Issue]:
+    """As C426, where the difference is the convention rather than a mistake: CA_AIRFRAME
+    fixes the axis (fixed-wing: forward), so there is no parameter to set, or the model's
+    rotors are tilted in a balanced pattern (R320: side forces and tilt torques cancel at
+    equal thrust, as on PX4's own quadtailsitter with its 0.17 rad tilts) that PX4's table
+    leaves out on purpose.
+
+    Severity (information): reedtool cannot tell the convention from a mistake here, so it
+    says what it sees.
+    """
+    for params, ca, k, rotor, axis, angle in _axis_angles(ctx):
+        if AXIS_TOL_DEG < angle <= AXIS_ERROR_DEG and _axis_ignored(ctx, axis):
+            yield Issue(_axis_message(ca, rotor, axis, angle), _axis_loc(params, ca, axis),
+                        f"CA_ROTOR{ca.index}")
 
 
 # --------------------------------------------------------------- PX4: command range
 
 @rule("C419", "px4-command-above-max", "warning",
-      "SIM_GZ_EC_MAX is above the motor's maxRotVelocity: the top of the range does nothing.")
+      "SIM_GZ_EC_MAX is above the motor's maxRotVelocity: the top of the range does nothing.", clause="suspicious")
 def px4_command_above_max(ctx: CheckContext) -> Iterator[Issue]:
     """The gz bridge scales PX4's motor output 0..1 to SIM_GZ_EC_MINk..SIM_GZ_EC_MAXk rad/s
     and the motor model clamps the command at maxRotVelocity. With MAX above that limit,
     the top of PX4's output range changes nothing: PX4's mixer believes it has thrust in
     reserve that does not exist, and saturation goes unnoticed (px4vision: 1100 against
     1000, 9 % of the range lost).
+
+    Severity (warning, suspicious): the vehicle flies; PX4 believes in a reserve of
+    thrust that does not exist.
     """
     for params in _px4(ctx):
         for ca, k, rotor in _px4_pairs(ctx, params):
@@ -356,12 +530,15 @@ def px4_command_above_max(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C424", "px4-command-below-max", "warning",
-      "SIM_GZ_EC_MAX is below the motor's maxRotVelocity: full thrust is never reached.")
+      "SIM_GZ_EC_MAX is below the motor's maxRotVelocity: full thrust is never reached.", clause="suspicious")
 def px4_command_below_max(ctx: CheckContext) -> Iterator[Issue]:
     """With SIM_GZ_EC_MAXk below maxRotVelocity, PX4's full output commands less than the
     motor's top speed; thrust grows with speed squared, so the vehicle has
     (MAX / maxRotVelocity)² of the thrust the model was built with. That may be a
     deliberate limit; the finding gives the fraction.
+
+    Severity (warning, suspicious): it may be a deliberate limit; the vehicle flies with
+    less thrust.
     """
     for params in _px4(ctx):
         for ca, k, rotor in _px4_pairs(ctx, params):
@@ -393,23 +570,26 @@ def _hover_speeds(ctx: CheckContext) -> dict[int, float] | None:
 
 
 @rule("C420", "px4-idle-command", "error",
-      "SIM_GZ_EC_MIN is not below the motor's hover speed (or not below SIM_GZ_EC_MAX).")
+      "SIM_GZ_EC_MIN is not below the motor's hover speed (or not below SIM_GZ_EC_MAX).", clause="flight-stack")
 def px4_idle_command(ctx: CheckContext) -> Iterator[Issue]:
     """SIM_GZ_EC_MINk is the rotor speed at PX4's zero output once armed. At or above the
     speed the rotor needs to hover the vehicle climbs at zero throttle and cannot
-    descend; at or above SIM_GZ_EC_MAXk the command range is empty.
+    descend; at or above SIM_GZ_EC_MAXk the command range is empty. A reversible rotor
+    (PX4's omnicopter) is commanded both ways and has no idle speed to compare.
+
+    Severity (error, flight-stack): PX4 cannot command the motor below what it needs.
     """
     hover = _hover_speeds(ctx)
     for params in _px4(ctx):
         for ca, k, rotor in _px4_pairs(ctx, params):
             low, high = params.get(f"SIM_GZ_EC_MIN{k}"), params.get(f"SIM_GZ_EC_MAX{k}")
             if low.value >= high.value:
-                yield Issue(f"SIM_GZ_EC_MIN{k} {low.value:g} ({low.loc}) is not below "
-                            f"SIM_GZ_EC_MAX{k} {high.value:g} ({high.loc}): output {k} "
+                yield Issue(f"{low.describe()} is not below {high.describe()}: output {k} "
                             f"({_rotor_label(rotor)}) has no command range", low.loc,
                             f"SIM_GZ_EC_MIN{k}", hint="idle is usually 10-20 % of the maximum")
-            elif hover and id(rotor) in hover and low.value >= hover[id(rotor)]:
-                yield Issue(f"SIM_GZ_EC_MIN{k} {low.value:g} rad/s ({low.loc}) is at or above "
+            elif hover and id(rotor) in hover and not rotor.reversible \
+                    and low.value >= hover[id(rotor)]:
+                yield Issue(f"{low.describe()} rad/s is at or above "
                             f"the {hover[id(rotor)]:.0f} rad/s {_rotor_label(rotor)} needs to "
                             "hover: at zero throttle the vehicle still climbs", low.loc,
                             f"SIM_GZ_EC_MIN{k}",
@@ -422,8 +602,8 @@ def _hover_throttle(ctx: CheckContext, params: "Px4Params") -> tuple[float, floa
 
     hover = _hover_speeds(ctx)
     pairs = _px4_pairs(ctx, params)
-    if not hover or not pairs:
-        return None
+    if not hover or not pairs or ctx.omnidirectional:
+        return None     # 6-DoF hover (reversible rotors): no single collective throttle
     factor = params.get("THR_MDL_FAC").value
     needed = []
     for ca, k, rotor in pairs:
@@ -448,7 +628,7 @@ def _hover_message(params: "Px4Params", needed: float, setting: float) -> str:
 
 
 @rule("C421", "px4-hover-throttle", "info",
-      "MPC_THR_HOVER and the throttle the model needs at hover, side by side.")
+      "MPC_THR_HOVER and the throttle the model needs at hover, side by side.", clause="explains")
 def px4_hover_throttle(ctx: CheckContext) -> Iterator[Issue]:
     """MPC_THR_HOVER is the collective thrust PX4 starts from in position control
     (it learns the real value in flight when MPC_USE_HTE is on). reedtool computes what
@@ -456,6 +636,8 @@ def px4_hover_throttle(ctx: CheckContext) -> Iterator[Issue]:
     u = (ω - SIM_GZ_EC_MIN) / (SIM_GZ_EC_MAX - SIM_GZ_EC_MIN), through PX4's thrust model
     THR_MDL_FAC·u² + (1 - THR_MDL_FAC)·u, averaged over the rotors. Within 0.15 of each
     other this is information (C422 warns beyond).
+
+    Severity (info, explains): it shows two numbers side by side.
     """
     for params in _px4(ctx):
         values = _hover_throttle(ctx, params)
@@ -465,11 +647,14 @@ def px4_hover_throttle(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C422", "px4-hover-throttle-mismatch", "warning",
-      "MPC_THR_HOVER is more than 0.15 from the throttle the model needs at hover.")
+      "MPC_THR_HOVER is more than 0.15 from the throttle the model needs at hover.", clause="suspicious")
 def px4_hover_throttle_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     """As C421, with the two values more than 0.15 apart: PX4 takes off with the wrong
     feed-forward, sinks or balloons after take-off until the hover thrust estimator
     catches up, and a position controller without the estimator never does.
+
+    Severity (warning, suspicious): the vehicle flies; take-off sinks or balloons until
+    the hover estimator catches up.
     """
     for params in _px4(ctx):
         values = _hover_throttle(ctx, params)
@@ -480,7 +665,7 @@ def px4_hover_throttle_mismatch(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C425", "px4-param-out-of-range", "warning",
-      "A PX4 parameter is outside the range PX4 documents for it.")
+      "A PX4 parameter is outside the range PX4 documents for it.", clause="suspicious")
 def px4_param_out_of_range(ctx: CheckContext) -> Iterator[Issue]:
     """reedtool knows the documented ranges of the parameters it reads (the PARAM_RANGES
     table in reedtool.flightstack.px4, with its sources): CA_ROTOR_COUNT 0..12,
@@ -488,6 +673,9 @@ def px4_param_out_of_range(ctx: CheckContext) -> Iterator[Issue]:
     MPC_THR_HOVER 0.1..0.8, THR_MDL_FAC 0..1. QGroundControl refuses such values, and
     PX4 may clamp them. SIM_GZ_EC_MIN/MAX are left to C419/C420/C424, which compare them
     with the model's motors (PX4's own px4vision airframe commands up to 1100 rad/s).
+
+    Severity (warning, suspicious): QGroundControl refuses the value and PX4 may clamp
+    it, but the vehicle loads.
     """
     from reedtool.flightstack.px4 import out_of_range
 
@@ -539,7 +727,8 @@ def _ap_where(params: "ArduPilotParams") -> str:
     from reedtool.flightstack.ardupilot import frame_name
 
     frame_class, frame_type = params.frame()
-    type_loc = str(frame_type.loc) if frame_type.explicit else "FRAME_TYPE not set: 1"
+    type_loc = str(frame_type.loc) if frame_type.explicit else \
+        f"not set: ArduCopter's default 1, {frame_type.loc}"
     return (f"FRAME_CLASS {frame_class.value:g} ({frame_class.loc}), FRAME_TYPE "
             f"{frame_type.value:g} ({type_loc}): "
             f"{frame_name(int(frame_class.value), int(frame_type.value))}")
@@ -549,14 +738,18 @@ def _output_text(output: int, line) -> str:
     return f"SERVO{output}" + (f" ({line.loc})" if line is not None else " (default)")
 
 
-@rule("C430", "ardupilot-frame-unknown", "warning",
-      "FRAME_CLASS/FRAME_TYPE is not set or names a frame reedtool has no motor table for.")
+@rule("C430", "ardupilot-frame-unknown", "info",
+      "FRAME_CLASS/FRAME_TYPE is not set or names a frame reedtool has no motor table for.",
+      clause="ambiguous")
 def ardupilot_frame_unknown(ctx: CheckContext) -> Iterator[Issue]:
-    """ArduCopter's FRAME_CLASS defaults to 0 (undefined: the motors do not start).
-    reedtool knows the motor tables of quad (plus, X, V, H, V-tail, A-tail, plus-rev,
-    BetaFlight X and reversed, DJI X, clockwise X, no-yaw plus and X), hexa (plus, X),
-    octa (plus, X), octaquad (plus, X, H) and Y6 (default, Y6B, Y6F); for other frames
-    nothing is compared.
+    """ArduCopter's FRAME_CLASS defaults to 0 (undefined: the motors do not start), but a
+    parameter file is often one of several (SITL loads its frame's defaults first, then
+    the user's file), so a file without it cannot be judged alone. reedtool knows the
+    motor tables of quad (plus, X, V, H, V-tail, A-tail, plus-rev, BetaFlight X and
+    reversed, DJI X, clockwise X, no-yaw plus and X), hexa (plus, X), octa (plus, X),
+    octaquad (plus, X, H) and Y6 (default, Y6B, Y6F); for other frames nothing is compared.
+
+    Severity (information): it says what reedtool could not compare.
     """
     for params in _ardupilot(ctx):
         frame_class, frame_type = params.frame()
@@ -570,11 +763,14 @@ def ardupilot_frame_unknown(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C431", "ardupilot-motor-count", "error",
-      "The ArduPilot frame has a different number of motors than the model has lift rotors.")
+      "The ArduPilot frame has a different number of motors than the model has lift rotors.", clause="flight-stack")
 def ardupilot_motor_count(ctx: CheckContext) -> Iterator[Issue]:
     """FRAME_CLASS fixes the number of motors ArduCopter mixes for (quad 4, hexa 6, octa
     and octaquad 8, Y6 6). A model with a different number of lift rotors cannot be flown
     by that mixer.
+
+    Severity (error, flight-stack): ArduPilot's mixer mixes for another number of motors
+    than the model has.
     """
     rotors = _lift_rotors(ctx)
     for params in _ardupilot(ctx):
@@ -588,13 +784,16 @@ def ardupilot_motor_count(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C432", "ardupilot-motor-position", "error",
-      "An ArduPilot motor is driven on a rotor in another place than its frame puts it.")
+      "An ArduPilot motor is driven on a rotor in another place than its frame puts it.", clause="flight-stack")
 def ardupilot_motor_position(ctx: CheckContext) -> Iterator[Issue]:
     """Each ArduPilot frame puts motor m at a bearing from the nose (AP_MotorsMatrix); the
     mixer gives it roll and pitch factors from that bearing. The model rotor that output
     receives (ArduPilotPlugin channel = output - 1, or actuator number = output - 1 without
     the plugin) must sit there, within 20° of bearing and in the same quadrant: a plus
     frame type on an X model, or two swapped channels, flip the vehicle on take-off.
+
+    Severity (error, flight-stack): ArduPilot commands the wrong motor for a roll or
+    pitch.
     """
     for params in _ardupilot(ctx):
         for motor, output, line, rotor in _ap_pairs(ctx, params):
@@ -620,12 +819,14 @@ def ardupilot_motor_position(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C433", "ardupilot-motor-spin", "error",
-      "An ArduPilot motor's spin disagrees with the turning direction of the rotor it drives.")
+      "An ArduPilot motor's spin disagrees with the turning direction of the rotor it drives.", clause="flight-stack")
 def ardupilot_motor_spin(ctx: CheckContext) -> Iterator[Issue]:
     """AP_MotorsMatrix gives every motor a yaw factor: +1 counter-clockwise, -1 clockwise
     seen from above. The rotor the motor's output drives must turn that way (the model's
     turningDirection, or the sign of the ArduPilotPlugin multiplier), or yaw control has
     the wrong sign for it.
+
+    Severity (error, flight-stack): ArduPilot yaws with the motor the other way.
     """
     for params in _ardupilot(ctx):
         for motor, output, line, rotor in _ap_pairs(ctx, params):
@@ -644,11 +845,14 @@ def ardupilot_motor_spin(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("C434", "ardupilot-motor-unassigned", "error",
-      "An ArduPilot motor reaches no rotor of the model, or a rotor gets no motor.")
+      "An ArduPilot motor reaches no rotor of the model, or a rotor gets no motor.", clause="flight-stack")
 def ardupilot_motor_unassigned(ctx: CheckContext) -> Iterator[Issue]:
     """Motor m goes out on the servo output whose SERVOn_FUNCTION is 32 + m (default:
     output m). When that output drives no rotor of the model, or a model rotor's output
     carries no motor, the mixer and the model disagree about which rotors exist.
+
+    Severity (error, flight-stack): ArduPilot commands a motor the model does not have,
+    or never one it has.
     """
     for params in _ardupilot(ctx):
         motors = _ap_frame(params)

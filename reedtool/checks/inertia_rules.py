@@ -92,11 +92,22 @@ def _with_geometry(ctx: CheckContext, link: Link, text: str) -> str:
     return f"{text}; {described} gives {_inertia_xml(I)}"
 
 
-@rule("I201", "mass-not-positive", "error", "A link's mass is negative, or zero on a moving link.")
+def _judged_alone(ctx: CheckContext, link: Link, I: np.ndarray) -> bool:
+    """Whether the simulator checks the link's own tensor (physics.inertia.
+    degenerate_but_accepted: a point mass on a fixed joint, a merged URDF link's zeros)."""
+    from reedtool.physics.inertia import degenerate_but_accepted
+
+    return not degenerate_but_accepted(I, moving=ctx.is_moving(link),
+                                       lumped=link.name in ctx.lumped_links)
+
+
+@rule("I201", "mass-not-positive", "error", "A link's mass is negative, or zero on a moving link.", clause="cannot-fly")
 def mass_not_positive(ctx: CheckContext) -> Iterator[Issue]:
     """A negative mass is never valid. A zero mass is fine on a link merged into its parent
     by a fixed joint (a frame marker), but a link that moves on its own joint needs mass:
     physics engines divide by it.
+
+    Severity (error, cannot-fly): physics engines divide by a moving link's mass.
     """
     for link in ctx.robot.links:
         inertial = link.inertial
@@ -113,19 +124,25 @@ def mass_not_positive(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("I202", "inertia-not-positive-definite", "error",
-      "A link's inertia tensor is not symmetric positive definite.")
+      "A link's inertia tensor is not symmetric positive definite.", clause="refused")
 def inertia_not_positive_definite(ctx: CheckContext) -> Iterator[Issue]:
     """The inertia tensor of a body with mass has three positive principal moments. A zero
     or negative moment (often a zero `ixx`/`iyy`/`izz`, or products of inertia larger than
     the moments) makes the simulator reject the link or integrate nonsense.
 
-    Links without mass are skipped (I201 covers moving ones; fixed ones are merged).
+    Links without mass are skipped (I201 covers moving ones; fixed ones are merged). A zero
+    tensor on a fixed joint is a point mass, which gz-math accepts and a URDF link merged
+    into its parent only adds to the parent's sum (aerial_gym's motor links); a negative
+    moment is reported wherever it is (rounding noise of 1e-9 of the largest moment is
+    zero, not negative).
+
+    Severity (error, refused): gz-math rejects the tensor of a link simulated on its own.
     """
     for link in ctx.robot.links:
         if not _massive(link):
             continue
         I = np.asarray(link.inertial.inertia_kg_m2, dtype=float)
-        if not _tensor_ok(I) or _positive_definite(I):
+        if not _tensor_ok(I) or _positive_definite(I) or not _judged_alone(ctx, link, I):
             continue
         moments = np.linalg.eigvalsh((I + I.T) / 2)
         yield Issue(f"link '{link.name}': inertia is not positive definite (principal moments "
@@ -135,7 +152,7 @@ def inertia_not_positive_definite(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("I203", "inertia-triangle-inequality", "error",
-      "A link's principal moments break the triangle inequality.")
+      "A link's principal moments break the triangle inequality.", clause="refused")
 def inertia_triangle_inequality(ctx: CheckContext) -> Iterator[Issue]:
     """For any real mass distribution each principal moment is at most the sum of the
     other two (A + B >= C; equality for a flat plate). Gazebo (gz-math) rejects a tensor
@@ -143,7 +160,12 @@ def inertia_triangle_inequality(ctx: CheckContext) -> Iterator[Issue]:
     0.1 % of the largest moment, for rounded hand-written values.
 
     Hand-edited inertia, or one copied from another model and scaled along one axis only,
-    is the usual cause. Compute the tensor from the geometry (`reedtool inertia`).
+    is the usual cause. Compute the tensor from the geometry (`reedtool inertia`). A URDF
+    link on a fixed joint is merged into its parent by Gazebo's URDF parser: it is reported
+    only when the merged body's tensor breaks the inequality too (RotorS's
+    base_link_inertia is most of its body, so the seed's error stays).
+
+    Severity (error, refused): gz-math rejects the tensor.
     """
     for link in ctx.robot.links:
         if not _massive(link):
@@ -151,6 +173,12 @@ def inertia_triangle_inequality(ctx: CheckContext) -> Iterator[Issue]:
         I = np.asarray(link.inertial.inertia_kg_m2, dtype=float)
         if not _tensor_ok(I) or not _positive_definite(I):
             continue  # I202
+        if link.name in ctx.lumped_links and tensor_problem(I) == "triangle":
+            # A merged URDF link counts only in the body Gazebo makes with its parent
+            # (RotorS's base_link_inertia is most of that body: seed 000 stays an error).
+            body = ctx.lumped_tensor(link.name)
+            if body is not None and tensor_problem(body) != "triangle":
+                continue
         a, b, c = np.linalg.eigvalsh((I + I.T) / 2)
         if tensor_problem(I) == "triangle":
             yield Issue(f"link '{link.name}': principal moments break the triangle inequality: "
@@ -180,21 +208,38 @@ def _trace_findings(ctx: CheckContext, verdict: str) -> Iterator[Issue]:
         r_geom = math.sqrt(expected / (2 * link.inertial.mass_kg))
         way = "larger" if ratio > 1 else "smaller"
         factor = ratio if ratio > 1 else 1 / ratio
+        # The robot-level judgement (physics.inertia.judge_in_robot) says why a tensor
+        # 100x off is only a warning, or why it is an error.
+        why = comparison.message.split("; ", 1)[1] if "; " in comparison.message else ""
         yield Issue(f"link '{link.name}': inertia is {factor:,.3g}x {way} than "
-                    f"{described} (radius of gyration {_fmt(r_decl)} m vs {_fmt(r_geom)} m)",
+                    f"{described} (radius of gyration {_fmt(r_decl)} m vs {_fmt(r_geom)} m)"
+                    + (f"; {why}" if why else ""),
                     link.inertial.inertia_loc or link.inertial.loc, link.name,
                     hint=f"{described} gives {_inertia_xml(I_geom)}")
 
 
 @rule("I204", "inertia-implausible-for-geometry", "warning",
-      "A link's inertia is 10x to 100x from what its own geometry and mass give.")
+      "A link's inertia is 10x above (or 100x below) what its geometry and mass give, "
+      "without changing how the robot flies.", clause="ambiguous")
 def inertia_implausible_for_geometry(ctx: CheckContext) -> Iterator[Issue]:
     """Compares the declared tensor with that of the link's geometry (first collision,
     else first visual) filled uniformly with the declared mass, through the trace (twice
-    the mass times the squared radius of gyration). Between 10x and 100x off either way is
-    no real mass distribution (all mass in the corners of a box gives only 3x the solid
-    box's inertia), but a body built of a light shell and heavy parts far out may come
-    close, so it is a warning; 100x and beyond is I209, an error.
+    the mass times the squared radius of gyration). 10x larger is no real mass
+    distribution (all mass in the corners of a box gives only 3x the solid box's inertia);
+    smaller is, down to any share (a hub inside a large collision cylinder), so the
+    smaller side is reported from 100x (a radius of gyration a tenth of the solid's).
+
+    Severity (warning: suspicious, but the model loads and flies): reedtool cannot tell
+    which of the two is wrong, the tensor or a placeholder geometry (RotorS omav's
+    0.28 kg tilt units on 5 mm boxes), and the robot flies the same either way: swapping
+    the tensor for the geometry's changes none of the whole robot's principal moments by
+    2x. A tensor 100x off that does change them 2x or more is I209, an error.
+
+    Placeholder links are not compared: a link whose mass and whose inertia about the
+    robot's centre of mass are both under 0.1 % of the robot's (control surfaces of
+    1e-8 kg, a 1e-15 kg sonar frame) changes hover thrust and attitude response by less
+    than any flight stack resolves (physics.inertia.PLACEHOLDER_FRACTION has the
+    derivation).
 
     A rotor link driven by a motor plugin with `rotorVelocitySlowdownSim` s (RotorS, PX4
     classic, gz MulticopterMotorModel) may declare s times its geometry's inertia: RotorS
@@ -208,24 +253,34 @@ def inertia_implausible_for_geometry(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("I209", "inertia-orders-off-geometry", "error",
-      "A link's inertia is 100x or more from what its own geometry and mass give.")
+      "A link's inertia is 100x or more above its geometry's and decides how the robot flies.", clause="cannot-fly")
 def inertia_orders_off_geometry(ctx: CheckContext) -> Iterator[Issue]:
-    """The declared tensor's trace is at least 100x larger or smaller than that of the
-    link's geometry filled uniformly with the declared mass. No mass distribution comes
-    within an order of magnitude of that: it is a placeholder (`1.0` copied into every
-    link: 43,000x for a 0.1 kg wheel of 6 cm radius) or a unit mistake (g·mm² or kg·mm²
-    for kg·m²), and the body spins up like a flywheel a thousand times its size (or,
-    too small, the solver becomes stiff and explodes). The RotorS slowdown convention is
-    recognised as for I204. `reedtool inertia` calls such a link "way-off" and exits 1.
+    """The declared tensor's trace is at least 100x larger than that of the link's
+    geometry filled uniformly with the declared mass (a smaller one is I204: mass gathered
+    inside a shape is real, down to any share), and it matters: swapping
+    every such tensor of the robot for its geometry's changes a principal moment of the
+    whole robot by 2x or more, and this link's share of that change is a tenth or more.
+    It is a placeholder value (`1.0` copied into every link: 43,000x for a 0.1 kg wheel
+    of 6 cm radius) or a unit mistake (kg·mm² for kg·m² on the heavy side).
+
+    Severity (error: the model as written cannot do what it is for): the robot's attitude
+    dynamics are those of another body, beyond the 2x gain margin a controller tuned on
+    the real vehicle keeps. Where the robot flies the same with either tensor it is I204
+    (warning); placeholder links are not compared (see I204). The RotorS slowdown
+    convention is recognised as for I204. `reedtool inertia` calls such a link "way-off"
+    and exits 1.
     """
     yield from _trace_findings(ctx, "way-off")
 
 
-@rule("I207", "robot-mass-not-positive", "error", "The whole robot's mass is zero or negative.")
+@rule("I207", "robot-mass-not-positive", "error", "The whole robot's mass is zero or negative.", clause="cannot-fly")
 def robot_mass_not_positive(ctx: CheckContext) -> Iterator[Issue]:
     """The links' declared masses add up to zero or less (one link with `mass 0` or
     `-0.0`, or negative masses cancelling positive ones). Gazebo cannot integrate a body
     without mass, and every thrust and hover figure divides by it.
+
+    Severity (error, cannot-fly): there is nothing to integrate, and every thrust figure
+    divides by the mass.
     """
     problem = robot_mass_problem(ctx.robot)
     if problem:
@@ -236,7 +291,7 @@ def robot_mass_not_positive(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("I208", "massless-link-with-inertia", "error",
-      "A link has zero mass but a non-zero inertia.")
+      "A link has zero mass but a non-zero inertia.", clause="refused")
 def massless_link_with_inertia(ctx: CheckContext) -> Iterator[Issue]:
     """Inertia is mass times squared distance: a body with no mass has none. A zero mass
     with a non-zero tensor is a mass that was forgotten (or set to 0 to "switch the link
@@ -244,6 +299,9 @@ def massless_link_with_inertia(ctx: CheckContext) -> Iterator[Issue]:
     rotational inertia but no translational one. A massless link with a zero tensor on a
     fixed joint is a frame and stays quiet. (On a moving link I201 already reports the
     zero mass.)
+
+    Severity (error, refused): gz-math rejects a tensor without mass, and engines treat
+    the link as half a body.
     """
     for link, comparison in zip(ctx.robot.links, ctx.link_comparisons):
         if comparison.verdict == "massless-inertia" and not ctx.is_moving(link):
@@ -287,15 +345,20 @@ def link_geometry_bounds(ctx: CheckContext, link: Link) -> np.ndarray | None:
 
 
 @rule("I205", "com-outside-geometry", "warning",
-      "A link's centre of mass lies outside its geometry.")
+      "A link's centre of mass lies outside its geometry.", clause="suspicious")
 def com_outside_geometry(ctx: CheckContext) -> Iterator[Issue]:
     """The `<inertial><origin>` is the centre of mass in the link frame; it lies inside
     the link's visual and collision shapes (their bounding box, plus 10 %). Outside it,
     the usual cause is an origin given in the parent's frame, or the joint offset applied
     twice.
+
+    Severity (warning): the model loads and flies; where the mass sits may be a mistake.
+    Placeholder links (under 0.1 % of the robot's mass and inertia, see I204: PX4's
+    1e-8 kg control surfaces with their COM at the hinge's far end) are not judged.
     """
     for link in ctx.robot.links:
-        if not _massive(link) or _mesh_extent_implausible(ctx, link):
+        if not _massive(link) or link.name in ctx.placeholder_links \
+                or _mesh_extent_implausible(ctx, link):
             continue
         bounds = link_geometry_bounds(ctx, link)
         com = np.asarray(link.inertial.com_m, dtype=float)
@@ -390,7 +453,7 @@ def _mesh_scale_findings(ctx: CheckContext, certain: bool) -> Iterator[Issue]:
 
 
 @rule("I206", "mesh-scale-implausible", "warning",
-      "A mesh is implausibly large or small: perhaps the wrong unit.")
+      "A mesh is implausibly large or small: perhaps the wrong unit.", clause="ambiguous")
 def mesh_scale_implausible(ctx: CheckContext) -> Iterator[Issue]:
     """CAD tools export STL in millimetres by default, URDF reads metres: a 470 mm frame
     becomes 470 m. The size is the mesh as Gazebo loads it: its coordinates times the
@@ -401,12 +464,15 @@ def mesh_scale_implausible(ctx: CheckContext) -> Iterator[Issue]:
     brings it into range: as this warning when the rest of the robot leaves room for it
     being intended (a large ground plane, a tiny marker), as I210 (error) when the unit is
     certainly wrong.
+
+    Severity (warning, ambiguous): a large ground plane or a tiny marker may be
+    intended; I210 is the certain case.
     """
     yield from _mesh_scale_findings(ctx, certain=False)
 
 
 @rule("I210", "mesh-unit-wrong", "error",
-      "A mesh is about 1000x too large or too small: certainly the wrong unit.")
+      "A mesh is about 1000x too large or too small: certainly the wrong unit.", clause="cannot-fly")
 def mesh_unit_wrong(ctx: CheckContext) -> Iterator[Issue]:
     """The mesh, sized as Gazebo loads it (see I206), is outside 1 mm - 20 m and the unit
     is certainly wrong, which is the case when any of these holds:
@@ -419,5 +485,8 @@ def mesh_unit_wrong(ctx: CheckContext) -> Iterator[Issue]:
 
     Gazebo shows and collides with a body a thousand times its size (or invisible), and
     a mesh used for inertia gives a tensor a million times off.
+
+    Severity (error, cannot-fly): the body collides and weighs as one a thousand times
+    its size (or invisible).
     """
     yield from _mesh_scale_findings(ctx, certain=True)

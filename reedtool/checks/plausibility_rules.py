@@ -22,7 +22,12 @@ from reedtool.checks.rotor_rules import MAX_CONDITION_NUMBER, _normalised_alloca
 if TYPE_CHECKING:
     from reedtool.physics.rotors import Rotor
 
-THRUST_TO_WEIGHT_HIGH = 6.0
+# Above this no multirotor flies: camera and transport frames are built for 2-3, 5-inch
+# racing quads for 8-15, the lightest freestyle builds approach 20, and omnidirectional
+# frames carry margin because half their rotors push against the other half (PX4's
+# omnicopter 9.1, RotorS omav 6.3). 25 leaves room above the lightest real builds; a
+# copied speed or a unit mistake lands far beyond (gz-sim's test quadrotor: 147).
+THRUST_TO_WEIGHT_HIGH = 25.0
 # Whole-robot mass over the cube of the rotor span (2 x the farthest rotor from the COM):
 # real multirotors sit at 10-150 kg/m³ (x500 ~17, a 65 mm whoop ~90); above this the mass
 # belongs to a larger vehicle.
@@ -30,6 +35,9 @@ SPAN_DENSITY_MAX_KG_M3 = 1000.0
 # Yaw radius of gyration sqrt(Izz/m) over the farthest rotor's distance from the COM: the
 # mass of a multirotor lies inside its rotor circle, so above this the inertia does not fit.
 GYRATION_RATIO_MAX = 1.5
+# Lift rotors all within this horizontal distance of the COM: a coaxial or single-rotor
+# helicopter (the Sikorsky X2 shape), whose size the rotor positions do not tell.
+SINGLE_AXIS_SPAN_M = 0.01
 JOINT_AXIS_TOL_DEG = 5.0
 TRIM_SPREAD_MAX = 0.15
 PARALLEL_TOL_DEG = 1.0
@@ -45,13 +53,17 @@ def _span_m(ctx: CheckContext) -> float:
 
 
 @rule("R340", "thrust-to-weight-high", "warning",
-      "Thrust-to-weight is above 6: the motor constants or speeds belong to another vehicle.")
+      "Thrust-to-weight is above 25: the motor constants or speeds belong to another vehicle.", clause="suspicious")
 def thrust_to_weight_high(ctx: CheckContext) -> Iterator[Issue]:
-    """Camera and transport multirotors fly with a thrust-to-weight ratio of 2-3, racing
-    quads up to 5-6. Far above that, the motor constant or maxRotVelocity was copied from
-    a larger vehicle or written in other units (gz-sim's test-world quadrotor with
-    maxRotVelocity 8000 reaches 147): the controller's output range then spans far more
-    thrust than the vehicle could have, and every gain tuned on it is wrong.
+    """Camera and transport multirotors fly with a thrust-to-weight ratio of 2-3, 5-inch
+    racing quads with 8-15, the lightest freestyle builds approach 20, and omnidirectional
+    frames need margin (PX4's omnicopter 9.1, RotorS omav 6.3): none of those is
+    suspicious. Above 25 no multirotor flies; the motor constant or maxRotVelocity was
+    copied from a larger vehicle or written in other units (gz-sim's test-world quadrotor
+    with maxRotVelocity 8000 reaches 147): the controller's output range then spans far
+    more thrust than the vehicle could have, and every gain tuned on it is wrong.
+
+    Severity (warning): the model loads and flies; only its numbers are implausible.
     """
     if not _physics_ready(ctx):
         return
@@ -70,7 +82,7 @@ def thrust_to_weight_high(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("I220", "mass-implausible-for-size", "warning",
-      "The whole-robot mass or inertia does not fit the rotor span.")
+      "The whole-robot mass or inertia does not fit the rotor span.", clause="suspicious")
 def mass_implausible_for_size(ctx: CheckContext) -> Iterator[Issue]:
     """Two ratios that real multirotors keep whatever their size. Mass over the cube of
     the rotor span (twice the farthest rotor's distance from the COM) stays within about
@@ -78,13 +90,17 @@ def mass_implausible_for_size(ctx: CheckContext) -> Iterator[Issue]:
     bounding cube. The yaw radius of gyration sqrt(Izz/m) stays inside the rotor circle:
     above 1.5 times the rotor distance the inertia puts the mass outside the rotors. Both
     catch a mass and inertia copied from a larger vehicle (1.5 kg on a 65 mm frame).
+    A coaxial or single-rotor helicopter (every lift rotor within 1 cm of the COM's
+    vertical) has no rotor span to compare with and is not judged.
+
+    Severity (warning): the model flies, like a vehicle of another size.
     """
     if not _physics_ready(ctx) or not _lift(ctx):
         return
     whole = ctx.whole_robot
     span = _span_m(ctx)
-    if span <= 0:
-        return
+    if span < SINGLE_AXIS_SPAN_M:
+        return      # coaxial or single-rotor: no rotor span to size the vehicle by
     rotor = _lift(ctx)[0]
     density = whole.mass_kg / (2.0 * span) ** 3
     if density > SPAN_DENSITY_MAX_KG_M3:
@@ -108,13 +124,16 @@ def mass_implausible_for_size(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R341", "rotor-joint-axis-not-thrust-axis", "warning",
-      "A rotor's joint turns about another axis than the rotor's thrust axis.")
+      "A rotor's joint turns about another axis than the rotor's thrust axis.", clause="suspicious")
 def rotor_joint_axis(ctx: CheckContext) -> Iterator[Issue]:
     """The motor plugin pushes along the rotor link's z axis and spins the rotor about
     its joint axis. When the two differ by more than 5°, the propeller visibly wobbles,
     its gyroscopic torque acts about the wrong axis, and usually one of the two poses
     is wrong (a rotor link rotated by a mesh correction, an axis given in the parent's
     frame).
+
+    Severity (warning, suspicious): the motor plugin pushes along the link's z axis, so
+    the vehicle flies; the prop spins and precesses about the wrong axis.
     """
     if not ctx.tree_ok:
         return
@@ -139,7 +158,7 @@ def rotor_joint_axis(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R342", "uneven-hover-trim", "warning",
-      "At hover the rotor thrusts differ by more than 15 %: the COM is off the rotor centroid.")
+      "At hover the rotor thrusts differ by more than 15 %: the COM is off the rotor centroid.", clause="suspicious")
 def uneven_hover_trim(ctx: CheckContext) -> Iterator[Issue]:
     """With every lift rotor parallel, equal thrusts hold the vehicle level only when the
     centre of mass sits over the rotors' centroid. Otherwise some rotors hover harder than
@@ -148,6 +167,8 @@ def uneven_hover_trim(ctx: CheckContext) -> Iterator[Issue]:
     than 15 % above the smallest, with the COM shift that would even them out. A nearly
     singular allocation (R306) spreads the thrusts by its geometry alone; that is R306's
     finding, not this one.
+
+    Severity (warning, suspicious): it hovers, with less margin on one side.
     """
     if not _physics_ready(ctx):
         return

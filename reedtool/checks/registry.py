@@ -35,6 +35,22 @@ EXTRA_RULE_MODULES: tuple[str, ...] = (
     "reedtool.checks.plausibility_rules",
 )
 
+# The severity policy (docs/validate.md, "Severity policy"): each rule names the clause that
+# gives its default severity. clause -> (the severities it allows, its wording).
+POLICY_CLAUSES: dict[str, tuple[tuple[str, ...], str]] = {
+    "refused": (("error",), "Gazebo refuses the model: libsdformat, urdfdom, TinyXML2, a "
+                            "mesh loader or a plugin rejects it, or Gazebo drops the element"),
+    "cannot-fly": (("error",), "the model as written cannot do what it is for: it cannot "
+                               "hover or be controlled, or a rotor spins against its "
+                               "allocation"),
+    "flight-stack": (("error",), "the flight stack or controller will command a motor the "
+                                 "model does not have, spin it the other way, or saturate it"),
+    "suspicious": (("warning",), "suspicious, but the model loads and can fly"),
+    "ambiguous": (("warning", "info"), "reedtool cannot tell a convention from a mistake, "
+                                       "so it says what it sees at a lower severity"),
+    "explains": (("info",), "it explains; nothing is wrong"),
+}
+
 _CODE = re.compile(r"^[A-Z]\d{3}$")
 _SLUG = re.compile(r"^[a-z0-9]+(-[a-z0-9]+)*$")
 
@@ -46,6 +62,12 @@ class Rule:
     severity: str          # default; a config may override it
     summary: str           # one line
     check: CheckFn
+    clause: str = ""       # POLICY_CLAUSES key: why the default severity is what it is
+
+    @property
+    def policy(self) -> str:
+        """The severity policy's sentence for this rule, as documented."""
+        return f"{self.severity}: {POLICY_CLAUSES[self.clause][1]}"
 
     @property
     def family(self) -> str:
@@ -59,8 +81,10 @@ class Rule:
 _RULES: dict[str, Rule] = {}
 
 
-def rule(code: str, slug: str, severity: str, summary: str) -> Callable[[CheckFn], CheckFn]:
-    """Register a check function under a stable code."""
+def rule(code: str, slug: str, severity: str, summary: str, *, clause: str
+         ) -> Callable[[CheckFn], CheckFn]:
+    """Register a check function under a stable code; `clause` names the severity
+    policy's clause (POLICY_CLAUSES) that gives `severity`."""
 
     def register(fn: CheckFn) -> CheckFn:
         # Programming errors in a rule module, caught at import time by the test suite.
@@ -70,13 +94,15 @@ def rule(code: str, slug: str, severity: str, summary: str) -> Callable[[CheckFn
             raise ValueError(f"bad rule slug {slug!r}")
         if severity not in SEVERITIES:
             raise ValueError(f"bad severity {severity!r} for {code}")
+        if clause not in POLICY_CLAUSES or severity not in POLICY_CLAUSES[clause][0]:
+            raise ValueError(f"rule {code}: clause {clause!r} does not give severity {severity}")
         if not fn.__doc__:
             raise ValueError(f"rule {code} has no docstring (its documentation)")
         if code in _RULES and _RULES[code].check is not fn:
             raise ValueError(f"rule code {code} registered twice")
         if any(r.slug == slug and r.code != code for r in _RULES.values()):
             raise ValueError(f"rule slug {slug!r} registered twice")
-        _RULES[code] = Rule(code, slug, severity, summary, fn)
+        _RULES[code] = Rule(code, slug, severity, summary, fn, clause)
         return fn
 
     return register

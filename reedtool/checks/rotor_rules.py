@@ -68,9 +68,10 @@ def _constants_ok(rotor: "Rotor") -> bool:
 
 
 def _physics_ready(ctx: CheckContext) -> bool:
-    """Every rotor placed, turning a known way, with usable constants; the robot has mass."""
+    """Every rotor placed, turning a known way, with usable constants; the robot has mass;
+    no rotor carried by an actuated joint (its zero pose is not the flight pose: R319)."""
     rotors = _lift(ctx)
-    if not rotors:
+    if not rotors or ctx.articulated_rotors:
         return False
     for rotor in rotors:
         if not (np.all(np.isfinite(rotor.position_m)) and np.all(np.isfinite(rotor.axis))
@@ -107,12 +108,15 @@ def _number_loc(rotor: "Rotor"):
     return rotor.param_loc(rotor.number_tag)
 
 
-@rule("R301", "motor-number-duplicate", "error", "Two rotors have the same motor number.")
+@rule("R301", "motor-number-duplicate", "error", "Two rotors have the same motor number.", clause="cannot-fly")
 def motor_number_duplicate(ctx: CheckContext) -> Iterator[Issue]:
     """The motor number (`<motorNumber>`; gz-sim `<actuator_number>`; ArduPilot the
     `<control channel>`) is the rotor's index in the command the flight stack sends. Two
     rotors with the same number receive the same command and another index drives
     nothing; the vehicle flips on take-off.
+
+    Severity (error, cannot-fly): two rotors read one command and another command spins
+    nothing.
     """
     seen: dict[int, "Rotor"] = {}
     for rotor in _rotors(ctx):
@@ -128,16 +132,29 @@ def motor_number_duplicate(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R302", "motor-numbers-not-contiguous", "error",
-      "Motor numbers are missing or not 0..n-1.")
+      "A motor has no number, or one its autopilot interface never commands.",
+      clause="cannot-fly")
 def motor_numbers_not_contiguous(ctx: CheckContext) -> Iterator[Issue]:
-    """With n rotors the motor numbers must be exactly 0, 1, ..., n-1: the command vector
-    has n entries and a rotor numbered n or above never receives one. A missing or
-    unreadable `<motorNumber>` is reported here as well.
+    """A motor plugin spins at the entry of the command vector its number names. The
+    vector is what the autopilot interface sends: RotorS's MAVLink interface sends
+    `rotor_count` entries (0..count-1), PX4 classic's fills entry `input_index` of each
+    control channel (a plane's puller is motor 4 because its channel's input_index is 4).
+    A motor whose number the interface never fills never spins. A missing or unreadable
+    `<motorNumber>` / `<actuator_number>` is reported as well.
+
+    Without such an interface (gz-sim, where PX4's gz bridge or another node sends the
+    commands) the numbers are the flight stack's outputs and a gap is no mistake by itself:
+    `--airframe` compares them with PX4's outputs (C414).
+
+    Severity (error, cannot-fly): the motor never receives a command.
     """
+    from reedtool.physics.rotors import command_vector
+
     # ArduPilot channels are servo outputs mapped by SERVOn_FUNCTION: any channel is fine.
     rotors = [r for r in _rotors(ctx) if r.kind != "ardupilot"]
     if not rotors:
         return
+    vector = command_vector(ctx.robot)
     for rotor in rotors:
         if rotor.motor_number is None:
             tag = rotor.number_tag
@@ -146,24 +163,31 @@ def motor_numbers_not_contiguous(ctx: CheckContext) -> Iterator[Issue]:
             yield Issue(f"rotor '{rotor.name}': {what}", _number_loc(rotor),
                         rotor.name, hint=f"add <{tag}>N</{tag}>, N from 0 to "
                                          f"{len(rotors) - 1}")
-    numbers = {r.motor_number for r in rotors if r.motor_number is not None}
-    expected = set(range(len(rotors)))
-    outside = sorted(numbers - expected)
-    missing = sorted(expected - numbers)
+    if vector is None:
+        return
+    used = {r.motor_number for r in rotors if r.motor_number is not None}
+    free = sorted(vector.indices - used)
     for rotor in rotors:
-        if rotor.motor_number in outside:
-            yield Issue(f"rotor '{rotor.name}' has {_number_what(rotor)} {rotor.motor_number}; "
-                        f"with {len(rotors)} rotors the numbers are 0..{len(rotors) - 1}",
+        if rotor.motor_number is not None and rotor.motor_number not in vector.indices:
+            indices = sorted(vector.indices)
+            shown = (f"{indices[0]}..{indices[-1]}" if indices == list(range(indices[0],
+                                                                              indices[-1] + 1))
+                     else ", ".join(map(str, indices)))
+            yield Issue(f"rotor '{rotor.name}' has {_number_what(rotor)} {rotor.motor_number}, "
+                        f"but the autopilot interface fills entries {shown} ({vector.what}, "
+                        f"{vector.loc}): this motor never receives a command",
                         _number_loc(rotor), rotor.name,
-                        hint=f"unused numbers: {', '.join(map(str, missing))}"
-                        if missing else None)
+                        hint=f"unused numbers: {', '.join(map(str, free))}" if free else None)
 
 
-@rule("R303", "rotor-direction-invalid", "error", "A rotor's turning direction is not cw or ccw.")
+@rule("R303", "rotor-direction-invalid", "error", "A rotor's turning direction is not cw or ccw.", clause="refused")
 def rotor_direction_invalid(ctx: CheckContext) -> Iterator[Issue]:
     """`<turningDirection>` must be exactly `ccw` or `cw` (lower case: the motor plugins
     compare the string). Anything else makes the plugin refuse to load or spin the
     rotor with an undefined sign.
+
+    Severity (error, refused): the motor plugin refuses the direction and the rotor
+    never turns.
     """
     for rotor in _rotors(ctx):
         if rotor.kind == "ardupilot":
@@ -181,7 +205,7 @@ def rotor_direction_invalid(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R304", "yaw-moment-imbalance", "error",
-      "At equal rotor speed the rotors' yaw moments do not cancel.")
+      "At equal rotor speed the rotors' yaw moments do not cancel.", clause="cannot-fly")
 def yaw_moment_imbalance(ctx: CheckContext) -> Iterator[Issue]:
     """Each rotor's drag pushes the body the other way round (a ccw rotor pushes it cw),
     by momentConstant x thrust. When every rotor spins at the same speed these moments
@@ -190,6 +214,8 @@ def yaw_moment_imbalance(ctx: CheckContext) -> Iterator[Issue]:
     must unbalance the rotors just to hold heading.
 
     The hint names the rotor whose direction, flipped, balances the set when there is one.
+
+    Severity (error, cannot-fly): the vehicle spins up in yaw at take-off.
     """
     found = None if ctx.omnidirectional else _yaw_imbalance(ctx)
     if found is None:
@@ -276,13 +302,15 @@ _AXES = ("thrust", "roll", "pitch", "yaw")
 
 
 @rule("R305", "allocation-rank-deficient", "error",
-      "The rotors cannot set thrust, roll, pitch and yaw independently.")
+      "The rotors cannot set thrust, roll, pitch and yaw independently.", clause="cannot-fly")
 def allocation_rank_deficient(ctx: CheckContext) -> Iterator[Issue]:
     """The allocation matrix maps rotor thrusts to collective thrust and roll, pitch and
     yaw torque about the centre of mass; it is built from the rotors' positions, axes,
     directions and constants. With rank below 4 some combination of the four cannot be
     commanded: typically neighbouring rotors of a quad-X turn the same way (yaw becomes
     roll or pitch), or all rotors lie on one line.
+
+    Severity (error, cannot-fly): some axis cannot be controlled.
     """
     if not _physics_ready(ctx):
         return
@@ -329,11 +357,14 @@ def _wrench_rank_deficient(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R306", "allocation-ill-conditioned", "warning",
-      "The allocation matrix is nearly singular.")
+      "The allocation matrix is nearly singular.", clause="suspicious")
 def allocation_ill_conditioned(ctx: CheckContext) -> Iterator[Issue]:
     """With each row scaled to unit norm, the allocation matrix of a symmetric frame has
     condition number 1. Above 25 one axis is controlled only by large, opposing thrust
     changes: the controller saturates motors on small commands.
+
+    Severity (warning, suspicious): every axis is controllable, with little authority on
+    one.
     """
     if not _physics_ready(ctx) or ctx.omnidirectional or _rank(ctx) < 4:
         return
@@ -347,7 +378,7 @@ def allocation_ill_conditioned(ctx: CheckContext) -> Iterator[Issue]:
 # ----------------------------------------------------------------------- trim
 
 @rule("R307", "trim-infeasible", "error",
-      "No rotor thrusts within [0, k·ω_max²] hold the robot level in hover.")
+      "No rotor thrusts within [0, k·ω_max²] hold the robot level in hover.", clause="cannot-fly")
 def trim_infeasible(ctx: CheckContext) -> Iterator[Issue]:
     """Hover needs thrusts that give collective thrust m·g and no torque about the
     centre of mass, each between 0 and the rotor's maximum k·ω_max². When the least-
@@ -356,6 +387,8 @@ def trim_infeasible(ctx: CheckContext) -> Iterator[Issue]:
     yaw moments cannot cancel.
 
     Not reported when R304, R305 or R308 already explain it.
+
+    Severity (error, cannot-fly): the vehicle cannot hover level.
     """
     if not _physics_ready(ctx):
         return
@@ -396,12 +429,14 @@ def _max_loc(rotor: "Rotor"):
 
 
 @rule("R308", "thrust-to-weight-below-one", "error",
-      "At full speed the rotors cannot lift the robot.")
+      "At full speed the rotors cannot lift the robot.", clause="cannot-fly")
 def thrust_to_weight_below_one(ctx: CheckContext) -> Iterator[Issue]:
     """Thrust-to-weight is the rotors' combined upward thrust at maxRotVelocity,
     sum(k·ω_max²·axis_z), over the robot's weight m·g. Below 1 the model cannot leave
     the ground. Usually a mass in grams read as kilograms, a motor constant off by a
     power of ten, or maxRotVelocity in rpm instead of rad/s.
+
+    Severity (error, cannot-fly): the vehicle cannot leave the ground.
     """
     trim = _weight_and_trim(ctx)
     if trim is None or trim.thrust_to_weight >= THRUST_TO_WEIGHT_MIN:
@@ -416,11 +451,13 @@ def thrust_to_weight_below_one(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R309", "thrust-to-weight-low", "warning",
-      "Thrust-to-weight is below 1.5: little margin to climb and control.")
+      "Thrust-to-weight is below 1.5: little margin to climb and control.", clause="suspicious")
 def thrust_to_weight_low(ctx: CheckContext) -> Iterator[Issue]:
     """A multirotor that can lift itself but with thrust-to-weight below 1.5 hovers near
     full throttle, with little left for attitude control or climbing; real vehicles are
     built for 2 or more.
+
+    Severity (warning, suspicious): it flies, with little margin to climb and control.
     """
     trim = _weight_and_trim(ctx)
     if trim is None or not THRUST_TO_WEIGHT_MIN <= trim.thrust_to_weight < THRUST_TO_WEIGHT_WARN:
@@ -434,11 +471,13 @@ def thrust_to_weight_low(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R310", "hover-throttle-high", "warning",
-      "A rotor needs more than 80 % of its maximum speed to hover.")
+      "A rotor needs more than 80 % of its maximum speed to hover.", clause="suspicious")
 def hover_throttle_high(ctx: CheckContext) -> Iterator[Issue]:
     """Hover throttle is the trim speed over maxRotVelocity. Above 0.8 for any rotor,
     that rotor has almost no speed left to correct attitude and the controller
     saturates in the first gust (or the first Gazebo step with an unlucky contact).
+
+    Severity (warning, suspicious): it hovers, with little left for control.
     """
     trim = _weight_and_trim(ctx)
     if trim is None or not trim.feasible or trim.hover_throttle_max <= HOVER_THROTTLE_MAX:
@@ -456,7 +495,7 @@ def hover_throttle_high(ctx: CheckContext) -> Iterator[Issue]:
 
 # ------------------------------------------------------------------- geometry
 
-@rule("R311", "rotor-axis-tilted", "warning", "A rotor's thrust axis is not along body z.")
+@rule("R311", "rotor-axis-tilted", "warning", "A rotor's thrust axis is not along body z.", clause="suspicious")
 def rotor_axis_tilted(ctx: CheckContext) -> Iterator[Issue]:
     """Motor plugins push along the rotor link's z axis. For a conventional multirotor
     that axis is the base link's z; a tilt usually comes from an `rpy` on the rotor joint
@@ -465,9 +504,12 @@ def rotor_axis_tilted(ctx: CheckContext) -> Iterator[Issue]:
 
     A balanced pattern (R320: several rotors tilted so that their side forces and tilt
     yaw torques cancel, as on the AscTec Neo) is information, not this warning. Propulsion
-    rotors (R319) and omnidirectional frames are not judged by tilt.
+    rotors (R319) and omnidirectional frames are not judged by tilt, nor rotors carried by
+    an actuated joint (R319: the servo sets their tilt in flight).
+
+    Severity (warning, suspicious): a tilt may be deliberate.
     """
-    if ctx.omnidirectional or balanced_tilt(ctx) is not None:
+    if ctx.omnidirectional or ctx.articulated_rotors or balanced_tilt(ctx) is not None:
         return
     for rotor in _lift(ctx):
         axis = np.asarray(rotor.axis, dtype=float)
@@ -486,12 +528,16 @@ def rotor_axis_tilted(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R312", "rotor-count-mismatch", "error",
-      "The MAVLink/PX4 interface declares a different number of rotors than exist.")
+      "The MAVLink/PX4 interface declares a different number of rotors than exist.", clause="flight-stack")
 def rotor_count_mismatch(ctx: CheckContext) -> Iterator[Issue]:
-    """The autopilot interface plugin forwards one motor command per declared rotor
-    (`rotor_count`, or its control channels). More than there are motor plugins and the
-    autopilot mixes for a frame that does not exist; fewer and some rotors never spin. A
-    count that is not a whole number is reported too: the plugin cannot use it either.
+    """RotorS's autopilot interface plugin forwards one motor command per declared rotor
+    (`rotor_count`). More than there are motor plugins and the autopilot mixes for a frame
+    that does not exist; fewer and some rotors never spin. A count that is not a whole
+    number is reported too: the plugin cannot use it either. PX4 classic's control
+    channels declare no count (unused channels are unused outputs; a motor no channel
+    fills is R302).
+
+    Severity (error, flight-stack): the autopilot commands motors the model does not have.
     """
     if not ctx.tree_ok:
         return
@@ -510,25 +556,46 @@ def rotor_count_mismatch(ctx: CheckContext) -> Iterator[Issue]:
                         hint=f"set rotor_count to {found}")
 
 
-@rule("R313", "rotor-joint-not-continuous", "error", "A rotor turns on a joint that is not continuous.")
+@rule("R313", "rotor-joint-not-continuous", "error", "A rotor turns on a joint that is not continuous.", clause="cannot-fly")
 def rotor_joint_not_continuous(ctx: CheckContext) -> Iterator[Issue]:
-    """A motor plugin spins its joint without end: the joint must be `continuous`. A
-    revolute joint stops at its limits, a fixed one is merged away by Gazebo and the
-    plugin finds no joint.
+    """A motor plugin spins its joint without end: the joint must be `continuous`, or a
+    revolute one whose limit in the way it turns is open. A revolute joint stops at its
+    limits, a fixed one is merged away by Gazebo and the plugin finds no joint.
+
+    sdformat writes "no limit" as ±1e16, and a rotor turns one way only, so a revolute
+    joint whose limit on that side is 1e9 rad or beyond spins like a continuous one: at
+    3000 rad/s it would take 92 hours of simulated time to reach it (SITL_Models'
+    mini_talon_vtail: -1e-16..1e16, turned positive by its multiplier; SwiftGust's
+    Sikorsky X2 blades: ±1e12). The
+    way is the sign of the joint velocity the plugin commands: the ArduPilotPlugin's
+    multiplier, or the motor model's turningDirection (ccw +1, cw -1).
+
+    Severity (error, cannot-fly): the rotor stops at the limit.
     """
     for rotor in _rotors(ctx):
         joint = ctx.robot.joint_map.get(rotor.joint or "")
+        if joint is not None and joint.type == "revolute" and joint.limit is not None:
+            if rotor.kind == "ardupilot":
+                way = np.sign(_number_or_nan(rotor.param("multiplier") or "1"))
+            else:
+                way = rotor.turning_sign
+            if (way > 0 and joint.limit.upper >= ROTOR_LIMIT_OPEN_RAD) \
+                    or (way < 0 and joint.limit.lower <= -ROTOR_LIMIT_OPEN_RAD):
+                continue
         if joint is not None and joint.type != "continuous":
             yield Issue(f"rotor '{rotor.name}' spins joint '{joint.name}', which is {joint.type}",
                         joint.loc, joint.name, hint='use type="continuous"')
 
 
 @rule("R314", "rotor-plugin-target-missing", "error",
-      "A motor plugin names a joint or link that does not exist.")
+      "A motor plugin names a joint or link that does not exist.", clause="refused")
 def rotor_plugin_target_missing(ctx: CheckContext) -> Iterator[Issue]:
     """`<jointName>` and `<linkName>` of a motor plugin must name the rotor's joint and
     link exactly (namespace prefix included); the plugin fails to load otherwise and the
     rotor does not exist in the simulation.
+
+    Severity (error, refused): the plugin finds no joint or link and the rotor never
+    turns.
     """
     import difflib
 
@@ -551,11 +618,14 @@ def rotor_plugin_target_missing(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R315", "rotor-link-not-joint-child", "error",
-      "A motor plugin's link is not the child of its joint.")
+      "A motor plugin's link is not the child of its joint.", clause="cannot-fly")
 def rotor_link_not_joint_child(ctx: CheckContext) -> Iterator[Issue]:
     """The plugin spins `<jointName>` and applies thrust to `<linkName>`; they must be the
     same rotor: the link is the joint's child. Otherwise thrust is applied to a link that
     does not turn, typically after copying a rotor block and renaming only one of them.
+
+    Severity (error, cannot-fly): thrust is applied to another body than the one that
+    spins.
     """
     for rotor in _rotors(ctx):
         joint = ctx.robot.joint_map.get(rotor.joint or "")
@@ -569,13 +639,15 @@ def rotor_link_not_joint_child(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R316", "rotor-constant-invalid", "error",
-      "A rotor's motor constant, moment constant or maximum speed is missing or not positive.")
+      "A rotor's motor constant, moment constant or maximum speed is missing or not positive.", clause="cannot-fly")
 def rotor_constant_invalid(ctx: CheckContext) -> Iterator[Issue]:
     """`motorConstant` (thrust = k·ω², N/(rad/s)²) and `maxRotVelocity` (rad/s) must be
     positive and `momentConstant` (yaw drag torque per newton of thrust, m) must not be
     negative. Missing values silently fall back to a plugin default that differs between
     RotorS, PX4 and gz-sim; write them out. (ArduPilot rotors have no such elements:
     R317 says what is estimated for them.)
+
+    Severity (error, cannot-fly): the rotor gives no thrust, or pulls down.
     """
     for rotor in filter(_written, _rotors(ctx)):
         for attr, tag, unit in CONSTANTS:
@@ -590,6 +662,31 @@ def rotor_constant_invalid(ctx: CheckContext) -> Iterator[Issue]:
                             rotor.param_loc(tag), rotor.name,
                             hint=f"a {'non-negative' if attr == 'moment_constant' else 'positive'}"
                                  f" number in {unit}")
+
+
+# A revolute rotor joint's limit this far out is never reached (3000 rad/s: 92 h).
+ROTOR_LIMIT_OPEN_RAD = 1e9
+# Beyond this angle between a rotor's joint axis and its thrust axis, "the way it spins
+# about its thrust axis" is not defined (the two are closer to perpendicular than parallel).
+SPIN_AXIS_UNDEFINED_DEG = 45.0
+
+
+def joint_axis_angle_deg(ctx: CheckContext, rotor: "Rotor") -> float | None:
+    """Angle between the rotor's joint axis (in the base frame) and its thrust axis, folded
+    to 0-90° (a joint axis either way spins the same rotor); None when undefined."""
+    if not ctx.tree_ok:
+        return None
+    poses = ctx.link_poses
+    joint = ctx.robot.joint_map.get(rotor.joint or "")
+    if joint is None or joint.child not in poses or not np.all(np.isfinite(rotor.axis)) \
+            or np.linalg.norm(rotor.axis) == 0:
+        return None
+    axis = np.asarray(joint.axis, dtype=float)
+    if not np.all(np.isfinite(axis)) or np.linalg.norm(axis) == 0:
+        return None
+    axis_base = poses[joint.child][:3, :3] @ (axis / np.linalg.norm(axis))
+    cos = abs(float(np.dot(axis_base, rotor.axis / np.linalg.norm(rotor.axis))))
+    return math.degrees(math.acos(min(1.0, cos)))
 
 
 # ------------------------------------------------- families, roles and patterns
@@ -619,7 +716,7 @@ def balanced_tilt(ctx: CheckContext):
 
 
 @rule("R317", "rotor-constants-estimated", "info",
-      "An ArduPilot rotor's thrust constants are estimated from its LiftDrag blades.")
+      "An ArduPilot rotor's thrust constants are estimated from its LiftDrag blades.", clause="explains")
 def rotor_constants_estimated(ctx: CheckContext) -> Iterator[Issue]:
     """ArduPilotPlugin models write no motor constant: thrust comes from LiftDrag plugins
     on the blades. reedtool estimates k_f = sum(0.5·rho·r²·area·cla·a0) over the blades
@@ -628,6 +725,9 @@ def rotor_constants_estimated(ctx: CheckContext) -> Iterator[Issue]:
     |multiplier| (the joint target is multiplier × the [0, 1] command). The hover rules use
     these numbers; LiftDrag in flight also sees the inflow, so the real thrust is lower.
     Without blades the rotor's thrust is unknown and the hover rules are skipped.
+
+    Severity (info, explains): it says how numbers the model does not write were
+    estimated.
     """
     for rotor in _rotors(ctx):
         if rotor.kind != "ardupilot":
@@ -645,7 +745,7 @@ def rotor_constants_estimated(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R318", "ardupilot-spin-against-blades", "error",
-      "An ArduPilot channel spins its rotor against the way its blades make lift.")
+      "An ArduPilot channel spins its rotor against the way its blades make lift.", clause="cannot-fly")
 def ardupilot_spin_against_blades(ctx: CheckContext) -> Iterator[Issue]:
     """The ArduPilotPlugin turns the joint at `multiplier` × command about the joint axis,
     so the multiplier's sign is the spin direction. Each LiftDrag blade makes lift only
@@ -653,10 +753,19 @@ def ardupilot_spin_against_blades(ctx: CheckContext) -> Iterator[Issue]:
     it pushes down. A multiplier whose sign disagrees with the blades (copying a cw
     rotor's control block onto a ccw rotor) makes that rotor push the vehicle to the
     ground at take-off.
+
+    A rotor whose joint turns about an axis more than 45° from its thrust axis has no
+    spin direction about that axis to compare (SITL_Models' alti_transition_quad's forward
+    motor turns about the vertical while its blades face forward): R341 reports the axis.
+
+    Severity (error, cannot-fly): the rotor pushes the wrong way.
     """
     for rotor in _rotors(ctx):
         if rotor.kind != "ardupilot" or rotor.blade_turning_sign == 0 or rotor.turning_sign == 0:
             continue
+        angle = joint_axis_angle_deg(ctx, rotor)
+        if angle is not None and angle > SPIN_AXIS_UNDEFINED_DEG:
+            continue    # the joint does not spin it about its thrust axis: R341 says so
         if rotor.blade_turning_sign != rotor.turning_sign:
             want = "ccw" if rotor.blade_turning_sign > 0 else "cw"
             yield Issue(f"rotor '{rotor.name}' (channel {rotor.channel}): multiplier "
@@ -667,14 +776,19 @@ def ardupilot_spin_against_blades(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R319", "rotor-role", "info",
-      "Rotors that are not lift rotors, or an omnidirectional frame.")
+      "Rotors that are not lift rotors, or an omnidirectional frame.", clause="explains")
 def rotor_role(ctx: CheckContext) -> Iterator[Issue]:
     """A rotor whose thrust axis is 60-120° from body z on a vehicle that also has lift
     rotors (or a wing), pointing along body ±x or on a vehicle with a wing, is
     propulsion: a fixed-wing puller or a VTOL pusher. It is
     left out of the hover allocation, the trim and the lift-rotor rules (R304-R311). A
     frame with reversible motors or rotors pointing in every direction is
-    omnidirectional: it is judged by the full 6-DoF force-and-torque allocation.
+    omnidirectional: it is judged by the full 6-DoF force-and-torque allocation. Rotors
+    carried by an actuated joint (a tilt servo, an arm, a leg: SITL_Models' hexapod_copter
+    flies with its rotors where its leg servos put them) have no fixed flight pose: the
+    hover rules do not judge them at the model's zero pose.
+
+    Severity (info, explains): it says which rotors the hover rules leave out, and why.
     """
     for rotor in _rotors(ctx):
         if rotor.role == "propulsion":
@@ -682,6 +796,13 @@ def rotor_role(ctx: CheckContext) -> Iterator[Issue]:
             yield Issue(f"rotor '{rotor.name}' is propulsion (thrust axis "
                         f"{', '.join(f'{v:.3f}' for v in axis)}, {rotor.tilt_deg:.0f}° from "
                         "body z): not used for hover", rotor.loc, rotor.name)
+    if ctx.articulated_rotors:
+        name, joint = next(iter(ctx.articulated_rotors.items()))
+        more = len(ctx.articulated_rotors) - 1
+        yield Issue(f"rotor '{name}'{f' and {more} more' if more else ''} ride on actuated "
+                    f"joint '{joint}': their flight pose is set by it, so hover, trim, "
+                    "allocation and tilt are not judged at the zero pose (R304-R311, R340-R342, "
+                    "I220)", _lift(ctx)[0].loc, "rotors")
     if _lift(ctx) and ctx.omnidirectional:
         reversible = sum(r.reversible for r in _lift(ctx))
         yield Issue(f"omnidirectional frame: {len(_lift(ctx))} rotors ({reversible} "
@@ -690,13 +811,15 @@ def rotor_role(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("R320", "rotor-tilt-pattern", "info",
-      "The rotors are tilted in a balanced pattern.")
+      "The rotors are tilted in a balanced pattern.", clause="explains")
 def rotor_tilt_pattern(ctx: CheckContext) -> Iterator[Issue]:
     """Some frames tilt every rotor on purpose: the AscTec Neo (RotorS neo9/neo11) tilts
     each rotor 5° sideways, alternating, for more yaw authority; tailsitters tilt theirs
     tangentially. At equal thrust their side forces cancel and so do the yaw torques the
     tilts make through the lever arms. Such a pattern is reported here; a single or
     unbalanced tilt is R311's warning.
+
+    Severity (info, explains): a balanced tilt pattern is a design.
     """
     if ctx.omnidirectional:
         return

@@ -22,7 +22,7 @@ def _md(text: str) -> str:
 
 
 def render() -> str:
-    from reedtool.checks.registry import FAMILIES, all_rules
+    from reedtool.checks.registry import FAMILIES, POLICY_CLAUSES, all_rules
 
     rules = all_rules()
     out = [
@@ -39,16 +39,24 @@ def render() -> str:
         "`reedtool rules` and print one rule's documentation with "
         "`reedtool validate --explain CODE`. See [validate.md](validate.md).",
         "",
-        "| Code | Name | Severity | Summary |",
-        "| --- | --- | --- | --- |",
+        "Each rule's default severity follows one clause of the severity policy "
+        "([validate.md](validate.md#severity-policy)):",
+        "",
+        *[f"- **{key}** ({' or '.join(sevs)}): {text}." for key, (sevs, text) in
+          POLICY_CLAUSES.items()],
+        "",
+        "| Code | Name | Severity | Clause | Summary |",
+        "| --- | --- | --- | --- | --- |",
     ]
-    out += [f"| [{r.code}](#{r.code.lower()}-{r.slug}) | {r.slug} | {r.severity} | {_md(r.summary)} |"
-            for r in rules]
+    out += [f"| [{r.code}](#{r.code.lower()}-{r.slug}) | {r.slug} | {r.severity} | {r.clause} "
+            f"| {_md(r.summary)} |" for r in rules]
     for letter, family_rules in groupby(rules, key=lambda r: r.code[0]):
         out += ["", f"## {FAMILIES[letter][1]} ({letter})"]
         for r in family_rules:
             out += ["", f"### {r.code} {r.slug}", "",
-                    f"*Default severity: {r.severity}.* {_md(r.summary)}", "", _md(r.explanation)]
+                    f"*Default severity: {r.severity}* ({r.clause}: "
+                    f"{POLICY_CLAUSES[r.clause][1]}). {_md(r.summary)}", "",
+                    _md(r.explanation)]
     return "\n".join(out) + "\n"
 
 

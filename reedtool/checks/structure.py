@@ -24,6 +24,13 @@ SDF_MIN_MASS_KG = 1e-6
 _NON_FINITE_KINDS = {"non-finite"}
 _LEGACY_KINDS = {"legacy-xacro"}
 _TOLERATED_KINDS = {"xml-tolerated"}
+_DEFAULT_INERTIAL_KINDS = {"sdf-default-inertial"}
+_UNDEFINED_KINDS = {"sdf-undefined-element"}
+_LATE_DECLARATION_KINDS = {"xml-declaration-late"}
+_SHORT_POSE_KINDS = {"sdf-short-pose"}
+# libsdformat's joint types (sdf/1.x/joint.sdf): what an SDF <joint type=> may be.
+SDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "ball", "screw",
+                   "universal", "revolute2", "gearbox")
 _PACKAGE_KINDS = {"package-duplicate"}
 _PER_AXIS_JOINTS = {"revolute", "continuous", "prismatic", "planar"}
 _LIMITED_JOINTS = {"revolute", "prismatic"}
@@ -33,7 +40,7 @@ def _fmt_names(names) -> str:
     return ", ".join(f"'{n}'" for n in names)
 
 
-@rule("S101", "urdf-parse-error", "error", "An element or attribute could not be read as URDF.")
+@rule("S101", "urdf-parse-error", "error", "An element or attribute could not be read as URDF.", clause="refused")
 def urdf_parse_error(ctx: CheckContext) -> Iterator[Issue]:
     """The URDF reader could not read an element: a number that is not a number, a missing
     required attribute (a link or joint without name=, a <mass> without value=), a missing
@@ -42,19 +49,26 @@ def urdf_parse_error(ctx: CheckContext) -> Iterator[Issue]:
     urdfdom refuses such a file outright (check_urdf fails); Gazebo's parser may instead
     substitute defaults (zero mass, zero inertia) and simulate something you did not write.
     Fix the element at the reported line.
+
+    Severity (error, refused): urdfdom and sdformat's URDF parser refuse the element.
     """
     for issue in ctx.robot.parse_issues:
-        if issue.kind not in _NON_FINITE_KINDS | _LEGACY_KINDS | _TOLERATED_KINDS | _PACKAGE_KINDS:
+        if issue.kind not in _NON_FINITE_KINDS | _LEGACY_KINDS | _TOLERATED_KINDS \
+                | _PACKAGE_KINDS | _DEFAULT_INERTIAL_KINDS | _UNDEFINED_KINDS \
+                | _LATE_DECLARATION_KINDS | _SHORT_POSE_KINDS:
             yield Issue(issue.message, issue.loc, issue.subject)
 
 
-@rule("S102", "non-finite-number", "error", "A number in the model is NaN or infinite.")
+@rule("S102", "non-finite-number", "error", "A number in the model is NaN or infinite.", clause="cannot-fly")
 def non_finite_number(ctx: CheckContext) -> Iterator[Issue]:
     """Every number in a URDF must be finite. `nan` and `inf` usually come from an xacro
     expression that divided by zero or used an undefined property default.
 
     Physics engines propagate a NaN through the whole simulation: the model explodes or
     vanishes on the first step.
+
+    Severity (error, cannot-fly): a NaN spreads through the whole simulation on the
+    first step.
     """
     for issue in ctx.robot.parse_issues:
         if issue.kind in _NON_FINITE_KINDS:
@@ -62,12 +76,18 @@ def non_finite_number(ctx: CheckContext) -> Iterator[Issue]:
                         hint="check the xacro expression that computes this value")
 
 
-@rule("S103", "legacy-xacro-tag", "error", "An old-style xacro tag was copied into the URDF.")
+@rule("S103", "legacy-xacro-tag", "warning", "An old-style xacro tag was copied into the URDF.",
+      clause="suspicious")
 def legacy_xacro_tag(ctx: CheckContext) -> Iterator[Issue]:
     """Old tutorials use `<property>`, `<include>`, `<macro>` and macro calls without the
     `xacro:` prefix. xacro 2.x no longer understands them and copies them into the URDF
-    unchanged, so properties are never defined and macros never expanded: the model is
-    silently broken.
+    unchanged, so properties are never defined and macros never expanded.
+
+    Severity (warning: suspicious, but the model loads): Gazebo ignores the copied tag. What
+    it should have made is missing, and where that breaks the model it shows elsewhere: an
+    undefined property stops the expansion (an input error), a missing link or joint is
+    a structure error (S104, S105). A copied call of a macro that makes only a
+    `<transmission>` (GRVC's aeroarms) changes nothing Gazebo flies.
 
     Spell them `<xacro:property>`, `<xacro:include>`, `<xacro:macro>` and `<xacro:NAME/>`
     (`reedtool expand --fix-legacy` rewrites them).
@@ -79,11 +99,13 @@ def legacy_xacro_tag(ctx: CheckContext) -> Iterator[Issue]:
                         hint="use the xacro: prefix (reedtool expand --fix-legacy rewrites it)")
 
 
-@rule("S104", "single-root", "error", "The model must have exactly one root link.")
+@rule("S104", "single-root", "error", "The model must have exactly one root link.", clause="refused")
 def single_root(ctx: CheckContext) -> Iterator[Issue]:
     """A URDF is a tree: exactly one link is not the child of any joint. Two roots mean a
     joint is missing (or names the wrong child); urdfdom rejects the file with "two root
     links found". A model without any link is rejected too.
+
+    Severity (error, refused): urdfdom rejects a URDF without exactly one root.
     """
     if not ctx.robot.links:
         yield Issue("the model has no <link>", ctx.robot.loc, ctx.robot.name,
@@ -99,10 +121,12 @@ def single_root(ctx: CheckContext) -> Iterator[Issue]:
                         hint=f"add a joint with <child link=\"{name}\"/> to attach it")
 
 
-@rule("S105", "joint-link-missing", "error", "A joint's parent or child link does not exist.")
+@rule("S105", "joint-link-missing", "error", "A joint's parent or child link does not exist.", clause="refused")
 def joint_link_missing(ctx: CheckContext) -> Iterator[Issue]:
     """Every joint's `<parent link=>` and `<child link=>` must name a link of the model.
     A typo or a missing namespace prefix here makes urdfdom reject the file.
+
+    Severity (error, refused): urdfdom rejects the joint and Gazebo cannot create it.
     """
     links = ctx.robot.link_map
     for joint in ctx.robot.joints:
@@ -119,18 +143,22 @@ def _closest_hint(name: str, candidates) -> str:
     return f"did you mean '{close[0]}'?" if close else "declare the link or fix the name"
 
 
-@rule("S106", "duplicate-link-name", "error", "Two links have the same name.")
+@rule("S106", "duplicate-link-name", "error", "Two links have the same name.", clause="refused")
 def duplicate_link_name(ctx: CheckContext) -> Iterator[Issue]:
     """Link names must be unique. A macro instantiated twice without a distinct prefix or
     suffix is the usual cause; urdfdom rejects the file.
+
+    Severity (error, refused): urdfdom and libsdformat reject two elements of one name.
     """
     yield from _redeclared(ctx.robot.links, ctx.robot.link_map, "link")
 
 
-@rule("S107", "duplicate-joint-name", "error", "Two joints have the same name.")
+@rule("S107", "duplicate-joint-name", "error", "Two joints have the same name.", clause="refused")
 def duplicate_joint_name(ctx: CheckContext) -> Iterator[Issue]:
     """Joint names must be unique; urdfdom rejects the file otherwise, and Gazebo plugins
     that look a joint up by name would find only one of them.
+
+    Severity (error, refused): urdfdom and libsdformat reject two elements of one name.
     """
     yield from _redeclared(ctx.robot.joints, ctx.robot.joint_map, "joint")
 
@@ -146,10 +174,12 @@ def _redeclared(elements, first_by_name, kind: str) -> Iterator[Issue]:
         seen.add(element.name)
 
 
-@rule("S108", "link-multiple-parents", "error", "A link is the child of more than one joint.")
+@rule("S108", "link-multiple-parents", "error", "A link is the child of more than one joint.", clause="refused")
 def link_multiple_parents(ctx: CheckContext) -> Iterator[Issue]:
     """In a tree every link has at most one parent joint. A second joint naming the same
     child closes a loop that URDF cannot express.
+
+    Severity (error, refused): urdfdom rejects a link with two parents.
     """
     for child, joints in ctx.tree.extra_parents.items():
         first = ctx.tree.parent_joint[child]
@@ -159,10 +189,12 @@ def link_multiple_parents(ctx: CheckContext) -> Iterator[Issue]:
                         hint="each link can be the child of one joint only")
 
 
-@rule("S109", "kinematic-cycle", "error", "The joints form a cycle.")
+@rule("S109", "kinematic-cycle", "error", "The joints form a cycle.", clause="refused")
 def kinematic_cycle(ctx: CheckContext) -> Iterator[Issue]:
     """Following parent links from some link leads back to it. urdfdom reports this as
     "no root link found"; the links on the cycle are named here.
+
+    Severity (error, refused): urdfdom and libsdformat reject a loop in the tree.
     """
     for cycle in ctx.tree.cycles:
         joint = ctx.tree.parent_joint[cycle[0]]
@@ -170,24 +202,34 @@ def kinematic_cycle(ctx: CheckContext) -> Iterator[Issue]:
                     joint.name, hint="remove or re-parent one of these joints")
 
 
-@rule("S110", "joint-type-invalid", "error", "A joint has an unknown type.")
+@rule("S110", "joint-type-invalid", "error", "A joint has an unknown type.", clause="refused")
 def joint_type_invalid(ctx: CheckContext) -> Iterator[Issue]:
-    """URDF joint types are revolute, continuous, prismatic, fixed, floating and planar."""
+    """URDF joint types are revolute, continuous, prismatic, fixed, floating and planar;
+    an SDF model's are SDFormat's: revolute, continuous, prismatic, fixed, ball, screw,
+    universal, revolute2 and gearbox (ardupilot_gazebo's zephyr_with_parachute hangs its
+    parachute on a ball joint). Each file is held to its own format, as its parser does.
+
+    Severity (error, refused): the parser does not know the type.
+    """
     import difflib
 
+    types = SDF_JOINT_TYPES if ctx.robot.source_format == "sdf" else JOINT_TYPES
     for joint in ctx.robot.joints:
-        if joint.type not in JOINT_TYPES:
-            close = difflib.get_close_matches(joint.type, JOINT_TYPES, n=1)
-            hint = f"did you mean '{close[0]}'?" if close else f"use one of {', '.join(JOINT_TYPES)}"
+        if joint.type not in types:
+            close = difflib.get_close_matches(joint.type, types, n=1)
+            hint = f"did you mean '{close[0]}'?" if close else f"use one of {', '.join(types)}"
             what = f"type '{joint.type}'" if joint.type else "no type="
             yield Issue(f"joint '{joint.name}' has {what}", joint.loc, joint.name, hint=hint)
 
 
-@rule("S111", "joint-limit-missing", "error", "A revolute or prismatic joint lacks <limit>.")
+@rule("S111", "joint-limit-missing", "error", "A revolute or prismatic joint lacks <limit>.", clause="refused")
 def joint_limit_missing(ctx: CheckContext) -> Iterator[Issue]:
     """Revolute and prismatic joints need `<limit lower= upper= effort= velocity=/>`;
     urdfdom requires effort and velocity and rejects the joint without them. A spinning
     joint (a wheel, a rotor) should be `continuous` instead.
+
+    Severity (error, refused): urdfdom rejects a revolute or prismatic joint without
+    effort and velocity limits.
     """
     for joint in ctx.robot.joints:
         if joint.type not in _LIMITED_JOINTS:
@@ -204,10 +246,12 @@ def joint_limit_missing(ctx: CheckContext) -> Iterator[Issue]:
                         hint="urdfdom requires both effort= and velocity=")
 
 
-@rule("S112", "joint-limit-inverted", "error", "A joint's lower limit is above its upper limit.")
+@rule("S112", "joint-limit-inverted", "error", "A joint's lower limit is above its upper limit.", clause="cannot-fly")
 def joint_limit_inverted(ctx: CheckContext) -> Iterator[Issue]:
     """With lower > upper the allowed range is empty; simulators pin the joint or
     behave erratically.
+
+    Severity (error, cannot-fly): the joint cannot move between its limits.
     """
     for joint in ctx.robot.joints:
         limit = joint.limit
@@ -218,10 +262,12 @@ def joint_limit_inverted(ctx: CheckContext) -> Iterator[Issue]:
                         f"{limit.upper:g}", limit.loc, joint.name, hint="swap lower and upper")
 
 
-@rule("S113", "joint-axis-zero", "error", "A moving joint's axis is the zero vector.")
+@rule("S113", "joint-axis-zero", "error", "A moving joint's axis is the zero vector.", clause="refused")
 def joint_axis_zero(ctx: CheckContext) -> Iterator[Issue]:
     """Revolute, continuous, prismatic and planar joints move along or about their
     `<axis xyz=>`, which must not be zero (it is normalised by every consumer).
+
+    Severity (error, refused): libsdformat refuses an axis whose norm is zero.
     """
     for joint in ctx.robot.joints:
         axis = np.asarray(joint.axis, dtype=float)
@@ -232,11 +278,14 @@ def joint_axis_zero(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("S114", "gazebo-reference-missing", "warning",
-      "A <gazebo reference=> names no link or joint.")
+      "A <gazebo reference=> names no link or joint.", clause="suspicious")
 def gazebo_reference_missing(ctx: CheckContext) -> Iterator[Issue]:
     """A `<gazebo reference="NAME">` block applies to the link or joint called NAME.
     When there is none, Gazebo ignores the block silently: its material, friction or
     sensor never appears.
+
+    Severity (warning, suspicious): Gazebo ignores the block and the model loads; the
+    settings meant for it are lost.
     """
     names = set(ctx.robot.link_map) | set(ctx.robot.joint_map)
     for block in ctx.robot.gazebo:
@@ -265,7 +314,7 @@ def _refused(ctx: CheckContext, mesh: Mesh) -> bool:
     return bool(uri_problem(mesh.uri, mesh.path) or format_problem(mesh.uri, ctx.simulator))
 
 
-@rule("S115", "mesh-unresolved", "error", "A mesh file cannot be found or read.")
+@rule("S115", "mesh-unresolved", "error", "A mesh file cannot be found or read.", clause="refused")
 def mesh_unresolved(ctx: CheckContext) -> Iterator[Issue]:
     """Every `<mesh filename=>` must resolve to a readable file: `package://PKG/...`
     through the package search path, `file://` and plain paths relative to the model.
@@ -275,6 +324,8 @@ def mesh_unresolved(ctx: CheckContext) -> Iterator[Issue]:
     or truncated file (not XML, a `<triangles>` index past the positions, an STL whose
     size does not match its facet count), an empty export, or one with NaN coordinates
     is reported with what is wrong with it. (glTF/GLB/FBX are only checked to exist.)
+
+    Severity (error, refused): Gazebo cannot load a mesh it cannot find.
     """
     for link, kind, shape, mesh in _mesh_shapes(ctx):
         if _refused(ctx, mesh):
@@ -294,8 +345,85 @@ def mesh_unresolved(ctx: CheckContext) -> Iterator[Issue]:
                         hint=f"export the part again as {mesh.path.suffix.lstrip('.').upper()}")
 
 
+@rule("S120", "sdf-link-default-inertial", "warning",
+      "An SDF link has no <inertial>: sdformat gives it 1 kg and a 1 kg·m² inertia.",
+      clause="suspicious")
+def sdf_link_default_inertial(ctx: CheckContext) -> Iterator[Issue]:
+    """libsdformat reads a `<link>` without `<inertial>` as 1 kg with a unit inertia
+    tensor, and Gazebo simulates it so: a visual-only link (a trail, a marker) adds a
+    kilogram to the vehicle. reedtool counts it the same way in every mass figure.
+
+    Severity (warning: suspicious, but the model loads and flies): the element is valid
+    SDF; whether the kilogram is meant cannot be told.
+    """
+    for issue in ctx.robot.parse_issues:
+        if issue.kind in _DEFAULT_INERTIAL_KINDS:
+            yield Issue(issue.message, issue.loc, issue.subject,
+                        hint="give the link its <inertial> (mass and inertia), even a small one")
+
+
+@rule("S123", "sdf-element-not-in-version", "info",
+      "An element the file's declared SDF version does not define is ignored.",
+      clause="explains")
+def sdf_element_not_in_version(ctx: CheckContext) -> Iterator[Issue]:
+    """libsdformat reads a file by the spec of the version it declares (converting older
+    versions up): an element that version does not define is ignored with a warning. A
+    1.7+ file's `<use_parent_model_frame>` (removed in 1.7; only a 1.6 file's is converted
+    to `expressed_in="__model__"`) therefore leaves the joint axis in the joint frame, and
+    reedtool reads it so too (SITL_Models' alti_transition_quad and skywalker_x8 declare
+    1.7 and keep it).
+
+    Severity (info, explains): libsdformat ignores the element the same way.
+    """
+    for issue in ctx.robot.parse_issues:
+        if issue.kind in _UNDEFINED_KINDS:
+            yield Issue(issue.message, issue.loc, issue.subject)
+
+
+@rule("S124", "xml-declaration-late", "warning",
+      "A comment precedes the XML declaration: gz-sim refuses the file, Gazebo classic reads it.",
+      clause="suspicious")
+def xml_declaration_late(ctx: CheckContext) -> Iterator[Issue]:
+    """TinyXML (Gazebo classic's libsdformat 9) reads an XML declaration anywhere; TinyXML2
+    5 and later (libsdformat 10+, so gz-sim) refuse one that follows a comment (PX4
+    classic's generated depth_camera.sdf starts with a comment line). Blank lines before it
+    are fine for both.
+
+    Severity (warning): a model written for Gazebo classic (its plugins are classic ones)
+    loads where it is meant to, so nothing is reported for it beyond S119; for gz-sim the
+    file is refused, but reedtool cannot be sure which Gazebo a model without plugins is
+    for.
+    """
+    if ctx.simulator == "classic":
+        return
+    for issue in ctx.robot.parse_issues:
+        if issue.kind in _LATE_DECLARATION_KINDS:
+            yield Issue(issue.message, issue.loc, issue.subject,
+                        hint="move the comment below the <?xml ...?> line, or drop the line")
+
+
+@rule("S125", "sdf-pose-short", "warning",
+      "A <pose> has 3 numbers: Gazebo classic reads a position, gz-sim refuses it.",
+      clause="suspicious")
+def sdf_pose_short(ctx: CheckContext) -> Iterator[Issue]:
+    """A pose is six numbers (x y z roll pitch yaw). libsdformat 9, Gazebo classic's, reads
+    `<pose>x y z</pose>` as a position with no rotation (its stream read has no failure
+    check); libsdformat 12 and later (gz-sim) refuse the file ("must have 6 values").
+    GymFC's nf1 twin is written so; reedtool reads it as libsdformat 9 does.
+
+    Severity (warning): a model made for Gazebo classic (classic plugins) loads where it
+    is meant to and is not reported; for any other model gz-sim may be its target.
+    """
+    if ctx.simulator == "classic":
+        return
+    for issue in ctx.robot.parse_issues:
+        if issue.kind in _SHORT_POSE_KINDS:
+            yield Issue(issue.message, issue.loc, issue.subject,
+                        hint="write all six numbers: x y z 0 0 0")
+
+
 @rule("S130", "mesh-format-unsupported", "error",
-      "A mesh file is in a format the simulator cannot load.")
+      "A mesh file is in a format the simulator cannot load.", clause="refused")
 def mesh_format_unsupported(ctx: CheckContext) -> Iterator[Issue]:
     """Gazebo picks its mesh loader by file extension. Gazebo classic loads STL, COLLADA
     (.dae) and Wavefront OBJ; gz-sim (gz-common) also loads glTF (.gltf, .glb) and FBX.
@@ -306,6 +434,8 @@ def mesh_format_unsupported(ctx: CheckContext) -> Iterator[Issue]:
     classic plugins (`lib*.so`: gazebo_ros, RotorS, PX4 classic) and no gz system mean
     classic; a model with neither is held to gz-sim's list. Case does not matter
     (`body.STL` is an STL).
+
+    Severity (error, refused): the simulator's mesh loader does not read the format.
     """
     from reedtool.io.meshes import format_problem, uri_problem
 
@@ -319,14 +449,17 @@ def mesh_format_unsupported(ctx: CheckContext) -> Iterator[Issue]:
                         hint="export the part as STL or COLLADA (.dae) and reference that file")
 
 
-@rule("S131", "mesh-uri-escapes", "error",
-      "A mesh reference leaves its package or points at system files.")
+@rule("S131", "mesh-uri-escapes", "warning",
+      "A mesh reference leaves its package or points at system files.", clause="suspicious")
 def mesh_uri_escapes(ctx: CheckContext) -> Iterator[Issue]:
     """A `package://PKG/../../..` or `model://` path that climbs out of its package with
     `..`, or a reference into a system directory (`file:///etc/passwd`, `/proc/...`),
     is never a mesh: it makes every machine that loads the model open files outside the
     model (a leak when the model comes from someone else) and works on no other machine.
     reedtool does not open such a file.
+
+    Severity (warning): Gazebo follows the path and loads the model on this machine; the
+    reference is suspicious, not refused.
     """
     from reedtool.io.meshes import uri_problem
 
@@ -350,23 +483,72 @@ def _geometry_sizes(geometry) -> dict[str, float]:
     return {}
 
 
-@rule("S116", "geometry-size-invalid", "error", "A geometry has a zero or negative size.")
+@rule("S116", "geometry-size-invalid", "error",
+      "A geometry has a zero or negative size (a mesh: a zero scale).", clause="refused")
 def geometry_size_invalid(ctx: CheckContext) -> Iterator[Issue]:
-    """Box sizes, cylinder radius and length, sphere radius and mesh scale must be
-    positive. A zero size makes a collision shape degenerate (objects fall through it),
-    a negative mesh scale mirrors the mesh and turns its normals inside out.
+    """Box sizes, cylinder radius and length and sphere radius must be positive, and a
+    mesh scale non-zero. A zero size makes a collision shape degenerate (objects fall
+    through it); libsdformat refuses a non-positive box size or radius. A negative mesh
+    scale is a mirror, which Gazebo draws (S121, S122).
+
+    Severity (error, refused): libsdformat refuses a non-positive box size or radius,
+    and a zero scale makes the shape degenerate.
     """
     for link in ctx.robot.links:
         for shape in [*link.visuals, *link.collisions]:
+            mesh = isinstance(shape.geometry, Mesh)
             for name, value in _geometry_sizes(shape.geometry).items():
-                if value is not None and math.isfinite(value) and value <= 0:
+                if value is not None and math.isfinite(value) and value <= 0 \
+                        and not (mesh and value < 0):
                     kind = type(shape.geometry).__name__.lower()
                     yield Issue(f"link '{link.name}': {kind} {name} is {value:g}", shape.loc,
                                 link.name, hint="sizes must be positive (metres)")
 
 
+def _mirrored_meshes(ctx: CheckContext, collisions: bool):
+    for link in ctx.robot.links:
+        for shape in (link.collisions if collisions else link.visuals):
+            if not isinstance(shape.geometry, Mesh):
+                continue
+            scale = np.broadcast_to(np.asarray(shape.geometry.scale, dtype=float), (3,))
+            axes = [f"{'xyz'[i]} {scale[i]:g}" for i in range(3)
+                    if math.isfinite(scale[i]) and scale[i] < 0]
+            if axes:
+                yield link, shape, axes
+
+
+@rule("S121", "visual-mesh-mirrored", "info",
+      "A visual mesh is mirrored by a negative scale.", clause="explains")
+def visual_mesh_mirrored(ctx: CheckContext) -> Iterator[Issue]:
+    """A negative `<mesh scale>` component mirrors the mesh. For a visual that is a
+    convention: the MRS UAV models draw their clockwise propellers as the counter-clockwise
+    mesh with scale -1. Gazebo draws it mirrored.
+
+    Severity (info, explains): a mirrored visual is drawn as written.
+    """
+    for link, shape, axes in _mirrored_meshes(ctx, collisions=False):
+        yield Issue(f"link '{link.name}': visual mesh '{shape.geometry.uri}' is mirrored "
+                    f"({', '.join(axes)})", shape.loc, link.name)
+
+
+@rule("S122", "collision-mesh-mirrored", "warning",
+      "A collision mesh is mirrored by a negative scale: its faces point inwards.",
+      clause="suspicious")
+def collision_mesh_mirrored(ctx: CheckContext) -> Iterator[Issue]:
+    """A negative `<mesh scale>` on a collision mirrors the mesh and with an odd number of
+    negative components turns its faces inside out: the physics engine's contacts may push
+    objects into the shape rather than out of it.
+
+    Severity (warning: the model loads and can fly): contacts only matter on the ground.
+    """
+    for link, shape, axes in _mirrored_meshes(ctx, collisions=True):
+        yield Issue(f"link '{link.name}': collision mesh '{shape.geometry.uri}' is mirrored "
+                    f"({', '.join(axes)})", shape.loc, link.name,
+                    hint="mirror the file itself, or use a primitive shape for the collision")
+
+
 @rule("S117", "link-dropped-by-sdf", "error",
-      "A moving link has no inertial or a mass below 1e-6 kg; Gazebo drops it.")
+      "A moving link has no inertial or a mass below 1e-6 kg; Gazebo drops it.", clause="refused")
 def link_dropped_by_sdf(ctx: CheckContext) -> Iterator[Issue]:
     """When Gazebo converts URDF to SDF it silently drops a link that is attached by a
     non-fixed joint and has no `<inertial>` or a mass below 1e-6 kg, together with its
@@ -376,6 +558,8 @@ def link_dropped_by_sdf(ctx: CheckContext) -> Iterator[Issue]:
 
     Negative or zero masses are reported by I201. Native SDF models are not converted
     (sdformat gives a link without `<inertial>` 1 kg), so this rule reads URDF input only.
+
+    Severity (error, refused): Gazebo's URDF to SDF conversion drops the link.
     """
     if ctx.robot.source_format != "urdf":
         return
@@ -413,7 +597,7 @@ def _keeps_fixed_joint(ctx: CheckContext, joint_name: str) -> bool:
 
 
 @rule("S118", "plugin-link-merged", "warning",
-      "A plugin names a link that fixed-joint lumping merges away.")
+      "A plugin names a link that fixed-joint lumping merges away.", clause="suspicious")
 def plugin_link_merged(ctx: CheckContext) -> Iterator[Issue]:
     """Gazebo merges every link attached by a fixed joint into its parent when it converts
     URDF to SDF, so the link's name no longer exists in the simulation. A plugin told to
@@ -428,6 +612,9 @@ def plugin_link_merged(ctx: CheckContext) -> Iterator[Issue]:
     </gazebo>` (`disableFixedJointLumping` on older Gazebo), or make it a revolute joint
     with zero limits, as RotorS does for its sensor links. Native SDF models are not
     lumped, so this rule reads URDF input only.
+
+    Severity (warning, suspicious): the model loads, and the plugin looks for a link
+    that is gone.
     """
     if ctx.robot.source_format != "urdf":
         return
@@ -447,7 +634,7 @@ def plugin_link_merged(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("S119", "xml-tolerated", "info",
-      "The file uses XML that Gazebo reads but strict XML tools reject.")
+      "The file uses XML that Gazebo reads but strict XML tools reject.", clause="explains")
 def xml_tolerated(ctx: CheckContext) -> Iterator[Issue]:
     """libsdformat parses with TinyXML2, which accepts `--` inside a comment and a
     namespace prefix (such as `gz:`) used without its `xmlns:` declaration. Gazebo loads
@@ -456,6 +643,8 @@ def xml_tolerated(ctx: CheckContext) -> Iterator[Issue]:
 
     Nothing breaks in simulation. To keep other tools happy, write single hyphens in
     comments and declare the prefix on the root element (`<sdf xmlns:gz="...">`).
+
+    Severity (info, explains): Gazebo reads the file; only strict XML tools do not.
     """
     for issue in ctx.robot.parse_issues:
         if issue.kind in _TOLERATED_KINDS:
@@ -464,7 +653,7 @@ def xml_tolerated(ctx: CheckContext) -> Iterator[Issue]:
 
 
 @rule("S150", "package-name-ambiguous", "warning",
-      "Two ROS packages with the same name are on the search path; one is ignored.")
+      "Two ROS packages with the same name are on the search path; one is ignored.", clause="suspicious")
 def package_name_ambiguous(ctx: CheckContext) -> Iterator[Issue]:
     """`$(find pkg)` and `package://pkg/...` name a package, not a directory. When two
     packages of that name sit under one search root (a copied package, a backup next to
@@ -472,6 +661,9 @@ def package_name_ambiguous(ctx: CheckContext) -> Iterator[Issue]:
     reach the simulation. The finding names both and the one used.
 
     Remove or rename the copy, or put the intended one first with `--package-path`.
+
+    Severity (warning, suspicious): one package is used; edits to the other never reach
+    the simulation.
     """
     for issue in ctx.robot.parse_issues:
         if issue.kind in _PACKAGE_KINDS:

@@ -34,6 +34,7 @@ def explain(code: str) -> int:
     click.echo(f"{found.code} {found.slug} ({found.severity}, {found.family})\n")
     click.echo(f"{found.summary}\n")
     click.echo(found.explanation)
+    click.echo(f"\nSeverity policy ({found.clause}): {found.policy}.")
     return 0
 
 

@@ -137,7 +137,8 @@ class ArduPilotParams:
 
     @property
     def loc(self) -> SourceLoc:
-        return SourceLoc(self.file, 1)
+        """The file, without a line: where a finding about an unset parameter points."""
+        return SourceLoc(self.file)
 
     def get(self, name: str, default: float | None = None) -> ParmValue | None:
         if name in self.values:

@@ -50,6 +50,13 @@ PARAM_RANGES: dict[str, tuple[float, float, float | None, str]] = {
     "CA_ROTOR#_KM": (-1.0, 1.0, 0.05, _CA),
     "SIM_GZ_EC_MIN#": (0.0, 1000.0, 0.0, _GZ),
     "SIM_GZ_EC_MAX#": (0.0, 1000.0, 1000.0, _GZ),
+    "CA_AIRFRAME": (0, 14, 0, _CA),
+    "CA_ROTOR#_TILT": (0, 4, 0, _CA),
+    "CA_SV_TL_COUNT": (0, 4, 0, _CA),
+    "CA_SV_TL#_MINA": (-90.0, 90.0, -45.0, _CA),
+    "CA_SV_TL#_MAXA": (-90.0, 90.0, 45.0, _CA),
+    "CA_SV_TL#_TD": (0, 359, 0, _CA),
+    "CA_SV_TL#_CT": (0, 3, 1, _CA),
     "MPC_THR_HOVER": (0.1, 0.8, 0.5, "PX4-Autopilot src/modules/mc_pos_control "
                                      "(PARAM_DEFINE_FLOAT MPC_THR_HOVER: @min 0.1, @max 0.8)"),
     "THR_MDL_FAC": (0.0, 1.0, 0.0, "PX4 parameter reference, THR_MDL_FAC (0..1)"),
@@ -61,7 +68,8 @@ _PARAM_CMD = re.compile(r"^\s*param\s+(set-default|set)\s+([A-Za-z0-9_]+)\s+(\S+
 
 def range_key(name: str) -> str:
     """CA_ROTOR3_KM -> CA_ROTOR#_KM, SIM_GZ_EC_MAX2 -> SIM_GZ_EC_MAX#: the PARAM_RANGES key."""
-    return re.sub(r"\d+", "#", name) if re.search(r"(ROTOR\d+_|EC_M(IN|AX)\d+$)", name) else name
+    return re.sub(r"\d+", "#", name) if re.search(r"(ROTOR\d+_|EC_M(IN|AX)\d+$|SV_TL\d+_)", name) \
+        else name
 
 
 @dataclass
@@ -69,8 +77,14 @@ class ParamValue:
     name: str
     value: float
     text: str
-    loc: SourceLoc
+    loc: SourceLoc                 # the line that sets it; the file alone for a default
     explicit: bool = True          # False: the documented default, no line in the file
+
+    def describe(self) -> str:
+        """'NAME V (file:line)', or 'NAME not set: PX4's default V (file)'."""
+        if self.explicit:
+            return f"{self.name} {self.value:g} ({self.loc})"
+        return f"{self.name} not set: PX4's default {self.value:g} ({self.loc})"
 
 
 @dataclass
@@ -87,8 +101,7 @@ class Px4Rotor:
         return self.params[suffix].loc
 
     def where(self, *suffixes: str) -> str:
-        return ", ".join(f"CA_ROTOR{self.index}_{s} {self.params[s].value:g} "
-                         f"({self.params[s].loc})" for s in suffixes)
+        return ", ".join(self.params[s].describe() for s in suffixes)
 
 
 @dataclass
@@ -104,7 +117,8 @@ class Px4Params:
 
     @property
     def loc(self) -> SourceLoc:
-        return SourceLoc(self.file, 1)
+        """The file, without a line: where a finding about an unset parameter points."""
+        return SourceLoc(self.file)
 
     def get(self, name: str) -> ParamValue:
         """The value set in the file, else PX4's documented default (explicit=False)."""
@@ -141,6 +155,122 @@ class Px4Params:
     @property
     def uses_gz_outputs(self) -> bool:
         return any(self.has(f"SIM_GZ_EC_FUNC{k}") for k in range(1, MAX_GZ_OUTPUTS + 1))
+
+
+# ------------------------------------------------------------ CA_AIRFRAME
+
+@dataclass(frozen=True)
+class Effectiveness:
+    """How PX4's control allocation reads the CA_ROTOR table for one CA_AIRFRAME value
+    (PX4-Autopilot src/modules/control_allocator: ControlAllocator::
+    update_effectiveness_source, VehicleActuatorEffectiveness/ActuatorEffectiveness*)."""
+
+    value: int
+    name: str
+    rotor_table: bool = True       # False: no CA_ROTOR geometry (rovers, helicopters)
+    # ActuatorEffectivenessRotors::AxisConfiguration: "configurable" reads CA_ROTORi_AX/AY/AZ,
+    # "forward" fixes (1, 0, 0), "upward" fixes (0, 0, -1), whatever the parameters say.
+    axes: str = "configurable"
+    tilts: bool = False            # CA_ROTORi_TILT makes a rotor's axis follow a tilt servo
+    # Fixed-wing: enablePropellerTorque(false), no rotor's KM is used; standard VTOL:
+    # enablePropellerTorqueNonUpwards(false), a pusher's KM is not used.
+    propeller_torque: bool = True
+    torque_upward_only: bool = False
+    # Tailsitter: yaw by differential thrust only with more than 3 rotors; tiltrotor: not
+    # when a tilt servo controls yaw (CA_SV_TLk_CT 1 or 3).
+    yaw_rule: str = "always"       # "always" | "more-than-3" | "unless-tilt-yaw"
+
+
+AIRFRAMES: dict[int, Effectiveness] = {e.value: e for e in (
+    Effectiveness(0, "multirotor"),
+    Effectiveness(1, "fixed-wing", axes="forward", propeller_torque=False),
+    Effectiveness(2, "standard VTOL", torque_upward_only=True),
+    Effectiveness(3, "tiltrotor VTOL", tilts=True, yaw_rule="unless-tilt-yaw"),
+    # ActuatorEffectivenessTailsitterVTOL: _mc_rotors(this), the default (configurable)
+    # axes; QGroundControl shows no axis for it, so they stay at PX4's default, upward.
+    Effectiveness(4, "tailsitter VTOL", yaw_rule="more-than-3"),
+    Effectiveness(5, "rover (Ackermann)", rotor_table=False),
+    Effectiveness(6, "rover (differential)", rotor_table=False),
+    Effectiveness(7, "motors 6DOF"),
+    Effectiveness(8, "multirotor with tilt", axes="upward", tilts=True),
+    Effectiveness(9, "custom"),
+    Effectiveness(10, "helicopter (tail ESC)", rotor_table=False),
+    Effectiveness(11, "helicopter (tail servo)", rotor_table=False),
+    Effectiveness(12, "helicopter (coaxial)", rotor_table=False),
+    Effectiveness(13, "spacecraft 2D", rotor_table=False),
+    Effectiveness(14, "spacecraft 3D", rotor_table=False),
+)}
+UPWARD_FRD = np.array([0.0, 0.0, -1.0])
+FORWARD_FRD = np.array([1.0, 0.0, 0.0])
+
+
+def effectiveness(params: "Px4Params") -> Effectiveness | None:
+    """The effectiveness class CA_AIRFRAME selects (default 0, multirotor); None for a value
+    PX4 does not know (it then allocates nothing: 'Unknown airframe')."""
+    value = params.get("CA_AIRFRAME").value
+    return AIRFRAMES.get(int(value)) if math.isfinite(value) and value.is_integer() else None
+
+
+def tilted_axis(tilt_rad: float, direction_rad: float) -> np.ndarray:
+    """ActuatorEffectivenessRotors::tiltedAxis: (0, 0, -1) rotated by -tilt about y, then
+    by the tilt direction about z (FRD)."""
+    return np.array([math.sin(tilt_rad) * math.cos(direction_rad),
+                     math.sin(tilt_rad) * math.sin(direction_rad), -math.cos(tilt_rad)])
+
+
+def is_upward(axis_frd: np.ndarray) -> bool:
+    """ActuatorEffectivenessRotors::getUpwardsMotors' test on a normalised axis."""
+    return abs(axis_frd[0]) < 0.1 and abs(axis_frd[1]) < 0.1 and axis_frd[2] < -0.5
+
+
+@dataclass
+class RotorAxis:
+    """The thrust axis PX4 allocates CA rotor i with (FRD, unit), and where it comes from."""
+
+    axis_frd: np.ndarray
+    source: str                    # "parameters", "fixed", "tilt"
+    text: str                      # for messages: the parameters or the rule that fix it
+
+
+def rotor_axis(params: "Px4Params", rotor: Px4Rotor, kind: Effectiveness) -> RotorAxis | None:
+    """The axis PX4 uses for the rotor in hover (tilts at their minimum angle: collective
+    tilt -1 while disarmed and hovering); None when the written axis is zero (PX4 ignores
+    the rotor)."""
+    if kind.tilts:
+        tilt = params.get(f"CA_ROTOR{rotor.index}_TILT")
+        index = int(tilt.value) - 1 if math.isfinite(tilt.value) else -1
+        count = params.get("CA_SV_TL_COUNT").value
+        if 0 <= index < count:
+            low = params.get(f"CA_SV_TL{index}_MINA").value
+            direction = params.get(f"CA_SV_TL{index}_TD").value
+            return RotorAxis(tilted_axis(math.radians(low), math.radians(direction)), "tilt",
+                             f"{tilt.describe()}: tilt servo {index} at its minimum angle "
+                             f"{low:g}° (hover), direction {direction:g}°")
+    if kind.axes == "forward":
+        return RotorAxis(FORWARD_FRD.copy(), "fixed",
+                         f"CA_AIRFRAME {kind.value} ({kind.name}) fixes every rotor forward")
+    if kind.axes == "upward":
+        return RotorAxis(UPWARD_FRD.copy(), "fixed",
+                         f"CA_AIRFRAME {kind.value} ({kind.name}) fixes every rotor upward")
+    norm = float(np.linalg.norm(rotor.axis_frd))
+    if not math.isfinite(norm) or norm <= 1e-7:
+        return None
+    return RotorAxis(rotor.axis_frd / norm, "parameters", rotor.where("AX", "AY", "AZ"))
+
+
+def uses_yaw_moment(params: "Px4Params", kind: Effectiveness, axis: RotorAxis) -> bool:
+    """Whether PX4 uses rotor i's KM (its yaw reaction torque) for yaw control."""
+    if not kind.propeller_torque:
+        return False
+    if kind.torque_upward_only and not is_upward(axis.axis_frd):
+        return False
+    if kind.yaw_rule == "more-than-3":
+        return (params.rotor_count or 0) > 3
+    if kind.yaw_rule == "unless-tilt-yaw":
+        count = int(params.get("CA_SV_TL_COUNT").value)
+        return not any(int(params.get(f"CA_SV_TL{k}_CT").value) in (1, 3)
+                       for k in range(max(0, min(count, 4))))
+    return True
 
 
 def _number(text: str, name: str, loc: SourceLoc) -> float:

@@ -197,8 +197,16 @@ def parse_dae(data: bytes, source: str | Path = "<dae>") -> DaeFile:
         root = etree.fromstring(data, etree.XMLParser(resolve_entities=False, no_network=True,
                                                       huge_tree=True))
     except etree.XMLSyntaxError as exc:
-        raise ReedtoolError(f"not a COLLADA file: {exc.msg}", file=source,
-                            line=exc.lineno or None, hint=HINT) from exc
+        # assimp reads COLLADA with its own lenient XML reader: what TinyXML2 accepts
+        # (reedtool.io.tolerant_xml) is read too, silently, as Gazebo's loader does.
+        try:
+            text = data.decode("utf-8")
+        except UnicodeDecodeError:
+            raise ReedtoolError(f"not a COLLADA file: {exc.msg}", file=source,
+                                line=exc.lineno or None, hint=HINT) from exc
+        from reedtool.io.tolerant_xml import parse_tolerant
+
+        root, _tolerated = parse_tolerant(text, source, error="not a COLLADA file", hint=HINT)
     if _local(root.tag) != "COLLADA":
         raise ReedtoolError(f"not a COLLADA file: the root element is <{_local(root.tag)}>",
                             file=source, line=root.sourceline, hint=HINT)

@@ -151,19 +151,17 @@ def _xacro_call(command: str, values: dict[str, str], resolver: PackageResolver,
 
 def _read_xml_launch(path: Path, given: dict[str, str], resolver: PackageResolver,
                      depth: int) -> LaunchCall | None:
-    from lxml import etree
-
     from reedtool.io.fileio import read_xml_file
+    from reedtool.io.tolerant_xml import parse_tolerant
     from reedtool.io.xml_lines import start_line
 
     text, _encoding = read_xml_file(path, what="launch file")
     lines = text.splitlines()
-    try:
-        root = etree.fromstring(text.encode("utf-8"),
-                                etree.XMLParser(remove_comments=True, resolve_entities=False))
-    except etree.XMLSyntaxError as exc:
-        raise ReedtoolError(f"not a launch file: {exc.msg}", file=_display(path),
-                            line=exc.lineno) from None
+    # roslaunch and ROS 2 launch read XML leniently too; what TinyXML2 accepts is read
+    # (reedtool.io.tolerant_xml).
+    root, _tolerated = parse_tolerant(text, _display(path), remove_comments=True,
+                                      error="not a launch file",
+                                      hint="fix the XML syntax at that position")
     if root.tag != "launch":
         raise ReedtoolError(f"not a launch file: the root element is <{root.tag}>, "
                             "expected <launch>", file=_display(path), line=root.sourceline)

@@ -96,6 +96,14 @@ def bundled_package_names() -> set[str]:
     return set(_crawl(BUNDLED_PACKAGES_DIR))
 
 
+def _same_directory(a: Path, b: Path) -> bool:
+    """Whether two paths are one directory on disk (symlinks resolved)."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return os.path.realpath(a) == os.path.realpath(b)
+
+
 def _crawl(root: Path, duplicates: list[tuple[str, Path, Path]] | None = None,
            origin: str = "") -> dict[str, Path]:
     """All packages under `root` (root included), first found per name wins."""
@@ -124,7 +132,10 @@ def _crawl(root: Path, duplicates: list[tuple[str, Path, Path]] | None = None,
         if manifest is not None and manifest.is_file():
             name = package_name(directory / "package.xml")
             if name:
-                if name in found and duplicates is not None:
+                # One directory reached twice (an install space's share/ symlinked to the
+                # sources) is one package, not two of the same name.
+                if name in found and duplicates is not None \
+                        and not _same_directory(found[name], directory):
                     duplicates.append((name, found[name], directory))
                 found.setdefault(name, directory)
             return  # packages do not nest (rospack/catkin rule)

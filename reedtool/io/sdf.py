@@ -53,6 +53,7 @@ joints) so URDF-only consumers such as the Pinocchio cross-check see the same mo
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
@@ -65,7 +66,12 @@ from reedtool.io.fileio import MAX_MAGNITUDE
 from reedtool.frames import make_T, matrix_to_rpy, rpy_to_matrix
 from reedtool.io.resources import resolve_model_file_uri
 from reedtool.io.sdf_include import SourceFile, SourceMap, expand_includes
-from reedtool.io.tolerant_xml import local_tag, parse_tolerant
+from reedtool.io.tolerant_xml import (
+    late_declaration_issues,
+    local_tag,
+    parse_tolerant,
+    tolerated_message,
+)
 from reedtool.model import (
     INERTIA_KEYS,
     Box,
@@ -94,6 +100,7 @@ _SCOPED_PLUGIN_PARAMS = {"jointName", "linkName", "joint_name", "link_name", "bo
                          "body_name"}
 # sdformat writes "no limit" as +-1e16; anything beyond this is unbounded.
 UNBOUNDED_LIMIT = 1e15
+_SDF_VERSION = re.compile(r"<sdf\b[^>]*\bversion\s*=\s*[\"']([\d.]+)[\"']")
 SDF_DEFAULT_MASS_KG = 1.0
 
 
@@ -233,6 +240,7 @@ class _ModelReader:
         self.sources = sources
         self.resolver = resolver
         self.issues: list[ParseIssue] = []
+        self._versions: dict[Path, str] = {}
         self.frames: dict[str, _FrameEntry] = {}
         self._resolved: dict[str, np.ndarray] = {MODEL_FRAME: np.eye(4)}
         self.link_els: list[tuple[str, str, etree._Element]] = []   # (scoped name, scope, el)
@@ -248,6 +256,21 @@ class _ModelReader:
 
     def file_of(self, el: etree._Element) -> Path:
         return self.sources.file_of(el).path
+
+    def _version_text(self, el: etree._Element) -> str:
+        """The SDF version declared by the file the element was read from."""
+        source = self.sources.file_of(el)
+        cached = self._versions.get(source.path)
+        if cached is None:
+            match = _SDF_VERSION.search("\n".join(source.lines[:200]))
+            cached = self._versions[source.path] = match.group(1) if match else "1.6"
+        return cached
+
+    def _version(self, el: etree._Element) -> tuple[int, ...]:
+        try:
+            return tuple(int(part) for part in self._version_text(el).split("."))
+        except ValueError:
+            return (1, 6)
 
     def _issue(self, kind: str, message: str, el: etree._Element, subject: str | None) -> None:
         self.issues.append(ParseIssue(kind, message, self.loc(el), subject))
@@ -301,7 +324,14 @@ class _ModelReader:
                           [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
                           [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
             return make_T(R, v[:3]), relative_to
-        v = self._numbers(el, (6,), [0, 0, 0, 0, 0, 0], subject)
+        v = self._numbers(el, (6, 3), [0, 0, 0, 0, 0, 0], subject)
+        if len(v) == 3:
+            # libsdformat 9 (Gazebo classic) reads "x y z" as a position with no rotation
+            # (`ss >> pose` without a fail check); 12 and later refuse it (S125).
+            self._issue("sdf-short-pose", f"<pose>{' '.join(el.text.split())}</pose> has 3 "
+                        "numbers: Gazebo classic reads a position without rotation, "
+                        "libsdformat 12+ (gz-sim) refuses it", el, subject)
+            v = np.concatenate([v, np.zeros(3)])
         rpy = np.radians(v[3:]) if (el.get("degrees") or "").lower() in ("true", "1") else v[3:]
         return make_T(rpy_to_matrix(rpy), v[:3]), relative_to
 
@@ -458,11 +488,9 @@ class _ModelReader:
             by_file.setdefault(source.path, []).append(tolerated)
         for path, items in by_file.items():
             items = sorted(set(items), key=lambda t: t.line)   # a file included twice
-            what = "; ".join(f"line {t.line}: {t.what}" for t in items)
-            self.issues.append(ParseIssue(
-                "xml-tolerated", f"Gazebo (TinyXML2) reads this file, but strict XML tools "
-                f"(xmllint, lxml, XML editors) reject it: {what}",
-                SourceLoc(str(path), items[0].line), path.name))
+            self.issues.append(ParseIssue("xml-tolerated", tolerated_message(items),
+                                          SourceLoc(str(path), items[0].line), path.name))
+            self.issues += late_declaration_issues(items, path)
 
     def _T_link_X(self, link_scoped: str, scope: str, pose_el: etree._Element | None,
                   subject: str) -> np.ndarray:
@@ -480,8 +508,8 @@ class _ModelReader:
             self._issue("missing-attribute", "<link> has no name= attribute", el, None)
         inertial_el = el.find("inertial")
         if inertial_el is None:
-            self._issue("missing-element", f"link '{scoped}' has no <inertial>: sdformat gives it "
-                        "a mass of 1 kg and an inertia of 1 kg*m^2", el, scoped)
+            self._issue("sdf-default-inertial", f"link '{scoped}' has no <inertial>: sdformat "
+                        "gives it a mass of 1 kg and an inertia of 1 kg*m^2", el, scoped)
             link.inertial = Inertial(SDF_DEFAULT_MASS_KG, np.eye(4), np.eye(3), self.loc(el))
         else:
             link.inertial = self._inertial(scoped, scope, inertial_el)
@@ -583,8 +611,16 @@ class _ModelReader:
         axis = self._numbers(xyz_el, (3,), [0.0, 0.0, 1.0], scoped)
         if xyz_el is not None and child in self.frames:
             expressed_in = xyz_el.get("expressed_in")
-            if expressed_in is None and (axis_el.findtext("use_parent_model_frame") or "") \
-                    .strip().lower() in ("true", "1"):
+            parent_frame_el = axis_el.find("use_parent_model_frame")
+            if parent_frame_el is not None and self._version(parent_frame_el) >= (1, 7):
+                # SDF 1.7 dropped the element (1_6.convert rewrites it only when a 1.6 file
+                # is upgraded): in a 1.7+ file libsdformat ignores it with a warning.
+                self._issue("sdf-undefined-element", f"<use_parent_model_frame> of joint "
+                            f"'{scoped}' is not part of SDF {self._version_text(parent_frame_el)}"
+                            ": ignored, as libsdformat does (the axis is in the joint frame)",
+                            parent_frame_el, scoped)
+            elif expressed_in is None and (parent_frame_el is not None) \
+                    and (parent_frame_el.text or "").strip().lower() in ("true", "1"):
                 expressed_in = MODEL_FRAME
             frame = self._scoped(scope, expressed_in) if expressed_in else scoped
             R_child_frame = (np.linalg.inv(self.T_model(child, el, scoped))

@@ -51,13 +51,11 @@ def parse_urdf(xml_text: str, file: Path | str, *, resolver=None,
     document order; without it locations are lines of `file` itself. `resolver` resolves
     mesh URIs (reedtool.io.packages.PackageResolver); by default one rooted at `file`.
     """
+    from reedtool.io.tolerant_xml import parse_tolerant
+
     file = Path(file)
-    try:
-        root = etree.fromstring(xml_text.encode("utf-8"), xml_parser())
-    except etree.XMLSyntaxError as exc:
-        line = exc.lineno if element_locs is None else None
-        raise ReedtoolError(f"malformed XML: {exc.msg}", file=file, line=line,
-                            hint="fix the XML syntax at that position") from exc
+    # As sdformat's URDF parser reads it (TinyXML2): see reedtool.io.tolerant_xml.
+    root, tolerated = parse_tolerant(xml_text, file, line_known=element_locs is None)
     if root.tag != "robot":
         raise ReedtoolError(f"not a URDF: the root element is <{root.tag}>, expected <robot>",
                             file=file, line=root.sourceline)
@@ -65,7 +63,16 @@ def parse_urdf(xml_text: str, file: Path | str, *, resolver=None,
         from reedtool.io.packages import PackageResolver
         resolver = PackageResolver(model_path=file)
     locate = _make_locator(root, file, element_locs, xml_text.splitlines())
-    return _RobotReader(file, locate, resolver).read(root, xml_text)
+    robot = _RobotReader(file, locate, resolver).read(root, xml_text)
+    if tolerated:
+        from reedtool.io.tolerant_xml import late_declaration_issues, tolerated_message
+
+        line = tolerated[0].line if element_locs is None else None
+        robot.parse_issues.append(ParseIssue("xml-tolerated", tolerated_message(tolerated),
+                                             SourceLoc(str(file), line), file.name))
+        if element_locs is None:
+            robot.parse_issues += late_declaration_issues(tolerated, file)
+    return robot
 
 
 def xml_parser() -> etree.XMLParser:

@@ -9,7 +9,7 @@ place, `combine`, where parts are summed about their common COM.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from typing import Iterable
 
@@ -335,6 +335,25 @@ def tensor_problem(inertia_kg_m2) -> str | None:
     return None
 
 
+# Eigenvalues of a tensor with zero moments come out as +-1e-25 of its largest moment:
+# below this fraction of the largest, a moment is zero, not negative.
+MOMENT_NOISE_REL = 1e-9
+
+
+def degenerate_but_accepted(inertia_kg_m2, *, moving: bool, lumped: bool) -> bool:
+    """A tensor with zero (not negative) principal moments that the simulator accepts: a
+    point mass (all zero) on a fixed joint, which gz-math calls valid, or any such tensor
+    of a URDF link merged into its parent, where it only adds to the parent's sum."""
+    I = np.asarray(inertia_kg_m2, dtype=float)
+    if moving or not np.all(np.isfinite(I)):
+        return False
+    moments = np.linalg.eigvalsh((I + I.T) / 2.0)
+    largest = float(np.max(np.abs(moments)))
+    if moments[0] < -MOMENT_NOISE_REL * max(largest, 1e-300):
+        return False
+    return lumped or largest == 0.0
+
+
 def physically_valid(inertia_kg_m2) -> bool:
     """Positive principal moments obeying the triangle inequality (A + B >= C)."""
     return tensor_problem(inertia_kg_m2) is None
@@ -397,7 +416,8 @@ def inertial_xml(props: MassProperties, indent: str = "  ", rpy: str = "0 0 0") 
 # A real part is not a uniform solid of its collision shape, so only a large difference
 # means a wrong tensor: within 50 % is "ok". The trace (twice the mass times the squared
 # radius of gyration) decides plausibility: all mass in the corners of a box gives only 3x
-# the solid box's inertia, so beyond 10x (or 1/10) no real mass distribution fits
+# the solid box's inertia, so beyond 10x (below, only at 1/100: see _plausible) no real
+# mass distribution fits
 # (implausible, warning), and beyond 100x the tensor is a placeholder or a unit mistake
 # (1.0 everywhere, mm^2 for m^2) that certainly changes how the body flies (way-off, error).
 OK_REL_DIFF = 0.5
@@ -560,7 +580,10 @@ def compare_link(link: Link, *, moving: bool = False, slowdown: float | None = N
     if slowdown and np.isfinite(ratio) and ratio > 0 \
             and abs(math.log(ratio / slowdown)) < abs(math.log(ratio)):
         judged = ratio / slowdown
-    if not _plausible(judged, ORDERS_OFF_TRACE_RATIO):
+    # Only a tensor too large for its geometry can be certainly wrong: no mass inside a
+    # shape turns it 100x harder than the solid shape; mass gathered inside it turns it
+    # easier down to any share, so a small tensor stays "implausible" (a warning).
+    if not _plausible(judged, ORDERS_OFF_TRACE_RATIO) and judged > 1.0:
         return result("way-off", f"declared inertia is {_times(ratio)} the {label}'s{hull}",
                       *args)
     if not _plausible(judged, PLAUSIBLE_TRACE_RATIO):
@@ -576,7 +599,14 @@ def compare_link(link: Link, *, moving: bool = False, slowdown: float | None = N
 
 
 def _plausible(ratio: float, factor: float = PLAUSIBLE_TRACE_RATIO) -> bool:
-    return 1.0 / factor < ratio < factor
+    """Within `factor` of the geometry's trace: above it, or below by ORDERS_OFF at least.
+
+    Asymmetric on purpose: a body inside its geometry has at most ~3x the uniform solid's
+    trace (all mass in the corners), so 10x more is no mass distribution; but any share
+    down to zero is one (a motor or a hub inside a large collision cylinder, a contact
+    sensor box around a light frame: PX4's bumper at 1/84), so smaller is judged only at
+    the orders-off bound, 1/100 (radius of gyration a tenth of the uniform body's)."""
+    return 1.0 / max(factor, ORDERS_OFF_TRACE_RATIO) < ratio < factor
 
 
 def _times(ratio: float) -> str:
@@ -593,13 +623,176 @@ def moving_links(robot: Robot) -> set[str]:
 
 
 def compare_links(robot: Robot) -> list[LinkComparison]:
-    """compare_link for every link of the robot, in document order."""
+    """compare_link for every link of the robot, in document order, then judged in the
+    robot (judge_in_robot): a placeholder link, or a tensor whose error does not change
+    how the robot flies, is not an error."""
     moving = moving_links(robot)
     slowdowns = rotor_slowdown_by_link(robot)
     unreadable = unreadable_masses(robot)
-    return [compare_link(link, moving=link.name in moving, slowdown=slowdowns.get(link.name),
-                         mass_unreadable=link.name in unreadable)
-            for link in robot.links]
+    # An SDF link without <inertial> carries sdformat's 1 kg and unit tensor (S120 says so):
+    # nothing the author wrote to compare with its geometry.
+    defaulted = {issue.subject for issue in robot.parse_issues
+                 if issue.kind == "sdf-default-inertial"}
+    comparisons = [compare_link(link, moving=link.name in moving,
+                                slowdown=slowdowns.get(link.name),
+                                mass_unreadable=link.name in unreadable)
+                   if link.name not in defaulted else
+                   LinkComparison(link.name, link.loc, declared_mass_properties(link), None,
+                                  None, None, None, None, "no-inertial",
+                                  "no <inertial>: sdformat's default 1 kg and unit inertia")
+                   for link in robot.links]
+    lumped = lumped_urdf_links(robot)
+    comparisons = [replace(c, verdict="point-mass", message="zero moments: a point mass on a "
+                           "fixed joint (or merged into its parent), which Gazebo accepts")
+                   if c.verdict == "invalid" and c.tensor_problem == "not-positive-definite"
+                   and degenerate_but_accepted(c.declared.inertia_kg_m2,
+                                               moving=c.link in moving,
+                                               lumped=c.link in lumped) else c
+                   for c in comparisons]
+    return judge_in_robot(robot, comparisons)
+
+
+def lumped_urdf_links(robot: Robot) -> set[str]:
+    """URDF links that Gazebo's URDF->SDF conversion merges into their parent: children of
+    fixed joints without preserveFixedJoint/disableFixedJointLumping (parser_urdf.cc)."""
+    if robot.source_format != "urdf":
+        return set()
+    kept = {block.reference for block in robot.gazebo for node in block.elements
+            if node.tag in ("disableFixedJointLumping", "preserveFixedJoint")
+            and (node.text or "").strip().lower() == "true"}
+    return {joint.child for joint in robot.joints
+            if joint.type == "fixed" and joint.name not in kept}
+
+
+# A link is a placeholder when its mass and its inertia about the robot's COM are both
+# below this fraction of the robot's. Derivation: hover thrust is proportional to the
+# mass, attitude response to the inverse inertia, so such a link changes either by less
+# than 0.1 %: ten times below the finest figure a flight stack is tuned to (PX4's
+# MPC_THR_HOVER resolution is 0.01 of full thrust; rate gains keep a 2x gain margin) and
+# below what a scale (1 g on 2 kg) or a pendulum test (1-5 %) measures. Control surfaces
+# of 1e-8 kg and sensor frames of 1e-15 kg are this: whatever their tensor, it cannot
+# change how the vehicle flies, so it is not compared.
+PLACEHOLDER_FRACTION = 1e-3
+# A way-off tensor (100x its geometry's) is an error when it changes how the robot flies:
+# swapping it for its geometry's changes a principal moment of the whole robot by this
+# factor or more. Attitude controllers keep about a 2x (6 dB) gain margin, so beyond it
+# the vehicle tuned on the real inertia is at the edge of stability, and a robot
+# dominated by one wrong tensor (a 0.1 kg wheel with 1.0 kg·m²) moves like another body.
+# Below it reedtool cannot tell a wrong tensor from a placeholder geometry (a 5 mm box
+# standing for a 0.28 kg tilt unit): a warning that says so.
+ROBOT_INERTIA_FACTOR = 2.0
+
+
+def _robot_frame(robot: Robot):
+    """(link poses in the base frame, whole-robot MassProperties) or None when the tree or
+    the masses leave them undefined."""
+    from reedtool.physics.kinematics import link_poses
+
+    try:
+        poses = link_poses(robot)
+    except (ReedtoolError, KeyError, ValueError):
+        return None
+    parts = []
+    for name, T_base_link in poses.items():
+        declared = declared_mass_properties(robot.link_map[name])
+        if declared is None:
+            continue
+        if not (np.isfinite(declared.mass_kg) and np.all(np.isfinite(declared.com_m))
+                and np.all(np.isfinite(declared.inertia_kg_m2))) or declared.mass_kg < 0:
+            return None
+        parts.append(declared.transformed(T_base_link))
+    whole = combine(parts)
+    if whole.mass_kg <= 0 or not np.all(np.isfinite(whole.inertia_kg_m2)):
+        return None
+    return poses, whole
+
+
+def _about_robot_com(part: MassProperties, T_base_link, com_m) -> np.ndarray:
+    return part.transformed(T_base_link).inertia_about(com_m)
+
+
+def _placeholder_shares(declared: MassProperties, T_base_link, whole: MassProperties,
+                        smallest_moment: float) -> tuple[float, float]:
+    """(mass share, inertia share) of a link in the robot; see PLACEHOLDER_FRACTION."""
+    J = _about_robot_com(declared, T_base_link, whole.com_m)
+    return (declared.mass_kg / whole.mass_kg,
+            float(np.max(principal_moments(J))) / smallest_moment)
+
+
+def placeholder_links(robot: Robot) -> set[str]:
+    """Links whose mass and inertia about the robot's COM are both under
+    PLACEHOLDER_FRACTION of the robot's: nothing about them can change how it flies."""
+    frame = _robot_frame(robot)
+    if frame is None:
+        return set()
+    poses, whole = frame
+    smallest = float(principal_moments(whole.inertia_kg_m2)[0])
+    if smallest <= 0:
+        return set()
+    out = set()
+    for name, T in poses.items():
+        declared = declared_mass_properties(robot.link_map[name])
+        if declared is None or not declared.mass_kg > 0:
+            continue
+        mass_share, inertia_share = _placeholder_shares(declared, T, whole, smallest)
+        if mass_share < PLACEHOLDER_FRACTION and inertia_share < PLACEHOLDER_FRACTION:
+            out.add(name)
+    return out
+
+
+def judge_in_robot(robot: Robot, comparisons: list[LinkComparison]) -> list[LinkComparison]:
+    """Lower way-off and implausible verdicts that cannot matter to the robot; the others
+    are returned unchanged.
+
+    A placeholder (PLACEHOLDER_FRACTION) is not compared. A way-off tensor stays an error
+    when swapping every way-off tensor of the robot for its geometry's changes a principal
+    moment of the whole robot by ROBOT_INERTIA_FACTOR or more (several links may share one
+    copied value: the smartcar's 1.0 everywhere), and this link's own swap is a tenth or
+    more of that change; otherwise it is implausible (a warning saying why).
+    """
+    if not any(c.verdict in ("way-off", "implausible") for c in comparisons):
+        return comparisons
+    frame = _robot_frame(robot)
+    if frame is None:
+        return comparisons
+    poses, whole = frame
+    J_robot = whole.inertia_kg_m2
+    moments = principal_moments(J_robot)
+    if moments[0] <= 0:
+        return comparisons
+
+    judged: dict[str, tuple[str, str]] = {}        # link -> (verdict, message)
+    changes: dict[str, np.ndarray] = {}            # way-off link -> J_geometry - J_declared
+    for c in comparisons:
+        T = poses.get(c.link)
+        if c.verdict not in ("way-off", "implausible") or T is None or c.derived is None:
+            continue
+        J_declared = _about_robot_com(c.declared, T, whole.com_m)
+        mass_share, inertia_share = _placeholder_shares(c.declared, T, whole, float(moments[0]))
+        if mass_share < PLACEHOLDER_FRACTION and inertia_share < PLACEHOLDER_FRACTION:
+            judged[c.link] = ("placeholder", (
+                f"{c.message}; a placeholder: {mass_share:.1e} of the whole-robot mass and "
+                f"{inertia_share:.1e} of its smallest moment cannot change how it flies"))
+        elif c.verdict == "way-off":
+            changes[c.link] = _about_robot_com(c.derived, T, whole.com_m) - J_declared
+    if changes:
+        total = sum(changes.values())
+        swapped = principal_moments(J_robot + total)
+        factor = float(np.max(np.maximum(swapped / moments,
+                                         moments / np.maximum(swapped, 1e-300))))
+        largest = float(np.max(np.abs(np.linalg.eigvalsh(total))))
+        for name, change in changes.items():
+            own = float(np.max(np.abs(np.linalg.eigvalsh(change))))
+            c = next(c for c in comparisons if c.link == name)
+            if factor >= ROBOT_INERTIA_FACTOR and own >= 0.1 * largest:
+                judged[name] = ("way-off", f"{c.message}; it changes the whole-robot inertia "
+                                           f"{factor:.3g}x")
+            else:
+                judged[name] = ("implausible", (
+                    f"{c.message}; the whole-robot inertia changes {factor:.3g}x at most "
+                    "with either: a wrong tensor or a placeholder geometry"))
+    return [replace(c, verdict=judged[c.link][0], message=judged[c.link][1])
+            if c.link in judged else c for c in comparisons]
 
 
 def robot_mass_problem(robot: Robot) -> str | None:

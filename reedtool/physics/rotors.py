@@ -46,9 +46,10 @@ ARDUPILOT_PLUGINS = {"ArduPilotPlugin"}        # libArduPilotPlugin.so (classic)
 LIFT_DRAG_PLUGINS = {"LiftDragPlugin", "gz-sim-lift-drag-system",
                      "ignition-gazebo-lift-drag-system"}
 LIFT_DRAG_NAMES = {"gz::sim::systems::LiftDrag", "ignition::gazebo::systems::LiftDrag"}
-# gz-sim's AdvancedLiftDrag models a whole airframe (PX4's advanced_plane): a wing, never
-# a propeller blade, so it only tells the roles a wing is there.
-ADVANCED_LIFT_DRAG_PLUGINS = {"gz-sim-advanced-lift-drag-system"}
+# gz-sim's AdvancedLiftDrag (and PX4 classic's libAdvancedLiftDragPlugin.so, which it was
+# ported from) models a whole airframe (PX4's advanced_plane): a wing, never a propeller
+# blade, so it only tells the roles a wing is there.
+ADVANCED_LIFT_DRAG_PLUGINS = {"gz-sim-advanced-lift-drag-system", "AdvancedLiftDragPlugin"}
 ADVANCED_LIFT_DRAG_NAMES = {"gz::sim::systems::AdvancedLiftDrag"}
 
 MAVLINK_PLUGINS = {"rotors_gazebo_mavlink_interface", "gazebo_mavlink_interface"}
@@ -457,10 +458,12 @@ def rotor_table(rotors: list[Rotor]) -> list[dict]:
 
 
 def declared_rotor_counts(robot: Robot) -> list[RotorCountDeclaration]:
-    """Rotor counts declared by MAVLink/PX4 interface plugins.
+    """Rotor counts declared by MAVLink/PX4 interface plugins: an explicit
+    <rotorCount>/<rotor_count> (RotorS's interface sends that many motor commands).
 
-    Read from an explicit <rotorCount>/<rotor_count> element, else from the number of
-    rotor channels in <control_channels> (PX4's mavlink interface names them rotorN).
+    PX4 classic's control channels declare no count: a channel no motor reads is an unused
+    output (the MRS models list eight for every frame, PX4's iris template channels for
+    another model's joints), and a motor that no channel fills is R302's finding.
     """
     out = []
     for _block, plugin in robot.plugins():
@@ -473,14 +476,48 @@ def declared_rotor_counts(robot: Robot) -> list[RotorCountDeclaration]:
                 count = int(text) if text.isdigit() else None
                 out.append(RotorCountDeclaration(count, plugin, node.loc, text))
                 break
-        else:
-            channels = plugin.node.find("control_channels")
-            if channels is not None:
-                rotor_channels = [c for c in channels.findall("channel")
-                                  if c.attrib.get("name", "").lower().startswith("rotor")]
-                if rotor_channels:
-                    out.append(RotorCountDeclaration(len(rotor_channels), plugin, channels.loc))
     return out
+
+
+@dataclass
+class CommandVector:
+    """The motor command indices an autopilot interface plugin fills (a motor plugin reads
+    the entry of its own number), or None when the model says nothing about them."""
+
+    indices: set[int]
+    what: str                       # how they are declared, for messages
+    loc: SourceLoc
+
+
+def command_vector(robot: Robot) -> CommandVector | None:
+    """RotorS's interface sends `rotor_count` commands (indices 0..count-1); PX4 classic's
+    gazebo_mavlink_interface fills entry `input_index` of each velocity control channel. Without such
+    a plugin (gz-sim, where PX4's gz bridge or another node sends the commands) None."""
+    for _block, plugin in robot.plugins():
+        if plugin.library not in MAVLINK_PLUGINS:
+            continue
+        for tag in ("rotorCount", "rotor_count"):
+            node = plugin.node.find(tag)
+            if node is not None:
+                text = (node.text or "").strip()
+                if not text.isdigit():
+                    return None                 # R312 reports the count itself
+                return CommandVector(set(range(int(text))), f"<{tag}> {text}", node.loc)
+        channels = plugin.node.find("control_channels")
+        if channels is not None:
+            # Every channel's entry is published, but only a velocity channel's is a
+            # speed: a motor on a servo channel's entry spins with a surface's angle.
+            indices = set()
+            for channel in channels.findall("channel"):
+                index = channel.find("input_index")
+                kind = channel.find("joint_control_type")
+                text = (index.text or "").strip() if index is not None else ""
+                if text.isdigit() and (kind is None or (kind.text or "").strip() == "velocity"):
+                    indices.add(int(text))
+            if indices:
+                return CommandVector(indices, "the input_index of its velocity control "
+                                              "channels", channels.loc)
+    return None
 
 
 # ------------------------------------------------- ArduPilot motor response
