@@ -6,8 +6,8 @@ collision cylinder, else its visual cylinder, else a default that keeps neighbou
 apart) with its motor number as the autopilot counts it (1-based: RotorS
 `motorNumber` + 1, the MAIN output) above the model's own index, an arrow for its spin
 (ccw / cw seen from above), and its arm from the centre of mass labelled with the arm
-length. The body is the base link's footprint (box or cylinder), a front arrow marks the
-nose, a cross marks the COM.
+length. The body is the base link's footprint (box or cylinder, its own or a fixed
+child's), a front arrow marks the nose, a cross marks the COM.
 
 SVG elements carry ids (`rotor-N`, `spin-N`, `label-N`, `arm-N`, `com`, `front`, and two
 a hairline `anchor` from (x, y) = (0, 0) to (ANCHOR_M, ANCHOR_M) m) so
@@ -87,15 +87,32 @@ def _default_radius(positions: np.ndarray) -> float:
     return 0.3 * max(reach) if reach and max(reach) > 0 else 0.1
 
 
+def _body_shapes(robot):
+    """(shape, T_base_geom) of the base link, then of the links fixed to it, nearest first:
+    Gazebo folds those into one body, and RotorS puts the body's box on a link fixed to a
+    bare base_link (base_link_inertia)."""
+    T_base = {robot.base_link: np.eye(4)}
+    order = [robot.base_link] if robot.base_link in robot.link_map else []
+    for name in order:                      # grows as fixed children are found
+        for joint in robot.joints:
+            if (joint.parent == name and joint.type == "fixed" and joint.child not in T_base
+                    and joint.child in robot.link_map):
+                T_base[joint.child] = T_base[name] @ joint.T_parent_joint
+                order.append(joint.child)
+    for name in order:
+        link = robot.link_map[name]
+        for shape in [*link.collisions, *link.visuals]:
+            yield shape, T_base[name] @ shape.T_link_geom
+
+
 def _footprint(robot):
-    """('box', half_x, half_y, cx, cy) / ('circle', r, cx, cy) of the base link, or None."""
+    """('box', half_x, half_y, cx, cy) / ('circle', r, cx, cy) of the body, or None."""
     from reedtool.model import Box, Cylinder
 
-    link = robot.link_map.get(robot.base_link)
-    if link is None:
-        return None
-    for shape in [*link.collisions, *link.visuals]:
-        g, T = shape.geometry, shape.T_link_geom
+    for shape, T in _body_shapes(robot):
+        g = shape.geometry
+        if not np.all(np.isfinite(T)):
+            continue
         cx, cy = float(T[0, 3]), float(T[1, 3])
         if isinstance(g, Box):
             # footprint of the box's extent projected onto the xy plane
