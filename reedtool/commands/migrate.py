@@ -44,10 +44,13 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
             model_name: str | None, launch_file: Path | None, to: str, output_dir: Path,
             name: str | None, urdf: bool, velocity_control: bool, autopilot: str | None,
             force: bool, fmt: str) -> int:
-    """Port MODEL (.urdf, .xacro with NAME:=VALUE arguments, or Classic .sdf) to a Gazebo
-    Sim model directory OUTPUT_DIR/NAME, then read it back and compare it with the
-    original: links, joints, masses, inertias, poses, rotors, hover trim, hover-test
-    verdict and validate's findings.
+    """Port MODEL to a Gazebo Sim model directory OUTPUT_DIR/NAME, then read it back and
+    compare it with the original: links, joints, masses, inertias, poses, rotors, hover
+    trim, hover-test verdict and validate's findings.
+
+    MODEL is a .urdf, .xacro (.urdf.xacro), .gazebo, or Classic .sdf or .world file, or a
+    directory, glob or ROS package holding one model; NAME:=VALUE words are its xacro
+    arguments.
     """
     from reedtool.assembly.migration import MigrateRequest, migrate
 
