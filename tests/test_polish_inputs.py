@@ -102,3 +102,18 @@ def test_authority_on_a_fixed_wing_says_no_rotor_lifts():
     code, out = run_cli("authority", FIXTURES / "ardupilot" / "zephyr_pusher.sdf")
     assert code == 2
     assert "no lift rotors" in out and "no motor plugins" not in out
+
+
+@pytest.mark.parametrize("command", ["validate", "hover-test", "expand"])
+def test_an_empty_word_is_refused_not_read_as_the_working_directory(command, tmp_path,
+                                                                    monkeypatch):
+    """`reedtool validate "$MODEL"` with MODEL unset: '' was read as '.', so validate
+    checked whatever lay under the working directory (and passed on a broken model it
+    never saw) and hover-test listed its 70-odd models."""
+    good = tmp_path / "good"
+    good.mkdir()
+    (good / "a.urdf").write_text("<robot name='a'><link name='a'/></robot>")
+    monkeypatch.chdir(good)
+    code, out = run_cli(command, "")
+    assert code == 2
+    assert "empty word" in out.strip().splitlines()[-1]

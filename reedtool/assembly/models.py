@@ -172,6 +172,11 @@ def request_from_words(words: Sequence[str], *, package_paths: Sequence[Path] = 
     ModelRequest). With --launch and no path, the launch file's model is the path."""
     from reedtool.io.mappings import MAPPING_SEPARATOR, parse_mappings
 
+    if any(not w.strip() for w in words):
+        # `reedtool validate "$MODEL"` with MODEL unset: read as ".", it would check every
+        # model under the working directory and could pass without seeing the one meant.
+        raise ReedtoolError("an empty word where a model path or NAME:=VALUE belongs",
+                            hint="check the shell variable that should name the model")
     request = ModelRequest(mappings=parse_mappings([w for w in words if MAPPING_SEPARATOR in w]),
                            package_paths=list(package_paths), model_name=model_name,
                            launch_file=launch_file, select=tuple(select), ignore=tuple(ignore))
