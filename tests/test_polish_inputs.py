@@ -117,3 +117,29 @@ def test_an_empty_word_is_refused_not_read_as_the_working_directory(command, tmp
     code, out = run_cli(command, "")
     assert code == 2
     assert "empty word" in out.strip().splitlines()[-1]
+
+
+def test_validate_diagram_draws_one_picture_per_model_even_when_names_repeat(tmp_path):
+    """Six of the VTOL fixtures are all called standard_vtol_like: with --force their
+    pictures overwrote one another (FILE-ROBOT.svg), leaving 2 files for 7 models."""
+    vtol = FIXTURES / "vtol"
+    models = sorted(vtol.glob("*.sdf"))
+    code, out = run_cli("validate", vtol, "--diagram", tmp_path / "d.svg", "--force")
+    assert code in (0, 1), out
+    drawn = sorted(p.name for p in tmp_path.glob("d-*.svg"))
+    assert drawn == sorted(f"d-{m.stem}.svg" for m in models)
+
+
+def test_validate_diagram_skips_a_model_without_rotors(tmp_path):
+    """A ground robot beside a multirotor aborted the whole run (exit 2, no report)."""
+    mixed = tmp_path / "mixed"
+    mixed.mkdir()
+    (mixed / "cart.urdf").write_text(
+        "<robot name='cart'><link name='body'><inertial><mass value='2'/>"
+        "<inertia ixx='0.1' ixy='0' ixz='0' iyy='0.1' iyz='0' izz='0.1'/></inertial>"
+        "</link></robot>")
+    (mixed / "vtol.sdf").write_text((FIXTURES / "vtol" / "vtol_pusher.sdf").read_text())
+    code, out = run_cli("validate", mixed, "--diagram", tmp_path / "m.svg")
+    assert code == 0, out
+    assert "cart.urdf" in out and "no rotors" in out
+    assert sorted(p.name for p in tmp_path.glob("m-*.svg")) == ["m-vtol.svg"]

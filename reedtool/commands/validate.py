@@ -88,7 +88,8 @@ def check_model(name: str, model: Path, options: RunOptions) -> list:
             options.notes += _agreement_lines(model, one.robot, one.findings, options,
                                               name + one.suffix)
         if options.diagram is not None:
-            _write_diagram(one.robot, one.findings, options, several=len(checked.models) > 1)
+            _write_diagram(model, one.robot, one.findings, options,
+                           several=len(checked.models) > 1)
     return results
 
 
@@ -120,12 +121,24 @@ def _agreement_lines(path: Path, robot, findings, options: RunOptions, model: st
     return lines
 
 
-def _write_diagram(robot, findings, options: RunOptions, several: bool) -> None:
+def _write_diagram(model: Path, robot, findings, options: RunOptions, several: bool) -> None:
+    """One picture per model: FILE itself for a run of one model; else FILE-STEM.svg, STEM
+    the model file's (and -ROBOT for each model of a world), so models that share a robot
+    name (variants of one xacro, fixtures) do not overwrite each other's picture."""
     from reedtool.assembly.diagram import write_diagram
+    from reedtool.physics.rotors import discover_rotors
 
     target = options.diagram
     if several or options.diagram_per_model:
-        target = target.with_name(f"{target.stem}-{robot.name}{target.suffix}")
+        if not discover_rotors(robot):
+            # A ground robot beside the multirotors has no layout; the run goes on.
+            options.notes.append(f"reedtool: --diagram: {model}"
+                                 + (f" [model {robot.name}]" if several else "")
+                                 + ": no rotors, no layout drawn")
+            return
+        stem = model.name.split(".")[0] if model.is_file() else model.name
+        name = f"{stem}-{robot.name}" if several else stem
+        target = target.with_name(f"{target.stem}-{name}{target.suffix}")
     write_diagram(robot, target, findings, options.force)
 
 
