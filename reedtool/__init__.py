@@ -1,3 +1,3 @@
 """reedtool: validate, trim and package multirotor models for ROS/Gazebo without ROS."""
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"

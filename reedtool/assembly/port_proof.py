@@ -115,21 +115,9 @@ class _Comparer:
 
 # ------------------------------------------------------------------ structure
 
-def _link_props(T_link_part_inertials):
-    """Mass properties in the port link's frame of (T_link_part, Inertial) parts."""
-    from reedtool.physics.inertia import MassProperties, combine
-
-    parts = []
-    for T_link_part, inertial in T_link_part_inertials:
-        T_link_com = T_link_part @ inertial.T_link_com
-        R = T_link_com[:3, :3]
-        parts.append(MassProperties(inertial.mass_kg, T_link_com[:3, 3],
-                                    R @ inertial.inertia_kg_m2 @ R.T))
-    return combine(parts)
-
-
 def compare_structure(original: Robot, port: Robot, fold: dict, proof: Proof) -> None:
     """Links, poses and joints; `fold` maps every original link to (port link, T)."""
+    from reedtool.physics.inertia import combine_inertials
     from reedtool.physics.kinematics import link_poses
 
     check = _Comparer(proof)
@@ -149,8 +137,9 @@ def compare_structure(original: Robot, port: Robot, fold: dict, proof: Proof) ->
         if name not in {s for s, _ in fold.values()}:
             check.differ("links", name, "present", False, True)
             continue
-        want = _link_props(expected.get(name, []))
-        got = _link_props([(np.eye(4), link.inertial)] if link.inertial is not None else [])
+        want = combine_inertials(expected.get(name, []))
+        got = combine_inertials([(np.eye(4), link.inertial)]
+                                if link.inertial is not None else [])
         mass_scale = max(want.mass_kg, 1e-12)
         check.numbers("links", name, "mass_kg", want.mass_kg, got.mass_kg, mass_scale)
         check.numbers("links", name, "com_m", want.com_m, got.com_m, size_m)

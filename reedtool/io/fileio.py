@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import codecs
 import errno
+import math
 import os
 import re
 import shutil
@@ -80,6 +81,18 @@ MAX_MESH_COORDINATE = 1e9
 # weighs 1e53 kg) is a typo or a broken expression, and squaring it (inertia, k*w^2)
 # overflows: the readers report it as S102 and read it as infinite.
 MAX_MAGNITUDE = 1e100
+
+
+def magnitude_problem(values: list[float]) -> tuple[list[float], str | None]:
+    """The numbers as a reader keeps them (beyond MAX_MAGNITUDE: infinite) and what is
+    wrong with them, for the reader's own finding; None when they are usable."""
+    if not all(math.isfinite(v) for v in values):
+        return values, "is not finite"
+    if all(abs(v) <= MAX_MAGNITUDE for v in values):
+        return values, None
+    return ([v if abs(v) <= MAX_MAGNITUDE else math.copysign(math.inf, v) for v in values],
+            f"is beyond any physical quantity (|value| > {MAX_MAGNITUDE:g}): "
+            "effectively infinite")
 
 
 def check_mesh_coordinates(triangles, source) -> None:

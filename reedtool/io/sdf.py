@@ -62,7 +62,7 @@ import numpy as np
 from lxml import etree
 
 from reedtool.errors import ReedtoolError
-from reedtool.io.fileio import MAX_MAGNITUDE
+from reedtool.io.fileio import magnitude_problem
 from reedtool.frames import make_T, matrix_to_rpy, rpy_to_matrix
 from reedtool.io.resources import resolve_model_file_uri
 from reedtool.io.sdf_include import SourceFile, SourceMap, expand_includes
@@ -291,14 +291,9 @@ class _ModelReader:
             self._issue("bad-number", f"<{el.tag}>{raw}</{el.tag}> has {len(values)} number(s), "
                         f"expected {expected}", el, subject)
             return np.full(len(default), math.nan)
-        if not all(math.isfinite(v) for v in values):
-            self._issue("non-finite", f"<{el.tag}>{raw}</{el.tag}> is not finite", el, subject)
-        elif not all(abs(v) <= MAX_MAGNITUDE for v in values):
-            self._issue("non-finite", f"<{el.tag}>{raw}</{el.tag}> is beyond any physical "
-                        f"quantity (|value| > {MAX_MAGNITUDE:g}): effectively infinite",
-                        el, subject)
-            values = [v if abs(v) <= MAX_MAGNITUDE else math.copysign(math.inf, v)
-                      for v in values]
+        values, problem = magnitude_problem(values)
+        if problem is not None:
+            self._issue("non-finite", f"<{el.tag}>{raw}</{el.tag}> {problem}", el, subject)
         return np.array(values, dtype=float)
 
     def _number(self, parent: etree._Element | None, tag: str, default: float,

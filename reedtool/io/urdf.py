@@ -16,7 +16,7 @@ import numpy as np
 from lxml import etree
 
 from reedtool.errors import ReedtoolError
-from reedtool.io.fileio import MAX_MAGNITUDE
+from reedtool.io.fileio import magnitude_problem
 from reedtool.frames import make_T, rpy_to_matrix
 from reedtool.io.xml_lines import start_line
 from reedtool.model import (
@@ -138,14 +138,9 @@ class _RobotReader:
             self._issue("bad-number", f"<{el.tag} {attr}=\"{raw}\"> has {len(values)} "
                         f"number(s), expected {count}", el, subject)
             return np.full(count, math.nan)
-        if not all(math.isfinite(v) for v in values):
-            self._issue("non-finite", f"<{el.tag} {attr}=\"{raw}\"> is not finite", el, subject)
-        elif not all(abs(v) <= MAX_MAGNITUDE for v in values):
-            self._issue("non-finite", f"<{el.tag} {attr}=\"{raw}\"> is beyond any physical "
-                        f"quantity (|value| > {MAX_MAGNITUDE:g}): effectively infinite",
-                        el, subject)
-            values = [v if abs(v) <= MAX_MAGNITUDE else math.copysign(math.inf, v)
-                      for v in values]
+        values, problem = magnitude_problem(values)
+        if problem is not None:
+            self._issue("non-finite", f"<{el.tag} {attr}=\"{raw}\"> {problem}", el, subject)
         return np.array(values, dtype=float)
 
     def _float(self, el: etree._Element | None, attr: str, default: float | None,

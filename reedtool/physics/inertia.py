@@ -274,6 +274,18 @@ def declared_mass_properties(link: Link) -> MassProperties | None:
                           inertial.inertia_in_link_axes())
 
 
+def combine_inertials(T_link_part_inertials) -> MassProperties:
+    """Mass properties in one link's frame of (T_link_part, Inertial) parts: the
+    <inertial>s of links folded into it, each posed in it by T_link_part."""
+    parts = []
+    for T_link_part, inertial in T_link_part_inertials:
+        T_link_com = T_link_part @ inertial.T_link_com
+        R_link_com = T_link_com[:3, :3]
+        parts.append(MassProperties(inertial.mass_kg, T_link_com[:3, 3],
+                                    R_link_com @ inertial.inertia_kg_m2 @ R_link_com.T))
+    return combine(parts)
+
+
 def whole_robot(robot: Robot) -> MassProperties:
     """reedtool's own sum over links, in the root link's frame, at zero joint positions.
 

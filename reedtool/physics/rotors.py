@@ -467,16 +467,24 @@ def declared_rotor_counts(robot: Robot) -> list[RotorCountDeclaration]:
     """
     out = []
     for _block, plugin in robot.plugins():
-        if plugin.library not in MAVLINK_PLUGINS:
-            continue
-        for tag in ("rotorCount", "rotor_count"):
-            node = plugin.node.find(tag)
-            if node is not None:
-                text = (node.text or "").strip()
-                count = int(text) if text.isdigit() else None
-                out.append(RotorCountDeclaration(count, plugin, node.loc, text))
-                break
+        declared = _rotor_count_node(plugin)
+        if declared is not None:
+            _tag, node, text = declared
+            count = int(text) if text.isdigit() else None
+            out.append(RotorCountDeclaration(count, plugin, node.loc, text))
     return out
+
+
+def _rotor_count_node(plugin):
+    """(tag, element, text) of an autopilot interface's <rotorCount>/<rotor_count>, or
+    None when the plugin is no such interface or declares no count."""
+    if plugin.library not in MAVLINK_PLUGINS:
+        return None
+    for tag in ("rotorCount", "rotor_count"):
+        node = plugin.node.find(tag)
+        if node is not None:
+            return tag, node, (node.text or "").strip()
+    return None
 
 
 @dataclass
@@ -496,13 +504,12 @@ def command_vector(robot: Robot) -> CommandVector | None:
     for _block, plugin in robot.plugins():
         if plugin.library not in MAVLINK_PLUGINS:
             continue
-        for tag in ("rotorCount", "rotor_count"):
-            node = plugin.node.find(tag)
-            if node is not None:
-                text = (node.text or "").strip()
-                if not text.isdigit():
-                    return None                 # R312 reports the count itself
-                return CommandVector(set(range(int(text))), f"<{tag}> {text}", node.loc)
+        declared = _rotor_count_node(plugin)
+        if declared is not None:
+            tag, node, text = declared
+            if not text.isdigit():
+                return None                     # R312 reports the count itself
+            return CommandVector(set(range(int(text))), f"<{tag}> {text}", node.loc)
         channels = plugin.node.find("control_channels")
         if channels is not None:
             # Every channel's entry is published, but only a velocity channel's is a

@@ -55,7 +55,7 @@ def _sub(parent, tag: str, text: object | None = None, **attrib: str):
 
 def _inertial(parent, inertials) -> None:
     """One <inertial>: the part as written, or the folded parts combined about their COM."""
-    from reedtool.physics.inertia import MassProperties, combine
+    from reedtool.physics.inertia import combine_inertials
 
     if not inertials:
         return
@@ -65,13 +65,7 @@ def _inertial(parent, inertials) -> None:
         inertia = inertial.inertia_kg_m2
         mass = inertial.mass_kg
     else:
-        parts = []
-        for T_link_part, inertial in inertials:
-            T_link_com = T_link_part @ inertial.T_link_com
-            R = T_link_com[:3, :3]
-            parts.append(MassProperties(inertial.mass_kg, T_link_com[:3, 3],
-                                        R @ inertial.inertia_kg_m2 @ R.T))
-        total = combine(parts)
+        total = combine_inertials(inertials)
         T_link_com = np.eye(4)
         T_link_com[:3, 3] = total.com_m
         inertia, mass = total.inertia_kg_m2, total.mass_kg
