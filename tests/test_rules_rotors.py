@@ -74,6 +74,19 @@ def test_thrust_to_weight_figures_match_hand_calculation():
     assert f"{838 * math.sqrt(1.5 * weight_N / thrust_N):.0f} rad/s" in finding.hint
 
 
+def test_rotors_without_thrust_get_no_infinite_speed_hint(tmp_path):
+    """k·ω_max² with maxRotVelocity 1e-300 underflows to 0 N: thrust-to-weight is 0 and no
+    speed scales it up, so the hint names the constants instead of 'inf rad/s'."""
+    text = (FIXTURES / "R308_bad_heavy.urdf").read_text()
+    assert text.count("<maxRotVelocity>838</maxRotVelocity>") == 4
+    model = tmp_path / "no_thrust.urdf"
+    model.write_text(text.replace("<maxRotVelocity>838</maxRotVelocity>",
+                                  "<maxRotVelocity>1e-300</maxRotVelocity>"))
+    (finding,) = run_checks(load_robot(model))
+    assert finding.code == "R308" and "thrust-to-weight 0 <" in finding.message
+    assert "inf" not in finding.hint and "motorConstant" in finding.hint
+
+
 def test_yaw_imbalance_names_the_rotor_to_flip():
     (finding,) = run_checks(load_robot(FIXTURES / "R304_bad_three_ccw.urdf"))
     assert finding.subject == "rotor_2"

@@ -415,13 +415,16 @@ def _weight_and_trim(ctx: CheckContext):
     return trim
 
 
-def _omega_for(ctx: CheckContext, ratio: float) -> str:
-    """maxRotVelocity that would bring thrust-to-weight to `ratio` (same for all rotors)."""
+def _omega_for(ctx: CheckContext, ratio: float) -> str | None:
+    """maxRotVelocity that would bring thrust-to-weight to `ratio` (same for all rotors),
+    or None when no speed would: rotors whose full-speed thrust is zero (a zero constant,
+    or k·ω_max² below the smallest float) scale to nothing."""
     trim = ctx.trim
     omega = max(r.max_rot_velocity_rad_s for r in _lift(ctx))
-    needed = omega * math.sqrt(ratio / trim.thrust_to_weight) if trim.thrust_to_weight > 0 \
-        else float("inf")
-    return f"{needed:.0f} rad/s"
+    if not trim.thrust_to_weight > 0:
+        return None
+    needed = omega * math.sqrt(ratio / trim.thrust_to_weight)
+    return f"{needed:.0f} rad/s" if math.isfinite(needed) else None
 
 
 def _max_loc(rotor: "Rotor"):
@@ -445,9 +448,16 @@ def thrust_to_weight_below_one(ctx: CheckContext) -> Iterator[Issue]:
                 f"{_fmt(trim.thrust_to_weight * trim.weight_N)} N, the robot weighs "
                 f"{_fmt(trim.weight_N)} N ({_fmt(ctx.whole_robot.mass_kg)} kg)",
                 _max_loc(_lift(ctx)[0]), "rotors",
-                hint=f"check mass and motor constants; for thrust-to-weight "
-                     f"{THRUST_TO_WEIGHT_WARN:g} maxRotVelocity would be "
-                     f"{_omega_for(ctx, THRUST_TO_WEIGHT_WARN)}")
+                hint=_more_thrust_hint(ctx))
+
+
+def _more_thrust_hint(ctx: CheckContext) -> str:
+    omega = _omega_for(ctx, THRUST_TO_WEIGHT_WARN)
+    if omega is None:
+        return ("the rotors give no thrust at full speed: check motorConstant and "
+                "maxRotVelocity (units: N/(rad/s)^2 and rad/s), and the mass")
+    return (f"check mass and motor constants; for thrust-to-weight "
+            f"{THRUST_TO_WEIGHT_WARN:g} maxRotVelocity would be {omega}")
 
 
 @rule("R309", "thrust-to-weight-low", "warning",
@@ -467,7 +477,8 @@ def thrust_to_weight_low(ctx: CheckContext) -> Iterator[Issue]:
                 f"{_fmt(trim.weight_N)} N of weight",
                 _max_loc(_lift(ctx)[0]), "rotors",
                 hint=f"maxRotVelocity {_omega_for(ctx, THRUST_TO_WEIGHT_WARN)} (or a "
-                     "correspondingly larger motor constant, or less mass) gives 1.5")
+                     f"correspondingly larger motor constant, or less mass) gives "
+                     f"{THRUST_TO_WEIGHT_WARN:g}")
 
 
 @rule("R310", "hover-throttle-high", "warning",
