@@ -379,11 +379,27 @@ def test_meshes_are_sized_as_gazebo_sizes_them_collada_unit_and_scale(tmp_path):
     assert np.allclose(view.framing.extent_m, [0.6, 0.2, 0.1], rtol=1e-12, atol=0)
 
 
-def test_a_urdf_yourdfpy_cannot_read_is_drawn_from_reedtools_reading():
-    # 'one' is not a number: yourdfpy stops there, reedtool records it and reads on
-    view = view_robot(load_robot(ROOT / "tests/fixtures/core/broken_numbers.urdf"))
+def test_a_urdf_yourdfpy_cannot_read_is_drawn_from_reedtools_reading(tmp_path):
+    # 'one' is not a number: yourdfpy stops there, reedtool records it and reads on (the
+    # joint origin made whole, so every link has a place)
+    text = (ROOT / "tests/fixtures/core/broken_numbers.urdf").read_text()
+    model = tmp_path / "unreadable_mass.urdf"
+    model.write_text(text.replace('<origin xyz="0 0"/>', '<origin xyz="0 0 0.1"/>'))
+    view = view_robot(load_robot(model))
     assert view.source == "reedtool"
     assert any("yourdfpy cannot read this URDF" in note for note in view.notes)
+    assert np.all(np.isfinite(view.framing.bounds_m))
+
+
+@pytest.mark.parametrize("suffix", ["png", "glb", "html"])
+def test_a_link_with_no_finite_pose_is_one_line_exit_2(tmp_path, suffix):
+    """`<origin xyz="0 0"/>` reads as NaN: the child has nowhere to be drawn, so every
+    output format refuses with the link named (was a matplotlib ValueError for PNG and a
+    'nan m' bounding box for GLB)."""
+    out = tmp_path / f"m.{suffix}"
+    code, text = run_cli("view", ROOT / "tests/fixtures/core/broken_numbers.urdf", "-o", out)
+    assert code == 2 and "cannot place link 'arm'" in text
+    assert len(text.strip().splitlines()) == 1 and not out.exists()
 
 
 def test_a_file_without_links_is_one_line_exit_2(tmp_path):

@@ -60,7 +60,17 @@ def view_robot(robot, *, collision: bool = False, findings=None):
         raise ReedtoolError("no root link: every link is some joint's child, so nothing "
                             "says where the robot is", file=robot.source_file,
                             hint="run `reedtool validate` on the model; it names the loop")
-    return build_scene(robot, link_poses(robot), discover_rotors(robot), com_m=com_m(robot),
+    T_base_link = link_poses(robot)
+    unplaced = sorted(name for name, T in T_base_link.items() if not np.all(np.isfinite(T)))
+    if unplaced:
+        # a NaN joint origin leaves its child (and everything below it) nowhere to draw
+        shown = ", ".join(f"'{name}'" for name in unplaced[:3])
+        more = f" and {len(unplaced) - 3} more" if len(unplaced) > 3 else ""
+        raise ReedtoolError(f"cannot place link {shown}{more}: a joint origin on its way "
+                            "from the root is not a finite number", file=robot.source_file,
+                            hint="run `reedtool validate` on the model; it names the number "
+                                 "and its line")
+    return build_scene(robot, T_base_link, discover_rotors(robot), com_m=com_m(robot),
                        collision=collision,
                        link_severity=link_severities(robot, findings) if findings else None)
 

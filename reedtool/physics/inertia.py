@@ -297,10 +297,12 @@ def whole_robot(robot: Robot) -> MassProperties:
     from reedtool.physics.kinematics import link_poses
 
     parts = []
-    for name, T_base_link in link_poses(robot).items():
-        declared = declared_mass_properties(robot.link_map[name])
-        if declared is not None:
-            parts.append(declared.transformed(T_base_link))
+    # inf/NaN in a link are expected here and judged below, not warned about
+    with np.errstate(invalid="ignore", over="ignore"):
+        for name, T_base_link in link_poses(robot).items():
+            declared = declared_mass_properties(robot.link_map[name])
+            if declared is not None:
+                parts.append(declared.transformed(T_base_link))
 
     def finite(p: MassProperties) -> bool:
         return bool(np.isfinite(p.mass_kg) and np.all(np.isfinite(p.com_m))
@@ -797,8 +799,11 @@ def judge_in_robot(robot: Robot, comparisons: list[LinkComparison]) -> list[Link
             own = float(np.max(np.abs(np.linalg.eigvalsh(change))))
             c = next(c for c in comparisons if c.link == name)
             if factor >= ROBOT_INERTIA_FACTOR and own >= 0.1 * largest:
-                judged[name] = ("way-off", f"{c.message}; it changes the whole-robot inertia "
-                                           f"{factor:.3g}x")
+                others = len(changes) - 1
+                together = (f"with the {others} other way-off tensor{'s' * (others > 1)} "
+                            "it changes" if others else "it changes")
+                judged[name] = ("way-off", f"{c.message}; {together} the whole-robot "
+                                           f"inertia {factor:.3g}x")
             else:
                 judged[name] = ("implausible", (
                     f"{c.message}; the whole-robot inertia changes {factor:.3g}x at most "
