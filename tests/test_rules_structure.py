@@ -108,3 +108,16 @@ def test_superset_of_check_urdf(name):
                                   "clean_arm.urdf", "clean_car.urdf"])
 def test_clean_models_pass_check_urdf(name):
     assert _check_urdf_ok(FIXTURES / name)
+
+
+def test_a_nan_in_sdf_is_not_blamed_on_xacro(tmp_path):
+    """SDF has no expressions: S102's hint on an SDF says to write the number, and only a
+    URDF (possibly from xacro) gets the xacro hint."""
+    model = tmp_path / "nan.sdf"
+    model.write_text('<sdf version="1.9"><model name="m"><link name="base">'
+                     '<inertial><mass>nan</mass></inertial></link></model></sdf>')
+    s102 = [f for f in run_checks(load_robot(model)) if f.code == "S102"]
+    assert len(s102) == 1 and "xacro" not in s102[0].hint
+    (urdf,) = [f for f in run_checks(load_robot(FIXTURES / "S102_bad_nan.urdf"))
+               if f.code == "S102"]
+    assert "xacro" in urdf.hint

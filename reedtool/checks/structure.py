@@ -61,7 +61,7 @@ def urdf_parse_error(ctx: CheckContext) -> Iterator[Issue]:
 
 @rule("S102", "non-finite-number", "error", "A number in the model is NaN or infinite.", clause="cannot-fly")
 def non_finite_number(ctx: CheckContext) -> Iterator[Issue]:
-    """Every number in a URDF must be finite. `nan` and `inf` usually come from an xacro
+    """Every number in a URDF or SDF must be finite. `nan` and `inf` usually come from an xacro
     expression that divided by zero or used an undefined property default.
 
     Physics engines propagate a NaN through the whole simulation: the model explodes or
@@ -70,10 +70,12 @@ def non_finite_number(ctx: CheckContext) -> Iterator[Issue]:
     Severity (error, cannot-fly): a NaN spreads through the whole simulation on the
     first step.
     """
+    hint = ("write the number itself: SDF computes nothing, the text is the value"
+            if ctx.robot.source_format == "sdf"
+            else "check the xacro expression that computes this value")
     for issue in ctx.robot.parse_issues:
         if issue.kind in _NON_FINITE_KINDS:
-            yield Issue(issue.message, issue.loc, issue.subject,
-                        hint="check the xacro expression that computes this value")
+            yield Issue(issue.message, issue.loc, issue.subject, hint=hint)
 
 
 @rule("S103", "legacy-xacro-tag", "warning", "An old-style xacro tag was copied into the URDF.",
