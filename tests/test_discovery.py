@@ -316,3 +316,42 @@ def test_every_command_suggests_the_mapping():
 
     code, out = run_cli("inertia", FLIE / "urdf" / "flie_base.xacro", "namespace=flie")
     assert code == 2 and "did you mean 'namespace:=flie'?" in out
+
+
+def _hector_shaped(tmp_path: Path, body: str) -> Path:
+    """A hector_quadrotor-shaped package: the file its launch files pass as the model is
+    `<robot name=...>` holding nothing but includes; the included file lays out the links."""
+    pkg = tmp_path / "hq_description"
+    (pkg / "urdf").mkdir(parents=True)
+    (pkg / "package.xml").write_text("<package><name>hq_description</name></package>")
+    (pkg / "urdf" / "body.urdf.xacro").write_text(
+        '<robot xmlns:xacro="http://www.ros.org/wiki/xacro">' + body + "</robot>")
+    model = pkg / "urdf" / "quadrotor.gazebo.xacro"
+    model.write_text('<robot name="quadrotor" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+                     '<xacro:include filename="$(find hq_description)/urdf/body.urdf.xacro"/>'
+                     "</robot>")
+    return model
+
+
+LINK = ('<link name="base_link"><inertial><mass value="{mass}"/>'
+        '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.02"/></inertial>'
+        '</link>')
+
+
+def test_a_file_of_includes_that_expands_into_links_is_validated_as_itself(tmp_path, capsys):
+    """Issue 18 item 4: judged by its expansion, not its text. A file whose own children
+    are only includes is a model when those includes lay out links (was 'skipped: a xacro
+    macro library', exit 0, on hector_quadrotor's spawn models)."""
+    model = _hector_shaped(tmp_path, LINK.format(mass="-1"))
+    code, doc = run_json([str(model)], capsys)
+    (entry,) = doc["models"]
+    assert entry.get("skipped") is None and code == 1
+    assert "I201" in {f["code"] for f in doc["findings"]}     # the mass of -1 is seen
+
+
+def test_a_file_of_includes_that_lays_out_no_link_is_still_a_library(tmp_path, capsys):
+    """Control: the same file including only macro definitions has no robot of its own."""
+    model = _hector_shaped(tmp_path, '<xacro:macro name="arm"><link name="a"/></xacro:macro>')
+    code, doc = run_json([str(model)], capsys)
+    (entry,) = doc["models"]
+    assert code == 0 and "macro library" in (entry.get("skipped") or "")

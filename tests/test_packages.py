@@ -151,6 +151,21 @@ def test_two_packages_with_one_name_are_reported(tmp_path, copies, expected):
         assert "twin_0" in findings[0].message and "twin_1" in findings[0].message
 
 
+def test_a_twin_of_a_package_the_model_never_reads_is_not_reported(tmp_path):
+    """S150 good: two packages named 'other' on the search path cannot change a model that
+    reads only 'twin' (a workspace crawl finds every duplicate; only used ones matter)."""
+    from reedtool.checks.runner import Selection, run_checks
+    from reedtool.io.loader import load_robot
+
+    model = _twin_workspace(tmp_path, 1)
+    for i in range(2):
+        other = tmp_path / "src" / f"other_{i}"
+        other.mkdir()
+        (other / "package.xml").write_text("<package><name>other</name></package>")
+    robot = load_robot(model, {}, [tmp_path / "src"])
+    assert [f.code for f in run_checks(robot, Selection(select=("S",)))] == []
+
+
 def test_one_package_reached_through_a_symlink_is_one_package(tmp_path):
     """S150 good: an install space whose share/twin links to the sources (colcon
     --symlink-install, catkin's devel space) holds one package, reached twice."""

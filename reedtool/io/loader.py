@@ -44,8 +44,12 @@ def refuse_mesh(path: Path) -> None:
 
 
 def _with_package_notes(robot: Robot, resolver) -> Robot:
-    """The resolver's ambiguities (two packages with one name) as ParseIssues for S150."""
+    """The resolver's ambiguities (two packages with one name) as ParseIssues for S150:
+    only those of packages the model read; another package's twin cannot change it."""
+    read = resolver.resolved_names
     for name, used, ignored, where in resolver.duplicates:
+        if name not in read:
+            continue
         robot.parse_issues.append(ParseIssue(
             kind="package-duplicate",
             message=f"two packages named '{name}' under {where}: using {used}, ignoring "

@@ -91,6 +91,12 @@ def is_macro_library(path: Path) -> bool:
     return bool(children) and all(c in _LIBRARY_CHILDREN for c in children)
 
 
+def _includes_files(path: Path) -> bool:
+    """The file includes others (so its expansion may hold links its own text lacks)."""
+    _root, children = _root_and_children(path)
+    return any(tag in ("include", "xacro:include") for tag in children)
+
+
 def is_scene_world(path: Path) -> bool:
     """An SDF world with no vehicle in it: only static models, lights and systems, no
     `<include>` (the launch file spawns the robot into it, as `new-package` writes them).
@@ -244,6 +250,13 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
                                   error=f"include cycle: {chain} (remove one of the "
                                         "includes; a file cannot include itself)"))
                 return
+        if library and (has_arguments(path)
+                        or (_includes_files(path) and stands_alone(path))):
+            # Only includes by its text, but the user gave it arguments, or the files it
+            # includes lay out a robot when it is expanded alone (hector's
+            # quadrotor.gazebo.xacro): a model, judged by its expansion.
+            add(path)
+            return
         if library and not includers:
             # pre-commit passes every changed file: a macro library has no robot of its
             # own; the models that include it are where its mistakes show.

@@ -236,6 +236,11 @@ class PackageResolver:
         return self._index[root].get(name)
 
     # ------------------------------------------------------------ api
+    @property
+    def resolved_names(self) -> set[str]:
+        """The packages this resolver has found so far (those a model read)."""
+        return set(self._found)
+
     def find(self, name: str, *, requested_by: SourceLoc | None = None) -> Path:
         """The directory of package `name`; ReedtoolError naming what was searched."""
         if name in self._found:
