@@ -327,7 +327,9 @@ def mesh_unresolved(ctx: CheckContext) -> Iterator[Issue]:
     size does not match its facet count), an empty export, or one with NaN coordinates
     is reported with what is wrong with it. (glTF/GLB/FBX are only checked to exist.)
 
-    Severity (error, refused): Gazebo cannot load a mesh it cannot find.
+    Severity (error, refused): Gazebo classic does not report a mesh it cannot find; it
+    keeps looking (its model database included) and the world never comes up (a known
+    classic defect). gz-sim logs the error and spawns the model without that geometry.
     """
     for link, kind, shape, mesh in _mesh_shapes(ctx):
         if _refused(ctx, mesh):
