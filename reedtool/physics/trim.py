@@ -164,8 +164,8 @@ def trim_from_allocation(A: np.ndarray, motor_constant: np.ndarray, omega_max_ra
         omega = np.sqrt(thrust / k)
         u = omega / omega_max
         return result(True, None,
-                      f"hover at {omega.min():.1f}-{omega.max():.1f} rad/s "
-                      f"({100 * u.min():.0f}-{100 * u.max():.0f}% of max speed), "
+                      f"hover at {_span(omega, '.1f')} rad/s "
+                      f"({_span(100 * u, '.0f')}% of max speed), "
                       f"thrust-to-weight {thrust_to_weight:.2f}", thrust)
 
     # Infeasible with enough thrust: is it the weight (roll/pitch) or the yaw that cannot
@@ -349,3 +349,9 @@ def _empty(cause: TrimCause, message: str, n: int, weight_N: float,
 
 def _finite_or_none(value: float) -> float | None:
     return value if np.isfinite(value) else None
+
+
+def _span(values, spec: str) -> str:
+    """'low-high' as printed, or one number where both print alike (a symmetric frame)."""
+    low, high = format(float(values.min()), spec), format(float(values.max()), spec)
+    return low if low == high else f"{low}-{high}"
