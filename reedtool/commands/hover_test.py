@@ -326,9 +326,10 @@ def render_text(report: dict) -> str:
                          f"{_num(r['omega_rad_s'], '11.2f')}  {_pct(r['throttle']):>8}{limit}")
     if trim["feasible"]:
         a = trim["torque_authority_N_m"]
-        lines.append(f"  thrust-to-weight {trim['thrust_to_weight']:.3f}; torque authority at "
-                     f"hover: roll {a['roll']:.3g}, pitch {a['pitch']:.3g}, "
-                     f"yaw {a['yaw']:.3g} N*m")
+        authority = ("" if not all(math.isfinite(v) for v in a.values()) else
+                     f"; torque authority at hover: roll {a['roll']:.3g}, "
+                     f"pitch {a['pitch']:.3g}, yaw {a['yaw']:.3g} N*m")
+        lines.append(f"  thrust-to-weight {trim['thrust_to_weight']:.3f}{authority}")
     if sim is not None:
         from reedtool.sim.verdict import tuning_line
 

@@ -243,7 +243,8 @@ def solve_trim_6dof(mass_kg: float, com_m: np.ndarray, rotors: Sequence,
                    f"(6-DoF allocation rank {rank})")
     return TrimResult(thrust is not None, cause, message, clipped, omega, throttle,
                       thrust_to_weight, float(throttle.max()), A @ clipped - wrench,
-                      np.zeros(3), A, rank, cond, weight_N, names, demand_N=shown,
+                      # roll/pitch/yaw authority is the 4-row trim's; not computed here
+                      np.full(3, np.nan), A, rank, cond, weight_N, names, demand_N=shown,
                       limit=_limits(shown, thrust_min, thrust_max))
 
 
