@@ -121,3 +121,39 @@ def test_a_nan_in_sdf_is_not_blamed_on_xacro(tmp_path):
     (urdf,) = [f for f in run_checks(load_robot(FIXTURES / "S102_bad_nan.urdf"))
                if f.code == "S102"]
     assert "xacro" in urdf.hint
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")   # the control's infinite pose
+@pytest.mark.parametrize("as_sdf", [True, False])
+def test_dbl_max_joint_limits_mean_no_limit(tmp_path, as_sdf):
+    """A wheel joint limited at ±1.79769e+308 (DBL_MAX: exporters' 'no limit', PX4's
+    rc_cessna wheels) is read as unbounded, with no S102; the same number in a pose is
+    still S102 (control)."""
+    big = "1.79769e+308"
+    if as_sdf:
+        def model(limit: str, pose: str) -> str:
+            link = ('<link name="{n}"><pose>{p}</pose><inertial><mass>1</mass><inertia>'
+                    '<ixx>0.01</ixx><iyy>0.01</iyy><izz>0.01</izz></inertia></inertial></link>')
+            return ('<sdf version="1.9"><model name="m">' + link.format(n="body", p="0 0 0 0 0 0")
+                    + link.format(n="wheel", p=pose)
+                    + '<joint name="axle" type="revolute"><parent>body</parent>'
+                    '<child>wheel</child><axis><xyz>0 1 0</xyz><limit>' + limit
+                    + '</limit></axis></joint></model></sdf>')
+        good = model(f"<lower>-{big}</lower><upper>{big}</upper>", "0 0.1 0 0 0 0")
+        bad = model("<lower>-1</lower><upper>1</upper>", f"0 {big} 0 0 0 0")
+        suffix = ".sdf"
+    else:
+        def model(limit: str, xyz: str) -> str:
+            link = ('<link name="{n}"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" '
+                    'ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>')
+            return ('<robot name="m">' + link.format(n="body") + link.format(n="wheel")
+                    + '<joint name="axle" type="revolute"><parent link="body"/>'
+                    f'<child link="wheel"/><origin xyz="{xyz}"/><axis xyz="0 1 0"/>'
+                    f'<limit {limit} effort="1" velocity="1"/></joint></robot>')
+        good = model(f'lower="-{big}" upper="{big}"', "0 0.1 0")
+        bad = model('lower="-1" upper="1"', f"0 {big} 0")
+        suffix = ".urdf"
+    for text, expected in ((good, []), (bad, ["S102"])):
+        path = tmp_path / f"m{suffix}"
+        path.write_text(text)
+        assert [f.code for f in run_checks(load_robot(path)) if f.code == "S102"] == expected

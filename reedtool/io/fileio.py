@@ -83,16 +83,22 @@ MAX_MESH_COORDINATE = 1e9
 MAX_MAGNITUDE = 1e100
 
 
-def magnitude_problem(values: list[float]) -> tuple[list[float], str | None]:
+def magnitude_problem(values: list[float], *, unbounded_ok: bool = False
+                      ) -> tuple[list[float], str | None]:
     """The numbers as a reader keeps them (beyond MAX_MAGNITUDE: infinite) and what is
-    wrong with them, for the reader's own finding; None when they are usable."""
+    wrong with them, for the reader's own finding; None when they are usable.
+
+    `unbounded_ok`: a joint limit, where a huge finite number is the exporters' way of
+    writing "no limit" (DBL_MAX, 1.79769e+308, which the loaders store as given)."""
     if not all(math.isfinite(v) for v in values):
         return values, "is not finite"
     if all(abs(v) <= MAX_MAGNITUDE for v in values):
         return values, None
-    return ([v if abs(v) <= MAX_MAGNITUDE else math.copysign(math.inf, v) for v in values],
-            f"is beyond any physical quantity (|value| > {MAX_MAGNITUDE:g}): "
-            "effectively infinite")
+    kept = [v if abs(v) <= MAX_MAGNITUDE else math.copysign(math.inf, v) for v in values]
+    if unbounded_ok:
+        return kept, None
+    return kept, (f"is beyond any physical quantity (|value| > {MAX_MAGNITUDE:g}): "
+                  "effectively infinite")
 
 
 def check_mesh_coordinates(triangles, source) -> None:

@@ -276,7 +276,7 @@ class _ModelReader:
         self.issues.append(ParseIssue(kind, message, self.loc(el), subject))
 
     def _numbers(self, el: etree._Element | None, counts: tuple[int, ...], default,
-                 subject: str | None) -> np.ndarray:
+                 subject: str | None, unbounded_ok: bool = False) -> np.ndarray:
         if el is None or el.text is None or not el.text.strip():
             return np.array(default, dtype=float)
         raw = " ".join(el.text.split())
@@ -291,18 +291,19 @@ class _ModelReader:
             self._issue("bad-number", f"<{el.tag}>{raw}</{el.tag}> has {len(values)} number(s), "
                         f"expected {expected}", el, subject)
             return np.full(len(default), math.nan)
-        values, problem = magnitude_problem(values)
+        values, problem = magnitude_problem(values, unbounded_ok=unbounded_ok)
         if problem is not None:
             self._issue("non-finite", f"<{el.tag}>{raw}</{el.tag}> {problem}", el, subject)
         return np.array(values, dtype=float)
 
     def _number(self, parent: etree._Element | None, tag: str, default: float,
-                subject: str | None, required: bool = False) -> float:
+                subject: str | None, required: bool = False,
+                unbounded_ok: bool = False) -> float:
         el = parent.find(tag) if parent is not None else None
         if el is None and required and parent is not None:
             self._issue("missing-element", f"<{parent.tag}> has no <{tag}>; sdformat uses "
                         f"{default:g}", parent, subject)
-        return float(self._numbers(el, (1,), [default], subject)[0])
+        return float(self._numbers(el, (1,), [default], subject, unbounded_ok)[0])
 
     def _pose(self, el: etree._Element | None,
               subject: str | None) -> tuple[np.ndarray, str | None]:
@@ -636,10 +637,10 @@ class _ModelReader:
                     name: str) -> tuple[str, JointLimit | None]:
         if sdf_type not in ("revolute", "prismatic", "continuous"):
             return sdf_type, None
-        lower = self._number(limit_el, "lower", -1e16, name)
-        upper = self._number(limit_el, "upper", 1e16, name)
-        effort = self._number(limit_el, "effort", -1.0, name)
-        velocity = self._number(limit_el, "velocity", -1.0, name)
+        lower, upper, effort, velocity = (
+            self._number(limit_el, tag, default, name, unbounded_ok=True)
+            for tag, default in (("lower", -1e16), ("upper", 1e16), ("effort", -1.0),
+                                 ("velocity", -1.0)))
         # SDF writes "no effort/velocity limit" as -1; URDF needs a number, so: unlimited.
         limit = JointLimit(lower=lower, upper=upper,
                            effort=effort if effort >= 0 else math.inf,

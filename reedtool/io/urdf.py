@@ -118,7 +118,7 @@ class _RobotReader:
         self.issues.append(ParseIssue(kind, message, self.locate(el), subject))
 
     def _floats(self, el: etree._Element | None, attr: str, count: int, default: Sequence[float],
-                subject: str | None) -> np.ndarray:
+                subject: str | None, unbounded_ok: bool = False) -> np.ndarray:
         """Read `count` numbers from an attribute; problems become ParseIssues.
 
         `default` stands in for an absent attribute. An unreadable one reads as NaN, not
@@ -138,13 +138,14 @@ class _RobotReader:
             self._issue("bad-number", f"<{el.tag} {attr}=\"{raw}\"> has {len(values)} "
                         f"number(s), expected {count}", el, subject)
             return np.full(count, math.nan)
-        values, problem = magnitude_problem(values)
+        values, problem = magnitude_problem(values, unbounded_ok=unbounded_ok)
         if problem is not None:
             self._issue("non-finite", f"<{el.tag} {attr}=\"{raw}\"> {problem}", el, subject)
         return np.array(values, dtype=float)
 
     def _float(self, el: etree._Element | None, attr: str, default: float | None,
-               subject: str | None, required: bool = False) -> float | None:
+               subject: str | None, required: bool = False,
+               unbounded_ok: bool = False) -> float | None:
         if el is None:
             return default
         if el.get(attr) is None:
@@ -153,7 +154,7 @@ class _RobotReader:
                             el, subject)
             return default
         fallback = [default] if default is not None else [math.nan]
-        return float(self._floats(el, attr, 1, fallback, subject)[0])
+        return float(self._floats(el, attr, 1, fallback, subject, unbounded_ok)[0])
 
     def _origin(self, el: etree._Element | None, subject: str | None) -> np.ndarray:
         if el is None:
@@ -276,10 +277,11 @@ class _RobotReader:
         limit_el = el.find("limit")
         limit = None
         if limit_el is not None:
-            limit = JointLimit(lower=self._float(limit_el, "lower", None, name),
-                               upper=self._float(limit_el, "upper", None, name),
-                               effort=self._float(limit_el, "effort", None, name),
-                               velocity=self._float(limit_el, "velocity", None, name),
+            # DBL_MAX in a limit is "no limit" (urdfdom stores it as given)
+            lower, upper, effort, velocity = (
+                self._float(limit_el, attr, None, name, unbounded_ok=True)
+                for attr in ("lower", "upper", "effort", "velocity"))
+            limit = JointLimit(lower=lower, upper=upper, effort=effort, velocity=velocity,
                                loc=self.locate(limit_el))
         origin_el = el.find("origin")
         return Joint(name=name, type=el.get("type", ""), parent=parent, child=child,
