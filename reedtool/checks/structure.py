@@ -65,7 +65,8 @@ def non_finite_number(ctx: CheckContext) -> Iterator[Issue]:
     expression that divided by zero or used an undefined property default.
 
     Physics engines propagate a NaN through the whole simulation: the model explodes or
-    vanishes on the first step.
+    vanishes on the first step. A joint limit written as DBL_MAX (1.79769e+308) is the
+    exporters' "no limit", stored as given by the loaders: read as unbounded, not reported.
 
     Severity (error, cannot-fly): a NaN spreads through the whole simulation on the
     first step.
