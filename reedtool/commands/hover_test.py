@@ -22,6 +22,7 @@ from reedtool.assembly.vehicle import DEFAULT_MAX_MEMORY_MB
 from reedtool.commands.params import (
     FiniteFloatRange,
     model_inputs,
+    note_model_files,
     one_model_request,
     validation_options,
 )
@@ -149,9 +150,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
                                 hint="or use --engine numpy (the default)")
     from reedtool.io.fileio import check_writable, note_input
 
-    for word in inputs:         # the model is never an output of its own test
-        if Path(word).is_file():
-            note_input(Path(word))
+    note_model_files(inputs)          # the model is never an output of its own run
     if plot_path is not None:   # fail before flying, not after
         check_writable(plot_path, force)
     if csv_path is not None:

@@ -8,7 +8,12 @@ from pathlib import Path
 
 import click
 
-from reedtool.commands.params import model_inputs, one_model_request, validation_options
+from reedtool.commands.params import (
+    model_inputs,
+    note_model_files,
+    one_model_request,
+    validation_options,
+)
 from reedtool.report.layout_picture import output_format
 
 
@@ -34,9 +39,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
     from reedtool.io.fileio import check_writable, note_input
 
     output_format(output)
-    for word in inputs:              # the model is never the picture
-        if Path(word).is_file():
-            note_input(Path(word))
+    note_model_files(inputs)          # the model is never an output of its own run
     check_writable(output, force)         # a device, FIFO or existing file is refused here
     model, request = one_model_request("layout", inputs, package_paths, model_name,
                                        launch_file, ignore)

@@ -78,6 +78,16 @@ def validation_options(command):
     return ignore_option(command)
 
 
+def note_model_files(inputs) -> None:
+    """The model files named on the command line are inputs of this run: no output of it
+    (a picture, a plot, a CSV) may overwrite one."""
+    from reedtool.io.fileio import note_input
+
+    for word in inputs:
+        if Path(word).is_file():
+            note_input(Path(word))
+
+
 def one_model_request(command_name: str, inputs, package_paths, model_name, launch_file,
                       ignore=()):
     """The command line of a single-model command -> (model path, ModelRequest)."""

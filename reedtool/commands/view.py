@@ -6,7 +6,12 @@ from pathlib import Path
 
 import click
 
-from reedtool.commands.params import ignore_option, model_inputs, one_model_request
+from reedtool.commands.params import (
+    ignore_option,
+    model_inputs,
+    note_model_files,
+    one_model_request,
+)
 from reedtool.errors import ReedtoolError
 
 FORMATS = (".glb", ".png", ".html")
@@ -45,9 +50,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
     from reedtool.io.fileio import atomic_write_bytes, check_writable, note_input
 
     fmt = output_format(output)
-    for word in inputs:              # the model is never the picture
-        if Path(word).is_file():
-            note_input(Path(word))
+    note_model_files(inputs)          # the model is never an output of its own run
     check_writable(output, force)         # a device, FIFO or existing file is refused here
     model, request = one_model_request("view", inputs, package_paths, model_name,
                                        launch_file, ignore)
