@@ -290,3 +290,24 @@ def test_an_omni_frame_claims_no_roll_pitch_yaw_authority(capsys):
     assert doc["trim"]["torque_authority_N_m"] == {"roll": None, "pitch": None, "yaw": None}
     run_cli("hover-test", str(omni))
     assert "torque authority" not in capsys.readouterr().out
+
+
+def test_absent_time_constants_take_the_motor_plugins_defaults(capsys, tmp_path):
+    """RotorS, PX4 classic and gz-sim's MulticopterMotorModel all use kDefaultTimeConstantUp
+    = 1/80 s and kDefaultTimeConstantDown = 1/40 s when the elements are not written
+    (Bitcraze's gz crazyflie writes neither): the model flies, as in Gazebo, instead of
+    being refused as bad input. Written but unreadable stays an error (control)."""
+    from reedtool.physics.rotors import discover_rotors
+
+    xml = multirotor_urdf(4).replace(
+        '<timeConstantUp>0.0125</timeConstantUp><timeConstantDown>0.025</timeConstantDown>', "")
+    path = tmp_path / "no_tau.urdf"
+    path.write_text(xml)
+    rotors = discover_rotors(load_robot(path))
+    assert {r.time_constant_up_s for r in rotors} == {1.0 / 80.0}       # exact: the default
+    assert {r.time_constant_down_s for r in rotors} == {1.0 / 40.0}
+    code, report = run_json(capsys, str(path))
+    assert code == 0 and report["status"] == "flies"
+    bad = tmp_path / "bad_tau.urdf"
+    bad.write_text(multirotor_urdf(4).replace("<timeConstantUp>0.0125<", "<timeConstantUp>x<"))
+    assert run_cli("hover-test", str(bad)) == 2

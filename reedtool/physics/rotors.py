@@ -158,11 +158,18 @@ def is_lift_drag_plugin(plugin: Plugin) -> bool:
     return plugin.library in LIFT_DRAG_PLUGINS or (plugin.name or "") in LIFT_DRAG_NAMES
 
 
-def _float(text: str | None) -> float:
-    """The number, NaN when absent or unreadable, inf beyond any physical quantity
-    (MAX_MAGNITUDE: 1e300 squared overflows); R316 names what is not a usable constant."""
+# What every motor-model family (RotorS, PX4 classic, gz-sim MulticopterMotorModel) uses
+# when <timeConstantUp>/<timeConstantDown> is not written: its kDefaultTimeConstantUp/Down.
+DEFAULT_TIME_CONSTANT_UP_S = 1.0 / 80.0
+DEFAULT_TIME_CONSTANT_DOWN_S = 1.0 / 40.0
+
+
+def _float(text: str | None, absent: float = math.nan) -> float:
+    """The number; `absent` when not written (NaN unless the plugin has a default), NaN
+    when unreadable, inf beyond any physical quantity (MAX_MAGNITUDE: 1e300 squared
+    overflows); R316 names what is not a usable constant."""
     try:
-        value = float(text) if text is not None else math.nan
+        value = float(text) if text is not None else absent
     except ValueError:
         return math.nan
     return value if not abs(value) > MAX_MAGNITUDE else math.copysign(math.inf, value)
@@ -258,8 +265,9 @@ def _motor_model_rotor(robot: Robot, plugin: Plugin, kind: str, poses, index: in
         motor_constant=_float(plugin.param("motorConstant")),
         moment_constant=_float(plugin.param("momentConstant")),
         max_rot_velocity_rad_s=_float(plugin.param("maxRotVelocity")),
-        time_constant_up_s=_float(plugin.param("timeConstantUp")),
-        time_constant_down_s=_float(plugin.param("timeConstantDown")),
+        time_constant_up_s=_float(plugin.param("timeConstantUp"), DEFAULT_TIME_CONSTANT_UP_S),
+        time_constant_down_s=_float(plugin.param("timeConstantDown"),
+                                    DEFAULT_TIME_CONSTANT_DOWN_S),
         rotor_drag_coefficient=_float(plugin.param("rotorDragCoefficient")),
         rolling_moment_coefficient=_float(plugin.param("rollingMomentCoefficient")),
         kind=kind, plugin=plugin, loc=plugin.loc, node=plugin.node, number_tag=number_tag,
