@@ -102,3 +102,22 @@ def test_generated_gz_package_passes_inertia(tmp_path):
                    tmp_path)[0] == 0
     model = tmp_path / "gz_quad" / "urdf" / "gz_quad.urdf.xacro"
     assert run_cli("inertia", model, "--package-path", tmp_path)[0] == 0
+
+
+def test_a_negligible_whole_robot_change_is_said_in_percent():
+    """A tensor judged way off whose swap barely moves the whole robot is lowered to
+    implausible, and its message gives the change in percent, never 'changes 1x' (the
+    audit: a user cannot read '1x'). The rotor's comparison is marked way-off by hand;
+    its declared and geometric tensors are the fixture's, a few grams on a 1.5 kg body."""
+    import dataclasses
+    from pathlib import Path
+
+    from reedtool.io.loader import load_robot
+    from reedtool.physics.inertia import compare_links, judge_in_robot
+
+    robot = load_robot(Path(__file__).parent / "fixtures" / "validate" / "clean_quad_x.urdf")
+    rotor = next(c for c in compare_links(robot) if "rotor" in c.link and c.derived is not None)
+    way_off = dataclasses.replace(rotor, verdict="way-off", message="declared")
+    (judged,) = [c for c in judge_in_robot(robot, [way_off]) if c.link == rotor.link]
+    assert judged.verdict == "implausible"
+    assert "%" in judged.message and " 1x" not in judged.message

@@ -805,9 +805,12 @@ def judge_in_robot(robot: Robot, comparisons: list[LinkComparison]) -> list[Link
                 judged[name] = ("way-off", f"{c.message}; {together} the whole-robot "
                                            f"inertia {factor:.3g}x")
             else:
+                change = (f"{factor:.3g}x" if factor >= 1.1
+                          else f"{100 * (factor - 1):.2g} %")
                 judged[name] = ("implausible", (
-                    f"{c.message}; the whole-robot inertia changes {factor:.3g}x at most "
-                    "with either: a wrong tensor or a placeholder geometry"))
+                    f"{c.message}; swapping it for its geometry's changes the whole-robot "
+                    f"inertia by {change} at most, so a wrong tensor and a placeholder "
+                    "geometry fly alike"))
     return [replace(c, verdict=judged[c.link][0], message=judged[c.link][1])
             if c.link in judged else c for c in comparisons]
 
