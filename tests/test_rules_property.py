@@ -85,6 +85,15 @@ def _geometry_sdf(g) -> str:
     return f"<sphere><radius>{g[1]}</radius></sphere>"
 
 
+def _joint_ends(i: int, joint: dict) -> tuple[str, str]:
+    """Parent and child link names of broken joint i: itself, a ghost, empty, or (parent)
+    an earlier link."""
+    parent = {"self": f"l{i}", "ghost": "ghost", "": ""}.get(
+        joint["parent"], f"l{joint['parent'] % i}" if isinstance(joint["parent"], int) else "")
+    child = {"own": f"l{i}", "ghost": "ghost", "": ""}[joint["child"]]
+    return parent, child
+
+
 def _plugins(joints) -> str:
     out, channel = [], 0
     for i, (joint, _link) in enumerate(joints, start=1):
@@ -229,9 +238,7 @@ def broken_urdf(spec) -> str:
             f"</geometry></visual></link>")
     parts, plugins = [], []
     for i, (joint, _link) in enumerate(joints, start=1):
-        parent = {"self": f"l{i}", "ghost": "ghost", "": ""}.get(
-            joint["parent"], f"l{joint['parent'] % i}" if isinstance(joint["parent"], int) else "")
-        child = {"own": f"l{i}", "ghost": "ghost", "": ""}[joint["child"]]
+        parent, child = _joint_ends(i, joint)
         lower, upper = joint["limit"]
         parts.append(
             f'<joint name="j{i}" type="{joint["type"]}"><parent link="{parent}"/>'
@@ -281,9 +288,7 @@ def broken_sdf(spec) -> str:
             f'{link["radius"]}</radius><length>0.01</length></cylinder></geometry></visual>'
             "</link>")
     for i, (joint, _link) in enumerate(joints, start=1):
-        parent = {"self": f"l{i}", "ghost": "ghost", "": ""}.get(
-            joint["parent"], f"l{joint['parent'] % i}" if isinstance(joint["parent"], int) else "")
-        child = {"own": f"l{i}", "ghost": "ghost", "": ""}[joint["child"]]
+        parent, child = _joint_ends(i, joint)
         lower, upper = joint["limit"]
         parts.append(
             f'<joint name="j{i}" type="{joint["type"]}"><parent>{parent}</parent>'
