@@ -21,17 +21,19 @@ from reedtool.model import JOINT_TYPES, Box, Cylinder, Mesh, Sphere
 SDF_MIN_MASS_KG = 1e-6
 
 # Parse-issue kinds that have a rule of their own; every other kind is S101.
-_NON_FINITE_KINDS = {"non-finite"}
-_LEGACY_KINDS = {"legacy-xacro"}
-_TOLERATED_KINDS = {"xml-tolerated"}
-_DEFAULT_INERTIAL_KINDS = {"sdf-default-inertial"}
-_UNDEFINED_KINDS = {"sdf-undefined-element"}
-_LATE_DECLARATION_KINDS = {"xml-declaration-late"}
-_SHORT_POSE_KINDS = {"sdf-short-pose"}
+_ROUTED_KINDS = frozenset({
+    "non-finite",               # S102
+    "legacy-xacro",             # S103
+    "xml-tolerated",            # S119
+    "sdf-default-inertial",     # S120
+    "sdf-undefined-element",    # S123
+    "xml-declaration-late",     # S124
+    "sdf-short-pose",           # S125
+    "package-duplicate",        # S150
+})
 # libsdformat's joint types (sdf/1.x/joint.sdf): what an SDF <joint type=> may be.
 SDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "ball", "screw",
                    "universal", "revolute2", "gearbox")
-_PACKAGE_KINDS = {"package-duplicate"}
 _PER_AXIS_JOINTS = {"revolute", "continuous", "prismatic", "planar"}
 _LIMITED_JOINTS = {"revolute", "prismatic"}
 
@@ -53,10 +55,15 @@ def urdf_parse_error(ctx: CheckContext) -> Iterator[Issue]:
     Severity (error, refused): urdfdom and sdformat's URDF parser refuse the element.
     """
     for issue in ctx.robot.parse_issues:
-        if issue.kind not in _NON_FINITE_KINDS | _LEGACY_KINDS | _TOLERATED_KINDS \
-                | _PACKAGE_KINDS | _DEFAULT_INERTIAL_KINDS | _UNDEFINED_KINDS \
-                | _LATE_DECLARATION_KINDS | _SHORT_POSE_KINDS:
+        if issue.kind not in _ROUTED_KINDS:
             yield Issue(issue.message, issue.loc, issue.subject)
+
+
+def _reader_issues(ctx: CheckContext, kind: str, hint: str | None = None) -> Iterator[Issue]:
+    """The readers' issues of one routed kind, as this rule's findings."""
+    for issue in ctx.robot.parse_issues:
+        if issue.kind == kind:
+            yield Issue(issue.message, issue.loc, issue.subject, hint=hint)
 
 
 @rule("S102", "non-finite-number", "error", "A number in the model is NaN or infinite.", clause="cannot-fly")
@@ -74,9 +81,7 @@ def non_finite_number(ctx: CheckContext) -> Iterator[Issue]:
     hint = ("write the number itself: SDF computes nothing, the text is the value"
             if ctx.robot.source_format == "sdf"
             else "check the xacro expression that computes this value")
-    for issue in ctx.robot.parse_issues:
-        if issue.kind in _NON_FINITE_KINDS:
-            yield Issue(issue.message, issue.loc, issue.subject, hint=hint)
+    yield from _reader_issues(ctx, "non-finite", hint)
 
 
 @rule("S103", "legacy-xacro-tag", "warning", "An old-style xacro tag was copied into the URDF.",
@@ -96,7 +101,7 @@ def legacy_xacro_tag(ctx: CheckContext) -> Iterator[Issue]:
     (`reedtool expand --fix-legacy` rewrites them).
     """
     for issue in ctx.robot.parse_issues:
-        if issue.kind in _LEGACY_KINDS:
+        if issue.kind == "legacy-xacro":
             message = issue.message.removeprefix(f"{issue.loc}: ")  # the finding says where
             yield Issue(message, issue.loc, issue.subject,
                         hint="use the xacro: prefix (reedtool expand --fix-legacy rewrites it)")
@@ -361,10 +366,9 @@ def sdf_link_default_inertial(ctx: CheckContext) -> Iterator[Issue]:
     Severity (warning: suspicious, but the model loads and flies): the element is valid
     SDF; whether the kilogram is meant cannot be told.
     """
-    for issue in ctx.robot.parse_issues:
-        if issue.kind in _DEFAULT_INERTIAL_KINDS:
-            yield Issue(issue.message, issue.loc, issue.subject,
-                        hint="give the link its <inertial> (mass and inertia), even a small one")
+    yield from _reader_issues(
+        ctx, "sdf-default-inertial",
+        hint="give the link its <inertial> (mass and inertia), even a small one")
 
 
 @rule("S123", "sdf-element-not-in-version", "info",
@@ -380,9 +384,7 @@ def sdf_element_not_in_version(ctx: CheckContext) -> Iterator[Issue]:
 
     Severity (info, explains): libsdformat ignores the element the same way.
     """
-    for issue in ctx.robot.parse_issues:
-        if issue.kind in _UNDEFINED_KINDS:
-            yield Issue(issue.message, issue.loc, issue.subject)
+    yield from _reader_issues(ctx, "sdf-undefined-element")
 
 
 @rule("S124", "xml-declaration-late", "warning",
@@ -401,10 +403,9 @@ def xml_declaration_late(ctx: CheckContext) -> Iterator[Issue]:
     """
     if ctx.simulator == "classic":
         return
-    for issue in ctx.robot.parse_issues:
-        if issue.kind in _LATE_DECLARATION_KINDS:
-            yield Issue(issue.message, issue.loc, issue.subject,
-                        hint="move the comment below the <?xml ...?> line, or drop the line")
+    yield from _reader_issues(
+        ctx, "xml-declaration-late",
+        hint="move the comment below the <?xml ...?> line, or drop the line")
 
 
 @rule("S125", "sdf-pose-short", "warning",
@@ -421,10 +422,7 @@ def sdf_pose_short(ctx: CheckContext) -> Iterator[Issue]:
     """
     if ctx.simulator == "classic":
         return
-    for issue in ctx.robot.parse_issues:
-        if issue.kind in _SHORT_POSE_KINDS:
-            yield Issue(issue.message, issue.loc, issue.subject,
-                        hint="write all six numbers: x y z 0 0 0")
+    yield from _reader_issues(ctx, "sdf-short-pose", hint="write all six numbers: x y z 0 0 0")
 
 
 @rule("S130", "mesh-format-unsupported", "error",
@@ -651,10 +649,9 @@ def xml_tolerated(ctx: CheckContext) -> Iterator[Issue]:
 
     Severity (info, explains): Gazebo reads the file; only strict XML tools do not.
     """
-    for issue in ctx.robot.parse_issues:
-        if issue.kind in _TOLERATED_KINDS:
-            yield Issue(issue.message, issue.loc, issue.subject,
-                        hint="single hyphens in comments; declare xmlns:PREFIX on the root")
+    yield from _reader_issues(
+        ctx, "xml-tolerated",
+        hint="single hyphens in comments; declare xmlns:PREFIX on the root")
 
 
 @rule("S150", "package-name-ambiguous", "warning",
@@ -670,8 +667,7 @@ def package_name_ambiguous(ctx: CheckContext) -> Iterator[Issue]:
     Severity (warning, suspicious): one package is used; edits to the other never reach
     the simulation.
     """
-    for issue in ctx.robot.parse_issues:
-        if issue.kind in _PACKAGE_KINDS:
-            yield Issue(issue.message, issue.loc, issue.subject,
-                        hint="remove or rename the copy, or pass the intended package's "
-                             "parent first with --package-path")
+    yield from _reader_issues(
+        ctx, "package-duplicate",
+        hint="remove or rename the copy, or pass the intended package's parent first with "
+             "--package-path")
