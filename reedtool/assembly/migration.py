@@ -70,25 +70,17 @@ def port_name(robot_name: str, given: str | None) -> str:
     return name if name[0].isalpha() else f"model_{name}"
 
 
-def check_target(target: Path, force: bool) -> None:
-    if target.is_symlink() or (target.exists() and not target.is_dir()):
-        raise ReedtoolError("output exists and is not a directory", file=target,
-                            hint="choose another -o directory or --name")
-    if target.is_dir() and any(target.iterdir()) and not force:
-        raise ReedtoolError("output directory exists and is not empty", file=target,
-                            hint="choose another -o directory or --name, or pass --force to "
-                                 "replace the files migrate writes (other files are left)")
-
-
 def migrate(request: MigrateRequest) -> MigrateResult:
     from reedtool.assembly.assemble import load_robot_for
     from reedtool.io.fileio import atomic_write_many, note_input
+    from reedtool.scaffold.render import check_target
 
     note_input(request.model)
     original, _mappings = load_robot_for(request.model, request.models)
     name = port_name(original.name, request.name)
     target = Path(request.output_dir) / name
-    check_target(target, request.force)
+    check_target(target, request.force,
+                 force_does="replace the files migrate writes (other files are left)")
     source = str(request.model)
 
     port = plan_port(original, name, PortOptions(request.velocity_control, request.autopilot))

@@ -105,15 +105,17 @@ def render_tree(template_dirs: list[str], context: Mapping[str, object],
 
 # ------------------------------------------------------------------ writing
 
-def check_target(target: Path, force: bool) -> None:
-    """Refuse a target we must not touch, before any work is done."""
+def check_target(target: Path, force: bool, *,
+                 force_does: str = "regenerate it; the old tree is kept as NAME.bak") -> None:
+    """Refuse a target directory we must not touch, before any work is done; `force_does`
+    says what --force would do to it."""
     if target.is_symlink() or (target.exists() and not target.is_dir()):
         raise ReedtoolError("target exists and is not a directory", file=target,
                             hint="choose another name or -o directory")
     if target.is_dir() and any(target.iterdir()) and not force:
         raise ReedtoolError("target directory exists and is not empty", file=target,
-                            hint="choose another name or -o directory, or pass --force to "
-                                 "regenerate it; the old tree is kept as NAME.bak")
+                            hint=f"choose another name or -o directory, or pass --force to "
+                                 f"{force_does}")
 
 
 def write_tree(target: Path, files: list[RenderedFile], *, force: bool = False) -> Path | None:
