@@ -80,7 +80,7 @@ def migrate(request: MigrateRequest) -> MigrateResult:
     name = port_name(original.name, request.name)
     target = Path(request.output_dir) / name
     check_target(target, request.force,
-                 force_does="replace the files migrate writes (other files are left)")
+                 force_does="replace the files migrate writes; other files are left")
     source = str(request.model)
 
     port = plan_port(original, name, PortOptions(request.velocity_control, request.autopilot))
