@@ -507,7 +507,6 @@ def _motor(port: GzPort, robot, plugin: Plugin, family: Family, fold, by_name) -
     out = _gz_plugin(MOTOR_SYSTEM)
     carried: dict[str, str] = {}
     dropped: list[str] = []
-    numbered = False
     for child in node.children:
         tag = child.tag
         text = (child.text or "").strip()
@@ -518,7 +517,6 @@ def _motor(port: GzPort, robot, plugin: Plugin, family: Family, fold, by_name) -
         if tag not in GZ_MOTOR_PARAMS:
             dropped.append(tag)
             continue
-        numbered |= tag == "actuator_number"
         out.add(tag, text)
         carried[child.tag if child.tag != tag else tag] = text
     if out.find("motorType") is None:
