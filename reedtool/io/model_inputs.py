@@ -83,7 +83,10 @@ def _root_and_children(path: Path) -> tuple[str | None, list[str]]:
 
 def is_macro_library(path: Path) -> bool:
     """A xacro file that only defines macros, properties and arguments (and includes)."""
-    root, children = _root_and_children(path)
+    return _library_by_text(*_root_and_children(path))
+
+
+def _library_by_text(root: str | None, children: list[str]) -> bool:
     if root is None:
         return False     # unreadable: let the loader report it
     if root not in ("robot", "sdf"):
@@ -91,9 +94,8 @@ def is_macro_library(path: Path) -> bool:
     return bool(children) and all(c in _LIBRARY_CHILDREN for c in children)
 
 
-def _includes_files(path: Path) -> bool:
+def _includes_files(children: list[str]) -> bool:
     """The file includes others (so its expansion may hold links its own text lacks)."""
-    _root, children = _root_and_children(path)
     return any(tag in ("include", "xacro:include") for tag in children)
 
 
@@ -237,7 +239,8 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
     def add_file(path: Path) -> None:
         xacro = path.is_file() and path.suffix.lower() in XACRO_SUFFIXES
         includers = _includers(path, include_tree, include_globs) if xacro else []
-        library = xacro and is_macro_library(path)
+        root, children = _root_and_children(path) if xacro else (None, [])
+        library = xacro and _library_by_text(root, children)
         if library:
             # A library that includes itself breaks every model that includes it: an
             # error with the chain, not a skip.
@@ -251,7 +254,7 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
                                         "includes; a file cannot include itself)"))
                 return
         if library and (has_arguments(path)
-                        or (_includes_files(path) and stands_alone(path))):
+                        or (_includes_files(children) and stands_alone(path))):
             # Only includes by its text, but the user gave it arguments, or the files it
             # includes lay out a robot when it is expanded alone (hector's
             # quadrotor.gazebo.xacro): a model, judged by its expansion.
