@@ -43,8 +43,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
     MODEL is a .urdf, .xacro (.urdf.xacro), .gazebo, .sdf or .world file, or a directory,
     glob or ROS package holding one model; NAME:=VALUE words are its xacro arguments.
     .glb opens in any glTF viewer (Blender, VS Code, browsers); .png is an offline render
-    for CI and READMEs; .html is one page showing the GLB (it loads the model-viewer
-    script from the network). A picture refuses no model for validate's errors: with
+    for CI and READMEs; .html is one self-contained page showing the GLB (the
+    viewer is inside it: it draws offline, from file://). A picture refuses no model for validate's errors: with
     --findings they colour the links they name.
     """
     from reedtool.io.fileio import atomic_write_bytes, check_writable, note_input
