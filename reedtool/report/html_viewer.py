@@ -18,7 +18,10 @@ import html
 from functools import lru_cache
 from importlib import resources
 
-from reedtool.report.scene import SEVERITY_RGBA, SPIN_RGBA, ViewScene, glb_bytes
+import numpy as np
+
+from reedtool.report.scene import FRONT_RGBA, SEVERITY_RGBA, SPIN_RGBA, T_GLTF_ROS, ViewScene, \
+    glb_bytes
 
 MODEL_VIEWER_VERSION = "4.4.0"
 MODEL_VIEWER_FILE = "model-viewer-umd.min.js"
@@ -37,6 +40,9 @@ _PAGE = """<!doctype html>
   .key span {{ display: inline-block; width: 0.9em; height: 0.9em; margin: 0 0.3em 0 1em;
                vertical-align: middle; }}
   .notes {{ color: #7a4a00; font-size: 0.9em; }}
+  .hotspot {{ border: 1px solid #555; border-radius: 1em; background: #fff; padding: 0 0.35em;
+              font: bold 12px sans-serif; pointer-events: none; }}
+  .hotspot.front {{ color: #c81e1e; border-color: #c81e1e; }}
 </style>
 </head>
 <body>
@@ -48,6 +54,7 @@ _PAGE = """<!doctype html>
 </header>
 <model-viewer id="viewer" src="data:model/gltf-binary;base64,{glb}" camera-controls
   camera-orbit="-40deg 65deg auto" shadow-intensity="0.6" alt="{title}">
+{hotspots}
   <div slot="poster">Loading the 3-D view (model-viewer {version}, inside this page). If this
   text stays, this browser has no WebGL; the .glb file (reedtool view MODEL -o MODEL.glb)
   opens in Blender or VS Code.</div>
@@ -77,6 +84,17 @@ def _viewer_script() -> str:
     return text.replace("</script", "<\\/script")
 
 
+def _hotspots(view: ViewScene) -> str:
+    """The labels (FRONT, motor numbers) as model-viewer hotspots, which stay on their point
+    as the model turns. Positions are in the glTF scene's frame: y up, as T_GLTF_ROS turns it."""
+    spots = []
+    for number, label in enumerate(view.labels):
+        x, y, z = (T_GLTF_ROS[:3, :3] @ np.asarray(label.position_m, dtype=float)).tolist()
+        spots.append(f'  <div class="hotspot {label.kind}" slot="hotspot-{number}" '
+                     f'data-position="{x:.6g}m {y:.6g}m {z:.6g}m">{html.escape(label.text)}</div>')
+    return "\n".join(spots)
+
+
 def render_html(view: ViewScene, title: str) -> str:
     key = []
     spins = {int(d.turning_sign > 0) - int(d.turning_sign < 0) for d in view.discs}
@@ -87,10 +105,11 @@ def render_html(view: ViewScene, title: str) -> str:
         if severity in view.link_severity.values():
             key.append(_swatch(SEVERITY_RGBA[severity], f"{severity} finding"))
     key.append(_swatch((0, 0, 0), "COM, scale bar"))
+    key.append(_swatch(FRONT_RGBA, "FRONT arrow (+x)"))
     key.append(_swatch((220, 40, 40), "x (forward)") + _swatch((40, 170, 40), "y (left)")
                + _swatch((40, 80, 220), "z (up)"))
     notes = "".join(f'<div class="notes">{html.escape(n)}</div>' for n in view.notes)
     return _PAGE.format(title=html.escape(title), script=_viewer_script(),
                         version=MODEL_VIEWER_VERSION,
                         caption=html.escape(view.framing.caption()), key="".join(key),
-                        notes=notes, glb=base64.b64encode(glb_bytes(view)).decode("ascii"))
+                        notes=notes, hotspots=_hotspots(view), glb=base64.b64encode(glb_bytes(view)).decode("ascii"))
