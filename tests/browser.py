@@ -33,7 +33,7 @@ _FLAGS = [
     "--disable-background-networking", "--disable-component-update", "--disable-sync",
     "--enable-unsafe-swiftshader", "--use-angle=swiftshader",
     "--proxy-server=127.0.0.1:9", "--host-resolver-rules=MAP * ~NOTFOUND",
-    "--virtual-time-budget=15000",
+    "--virtual-time-budget=15000",       # replaced by settled_dom's budget_ms
 ]
 
 # Put before everything else in the page: every console.error call and every uncaught error
@@ -64,20 +64,23 @@ def require_chromium():
     pytest.skip("needs Debian's chromium (apt-get install chromium)")
 
 
-def _run(page: Path, *args: str, timeout_s: float = 120) -> subprocess.CompletedProcess:
+def _run(page: Path, *args: str, budget_ms: int = 15000,
+         timeout_s: float = 180) -> subprocess.CompletedProcess:
+    flags = [flag if not flag.startswith("--virtual-time-budget") else
+             f"--virtual-time-budget={budget_ms}" for flag in _FLAGS]
     with tempfile.TemporaryDirectory() as profile:
-        return subprocess.run([CHROMIUM, *_FLAGS, f"--user-data-dir={profile}", *args,
+        return subprocess.run([CHROMIUM, *flags, f"--user-data-dir={profile}", *args,
                                page.resolve().as_uri()],
                               capture_output=True, text=True, timeout=timeout_s, check=False)
 
 
-def settled_dom(page: Path) -> tuple[str, list[str]]:
+def settled_dom(page: Path, budget_ms: int = 15000) -> tuple[str, list[str]]:
     """The page's DOM once it settled, and the errors its console reported."""
     probed = page.with_name(f".probe-{page.name}")
     text = page.read_text(encoding="utf-8")
     probed.write_text(text.replace("<head>", "<head>" + _PROBE, 1), encoding="utf-8")
     try:
-        dom = _run(probed, "--dump-dom").stdout
+        dom = _run(probed, "--dump-dom", budget_ms=budget_ms).stdout
     finally:
         probed.unlink()
     found = re.search(r'data-console-errors="([^"]*)"', dom)
