@@ -27,11 +27,18 @@ def _pre_commit() -> str | None:
 
 
 def _index_reachable() -> bool:
-    index = os.environ.get("PIP_INDEX_URL", "https://pypi.org/simple/").rstrip("/")
+    """Whether pip, as pre-commit will run it, can reach its index. PIP_INDEX_URL set but
+    empty (a way to say "no index") is no index, never a crash of the check itself."""
+    index = os.environ.get("PIP_INDEX_URL")
+    if index is None:
+        index = "https://pypi.org/simple/"
+    index = index.strip().rstrip("/")
+    if not index or os.environ.get("PIP_NO_INDEX", "").lower() in ("1", "true", "yes"):
+        return False
     try:
         with urllib.request.urlopen(f"{index}/hatchling/", timeout=5):
             return True
-    except OSError:
+    except (OSError, ValueError):       # unreachable, or not a URL urllib can open
         return False
 
 

@@ -145,3 +145,26 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
         report["batch"]["start_scale"] = scale
         report["_envelope"] = batch.envelope
     return report
+
+
+def replay_page(vehicle: Vehicle, run, config, name: str, verdict: str) -> str:
+    """One flight (a recorded HoverRun) as the page report/replay_page.py draws."""
+    import numpy as np
+
+    from reedtool.report.replay_page import render_replay, replay_document
+
+    com_m = np.asarray(vehicle.props.com_m, dtype=float)
+    by_name = {rotor.name: rotor for rotor in vehicle.rotors}
+    rotors = [by_name[name] for name in run.rotor_names if name in by_name] or vehicle.rotors
+    document = replay_document(
+        run.series,
+        rotor_positions_m=np.array([np.asarray(r.position_m, dtype=float) - com_m
+                                    for r in rotors]),
+        turning_signs=[r.turning_sign for r in rotors],
+        omega_max_rad_s=np.array([r.max_rot_velocity_rad_s for r in rotors], dtype=float),
+        rotor_names=[r.name for r in rotors],
+        setpoint_m=(0.0, 0.0, config.hover_altitude_m),
+        position_tol_m=config.position_tol_m, attitude_tol_deg=config.attitude_tol_deg,
+        settle_time_s=run.settle_time_s, title=f"{name}: hover-test flight",
+        verdict=verdict)
+    return render_replay(document)

@@ -47,7 +47,7 @@ def com_m(robot) -> np.ndarray | None:
     return com if props.mass_kg > 0 and np.all(np.isfinite(com)) else None
 
 
-def view_robot(robot, *, collision: bool = False, findings=None):
+def view_robot(robot, *, collision: bool = False, findings=None, disc_style: str = "filled"):
     """A loaded robot as a ViewScene (report/scene.py)."""
     from reedtool.physics.kinematics import link_poses
     from reedtool.physics.rotors import discover_rotors
@@ -71,12 +71,12 @@ def view_robot(robot, *, collision: bool = False, findings=None):
                             hint="run `reedtool validate` on the model; it names the number "
                                  "and its line")
     return build_scene(robot, T_base_link, discover_rotors(robot), com_m=com_m(robot),
-                       collision=collision,
+                       collision=collision, disc_style=disc_style,
                        link_severity=link_severities(robot, findings) if findings else None)
 
 
 def view_model(model: Path, request: ModelRequest, *, collision: bool = False,
-               with_findings: bool = False):
+               with_findings: bool = False, disc_style: str = "filled"):
     """`model` with its arguments (configuration, --launch, name:=value) -> (ViewScene,
     validate's findings on it, or None without `with_findings`)."""
     from reedtool.assembly.assemble import load_robot_for
@@ -84,4 +84,5 @@ def view_model(model: Path, request: ModelRequest, *, collision: bool = False,
 
     robot, _ = load_robot_for(model, request, require_sound=False)
     findings = validation_findings(model, robot, request) if with_findings else None
-    return view_robot(robot, collision=collision, findings=findings), findings
+    return view_robot(robot, collision=collision, findings=findings,
+                      disc_style=disc_style), findings

@@ -59,6 +59,9 @@ PROGRESS_AFTER_S = 2.0
               help="Initial yaw [rad] (the setpoint heading is 0).")
 @click.option("--plot", "plot_path", type=click.Path(path_type=Path, dir_okay=False),
               help="Write a PNG of position, attitude and rotor speeds.")
+@click.option("--replay", "replay_path", type=click.Path(path_type=Path, dir_okay=False),
+              default=None, help="Write the flight as an HTML page that plays it back "
+              "(offline, any browser): pose, rotor speeds as colour, settle band.")
 @click.option("--csv", "csv_path", type=click.Path(path_type=Path, dir_okay=False),
               help="Write the sampled time series (100 Hz) as CSV ('-': standard output).")
 @click.option("--force", is_flag=True, help="Overwrite existing --plot/--csv files.")
@@ -95,6 +98,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
             model_name: str | None, launch_file: Path | None,
             duration_s: float, rate_hz: float, offset_m: tuple[float, float, float],
             roll_rad: float, pitch_rad: float, yaw_rad: float, plot_path: Path | None,
+            replay_path: Path | None,
             csv_path: Path | None, force: bool, fmt: str, samples: int | None,
             max_memory_mb: int, seed: int,
             mass_spread: float, com_spread_m: float, inertia_spread: float,
@@ -153,6 +157,11 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
     note_model_files(inputs)          # the model is never an output of its own run
     if plot_path is not None:   # fail before flying, not after
         check_writable(plot_path, force)
+    if replay_path is not None:
+        if replay_path.suffix.lower() != ".html":
+            raise ReedtoolError(f"--replay writes an HTML page, not '{replay_path.suffix or replay_path.name}'",
+                                file=replay_path, hint="name the --replay file .html")
+        check_writable(replay_path, force)
     if csv_path is not None:
         check_writable(csv_path, force, stdout_ok=True)
     # What the path is comes first (a FIFO is refused as such), then its format.
@@ -199,7 +208,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
 
     report = hover_test(robot, config, samples=samples, seed=seed,
                         spreads=(mass_spread, com_spread_m, inertia_spread, motor_spread),
-                        record=bool(plot_path or csv_path),
+                        record=bool(plot_path or csv_path or replay_path),
                         progress=TerminalProgress() if fmt == "text" else None,
                         engine=engine, envelope=plot_path is not None,
                         max_memory_bytes=max_memory_mb * 1024 * 1024,
@@ -231,6 +240,15 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
                         settle_time_s=run.settle_time_s, failures=failure_marks(run),
                         envelope=envelope)
         atomic_write_bytes(plot_path, figure, force=force)
+
+    if run is not None and replay_path is not None:
+        from reedtool.assembly.flight import replay_page
+        from reedtool.io.fileio import atomic_write_text
+
+        atomic_write_text(replay_path, replay_page(assembled.vehicle, run, config,
+                                                   robot.name, f"verdict: {report['status']}: "
+                                                   f"{report['message']}"),
+                          force=force)
 
     if fmt == "json":
         from reedtool.report.json_format import envelope

@@ -6,8 +6,10 @@ collision cylinder, else its visual cylinder, else a default that keeps neighbou
 apart) with its motor number as the autopilot counts it (1-based: RotorS
 `motorNumber` + 1, the MAIN output) above the model's own index, an arrow for its spin
 (ccw / cw seen from above), and its arm from the centre of mass labelled with the arm
-length. The body is the base link's footprint (box or cylinder, its own or a fixed
-child's), a front arrow marks the nose, a cross marks the COM.
+length. The body is the base link's outline from above (its own or a fixed child's):
+a visual mesh's silhouette (every triangle projected onto the xy plane, so a CAD body's
+arms and motor mounts show under the rotor discs), else its box or cylinder; a front
+arrow marks the nose, a cross marks the COM.
 
 SVG elements carry ids (`rotor-N`, `spin-N`, `label-N`, `arm-N`, `com`, `front`, and two
 a hairline `anchor` from (x, y) = (0, 0) to (ANCHOR_M, ANCHOR_M) m) so
@@ -105,6 +107,44 @@ def _body_shapes(robot):
             yield shape, T_base[name] @ shape.T_link_geom
 
 
+MAX_SILHOUETTE_FACES = 20_000   # triangles drawn at most (every k-th beyond); rasterised in SVG
+
+
+def _silhouette(robot) -> np.ndarray | None:
+    """(n, 3, 2) top-view triangles of the body's visual meshes in the base frame, or None.
+
+    Filled together they are the mesh's silhouette from above, holes and all: what a CAD
+    user checks the rotors against. A mesh that cannot be read is left to the box or
+    cylinder (validate names the problem)."""
+    from reedtool.errors import ReedtoolError
+    from reedtool.io.meshes import read_mesh
+    from reedtool.model import Mesh
+
+    parts = []
+    for shape, T in _body_shapes(robot):
+        g = shape.geometry
+        if not isinstance(g, Mesh) or g.path is None or shape not in _visuals(robot):
+            continue
+        try:
+            triangles = read_mesh(g.path).triangles_m
+        except ReedtoolError:
+            continue
+        scale = np.ones(3) if g.scale is None else np.broadcast_to(
+            np.asarray(g.scale, dtype=float), (3,))
+        points = triangles.reshape(-1, 3) * scale @ T[:3, :3].T + T[:3, 3]
+        points = points.reshape(-1, 3, 3)[..., :2]
+        parts.append(points[np.all(np.isfinite(points), axis=(1, 2))])
+    if not parts:
+        return None
+    triangles = np.concatenate(parts)
+    stride = max(1, math.ceil(len(triangles) / MAX_SILHOUETTE_FACES))
+    return triangles[::stride] if len(triangles) else None
+
+
+def _visuals(robot) -> list:
+    return [shape for link in robot.links for shape in link.visuals]
+
+
 def _footprint(robot):
     """('box', half_x, half_y, cx, cy) / ('circle', r, cx, cy) of the body, or None."""
     from reedtool.model import Box, Cylinder
@@ -130,6 +170,7 @@ def render_layout(robot, rotors, com_m, fmt: str, title: str = "",
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.collections import PolyCollection
     from matplotlib.patches import Circle, FancyArrow, Polygon, Rectangle
 
     marks = rotor_marks(robot, rotors, marked_names)
@@ -143,8 +184,14 @@ def render_layout(robot, rotors, com_m, fmt: str, title: str = "",
         ax.axis("off")
         reach = max([math.hypot(m.x_m, m.y_m) + m.radius_m for m in marks] + [0.1])
         cx, cy = (float(com_m[0]), float(com_m[1])) if com_m is not None else (0.0, 0.0)
-        foot = _footprint(robot)
-        if foot is not None and foot[0] == "box":
+        silhouette = _silhouette(robot)
+        foot = _footprint(robot) if silhouette is None else None
+        if silhouette is not None:
+            on_page = np.stack([-silhouette[..., 1], silhouette[..., 0]], axis=-1)
+            ax.add_collection(PolyCollection(on_page, facecolors="#cfcfcf",
+                                             edgecolors="#cfcfcf", linewidths=0.2, zorder=1,
+                                             rasterized=fmt == "svg", gid="body"))
+        elif foot is not None and foot[0] == "box":
             _, hx, hy, bx, by = foot
             X, Y = page(bx, by)
             ax.add_patch(Rectangle((X - hy, Y - hx), 2 * hy, 2 * hx, facecolor="#d9d9d9",

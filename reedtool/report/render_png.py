@@ -15,12 +15,18 @@ import math
 
 import numpy as np
 
-from reedtool.report.scene import DECORATION_PREFIXES, SEVERITY_RGBA, SPIN_RGBA, ViewScene, \
-    length_text
+from reedtool.report.scene import DECORATION_PREFIXES, FRONT_RGBA, SEVERITY_RGBA, SPIN_RGBA, \
+    ViewScene, length_text
 
 MAX_ROBOT_FACES = 15_000        # triangles of the robot's own geometry drawn at most
-VIEW_ELEVATION_DEG = 28.0
-VIEW_AZIMUTH_DEG = -130.0       # from front-left, above: x forward points to the lower left
+# (elevation, azimuth) of each named camera, matplotlib's convention (azimuth 0 looks
+# from +x). top: from above with x forward up the page and y left to the left, as
+# `layout` draws it; front: from ahead of the nose; side: from the left (+y); iso: from
+# front-left, above, x forward pointing to the lower left.
+VIEWS_DEG = {"top": (90.0, 180.0), "front": (0.0, 0.0), "side": (0.0, 90.0),
+             "iso": (28.0, -130.0)}
+DEFAULT_SIZE_PX = (576, 504)
+DPI = 90
 
 
 def _triangles(view: ViewScene):
@@ -60,24 +66,18 @@ def _shaded(triangles: np.ndarray, colours: np.ndarray, view_dir: np.ndarray) ->
     return out
 
 
-def render_png(view: ViewScene, title: str) -> bytes:
-    import matplotlib
+def _view_dir(name: str) -> np.ndarray:
+    elevation, azimuth = (math.radians(v) for v in VIEWS_DEG[name])
+    return np.array([math.cos(elevation) * math.cos(azimuth),
+                     math.cos(elevation) * math.sin(azimuth), math.sin(elevation)])
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+
+def _draw(ax, name: str, view: ViewScene, triangles: np.ndarray, colours: np.ndarray) -> None:
+    """One camera's picture on `ax`: orthographic, so lengths read true along the axes."""
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-    parts, stride = decimated(_triangles(view))
-    triangles = np.concatenate([t for t, _, _ in parts]) if parts else np.zeros((0, 3, 3))
-    colours = np.concatenate([c for _, c, _ in parts]) if parts else np.zeros((0, 4))
-    elevation, azimuth = math.radians(VIEW_ELEVATION_DEG), math.radians(VIEW_AZIMUTH_DEG)
-    view_dir = np.array([math.cos(elevation) * math.cos(azimuth),
-                         math.cos(elevation) * math.sin(azimuth), math.sin(elevation)])
-
-    fig = plt.figure(figsize=(6.4, 5.6))
-    ax = fig.add_subplot(projection="3d")
     if len(triangles):
-        shaded = _shaded(triangles, colours, view_dir)
+        shaded = _shaded(triangles, colours, _view_dir(name))
         # edges in the face colour close the anti-aliasing seams between triangles
         ax.add_collection3d(Poly3DCollection(triangles, facecolors=shaded, edgecolors=shaded,
                                              linewidths=0.3, zorder=1))
@@ -90,32 +90,65 @@ def render_png(view: ViewScene, title: str) -> bytes:
     halves = np.maximum((high - low) / 2.0, 0.3 * max(float(np.max(high - low)) / 2.0, 1e-9))
     for setter, c, h in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre, halves):
         setter(c - h, c + h)
+    ax.computed_zorder = False        # the COM and labels are drawn over the meshes
     if view.com_m is not None:
-        # drawn over the meshes: the COM usually sits inside the body
-        ax.computed_zorder = False
         ax.scatter(*view.com_m, marker="x", s=80, linewidths=2.5, color="black", zorder=9,
                    depthshade=False)
+    for label in view.labels:
+        front = label.kind == "front"
+        ax.text(*label.position_m, label.text, fontsize=9 if front else 8, fontweight="bold",
+                color="#c81e1e" if front else "black", ha="center", va="center", zorder=11,
+                bbox=None if front else dict(boxstyle="circle,pad=0.15", facecolor="white",
+                                             edgecolor="#555555", linewidth=0.6))
+    ax.set_proj_type("ortho")
     ax.set_box_aspect(tuple(halves), zoom=1.05)
-    ax.view_init(elev=VIEW_ELEVATION_DEG, azim=VIEW_AZIMUTH_DEG)
+    elevation, azimuth = VIEWS_DEG[name]
+    ax.view_init(elev=elevation, azim=azimuth)
     ax.set_xlabel("x [m]", fontsize=8)
     ax.set_ylabel("y [m]", fontsize=8)
     ax.set_zlabel("z [m]", fontsize=8)
     ax.tick_params(labelsize=7)
+    # an axis that points at the camera has all its ticks on one spot: leave it unlabelled
+    depth = {"top": ax.zaxis, "front": ax.xaxis, "side": ax.yaxis}.get(name)
+    if depth is not None:
+        depth.set_ticks([])
+        depth.set_label_text("")
     framing = view.framing
     bar_at = framing.bounds_m[0] + [framing.scale_bar_m / 2.0,
                                     -0.05 * float(np.max(framing.extent_m)), 0.0]
     ax.text(bar_at[0], bar_at[1], bar_at[2] + 0.03 * float(np.max(framing.extent_m)),
             length_text(framing.scale_bar_m), fontsize=9, fontweight="bold", ha="center",
             va="bottom", zorder=10)
-    ax.set_title(title, fontsize=10)
-    notes = [framing.caption()]
+
+
+def render_png(view: ViewScene, title: str, views: tuple[str, ...] = ("iso",),
+               size_px: tuple[int, int] = DEFAULT_SIZE_PX) -> bytes:
+    """The scene from each camera of `views` (VIEWS_DEG), side by side, `size_px` in all."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    parts, stride = decimated(_triangles(view))
+    triangles = np.concatenate([t for t, _, _ in parts]) if parts else np.zeros((0, 3, 3))
+    colours = np.concatenate([c for _, c, _ in parts]) if parts else np.zeros((0, 4))
+    columns = 2 if len(views) == 4 else len(views)
+    rows = math.ceil(len(views) / columns)
+    fig = plt.figure(figsize=(size_px[0] / DPI, size_px[1] / DPI))
+    for number, name in enumerate(views, start=1):
+        ax = fig.add_subplot(rows, columns, number, projection="3d")
+        _draw(ax, name, view, triangles, colours)
+        if len(views) > 1:
+            ax.set_title(name, fontsize=9)
+    fig.suptitle(title, fontsize=10)
+    notes = [view.framing.caption()]
     if stride > 1:
         notes.append(f"every {stride}th triangle of the meshes drawn")
-    fig.text(0.5, 0.04, "\n".join(notes), ha="center", fontsize=8)
+    fig.text(0.5, 0.01, "\n".join(notes), ha="center", va="bottom", fontsize=8)
     _legend(fig, view)
-    fig.subplots_adjust(left=0.0, right=1.0, bottom=0.08, top=0.93)
+    fig.subplots_adjust(left=0.0, right=1.0, bottom=0.08, top=0.93, wspace=0.0, hspace=0.05)
     buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=90)
+    fig.savefig(buffer, format="png", dpi=DPI)
     plt.close(fig)
     return buffer.getvalue()
 
@@ -133,6 +166,7 @@ def _legend(fig, view: ViewScene) -> None:
             entries.append((SEVERITY_RGBA[severity], f"{severity} finding"))
     if view.com_m is not None:
         entries.append(((0, 0, 0, 255), "COM"))
+    entries.append((FRONT_RGBA, "FRONT (+x)"))
     if entries:
         fig.legend(handles=[Patch(facecolor=np.asarray(rgba) / 255.0, label=label)
                             for rgba, label in entries],

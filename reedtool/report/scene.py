@@ -18,7 +18,12 @@ too big, which is exactly the mistake this picture exists to show.
 
 Around the robot, as children of the base link: a disc at each rotor across its thrust
 axis, coloured by spin direction (the `layout` picture's colours) with an arrow along
-the spin, the thrust axis, the centre of mass, the base frame's axes and a scale bar.
+the spin (or, with `disc_style="outline"`, a ring, so the frame and the motor mounts
+under it show through), the thrust axis, the centre of mass, the base frame's axes, a
+scale bar, and a FRONT arrow along +x as long as an arm, above the body. Labels (FRONT,
+each rotor's motor number as the autopilot counts it) are positions and texts in
+`ViewScene.labels`: glTF has no text, so each format draws them its own way (HTML
+hotspots, PNG text).
 Above the base link a root node turns ROS's z-up into glTF's y-up (glTF 2.0, 3.4), so
 viewers show the robot standing.
 
@@ -50,7 +55,9 @@ DEFAULT_RGBA = (178, 178, 178, 255)
 # What yourdfpy raises on a URDF it cannot read (a bad number, a missing attribute).
 YOURDFPY_ERRORS = (ValueError, TypeError, KeyError, AttributeError, IndexError)
 DECORATION_PREFIXES = ("rotor_disc/", "spin_arrow/", "thrust_axis/", "com", "base_axes/",
-                       "scale_bar")
+                       "scale_bar", "front_arrow")
+DISC_STYLES = ("filled", "outline")
+FRONT_RGBA = (200, 30, 30, 255)
 
 
 @dataclass
@@ -81,6 +88,15 @@ class RotorDisc:
 
 
 @dataclass
+class Label:
+    """A text at a point of the base frame: 'FRONT', or a rotor's motor number."""
+
+    text: str
+    position_m: np.ndarray
+    kind: str                       # "front" or "rotor"
+
+
+@dataclass
 class ViewScene:
     scene: object                   # trimesh.Scene, root ROOT_NODE, then the base link
     base_link: str
@@ -92,6 +108,7 @@ class ViewScene:
     link_severity: dict[str, str] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)   # what could not be drawn, and why
     name: str = ""                  # the robot's
+    labels: list[Label] = field(default_factory=list)
 
 
 def length_text(length_m: float) -> str:
@@ -370,6 +387,24 @@ def _flat_disc(radius_m: float, lift_m: float, sections: int = 48):
                            process=False)
 
 
+def _ring(radius_m: float, lift_m: float, width_fraction: float = 0.08, sections: int = 64):
+    """A flat ring (outer radius `radius_m`) at z = lift_m, both sides faced: a disc's outline."""
+    import trimesh
+
+    theta = np.linspace(0.0, 2.0 * math.pi, sections, endpoint=False)
+    r_in = (1.0 - width_fraction) * radius_m
+    outer = np.column_stack([radius_m * np.cos(theta), radius_m * np.sin(theta),
+                             np.full(sections, lift_m)])
+    inner = np.column_stack([r_in * np.cos(theta), r_in * np.sin(theta),
+                             np.full(sections, lift_m)])
+    i = np.arange(sections)
+    j = np.roll(i, -1)
+    faces = np.vstack([np.column_stack([i, j, sections + i]),
+                       np.column_stack([j, sections + j, sections + i])])
+    return trimesh.Trimesh(vertices=np.vstack([outer, inner]),
+                           faces=np.vstack([faces, faces[:, ::-1]]), process=False)
+
+
 def _spin_arrow(radius_m: float, sign: int, disc_lift_m: float):
     """A flat arc of 240 degrees just above the disc, in the spin's sense, with a head."""
     import trimesh
@@ -421,8 +456,8 @@ def _add(scene, mesh, node: str, parent: str, T: np.ndarray, rgba) -> None:
                        transform=T)
 
 
-def _decorate(view: ViewScene, robot, rotors) -> None:
-    """Rotor discs, spin arrows, thrust axes, COM, base axes and the scale bar."""
+def _decorate(view: ViewScene, robot, rotors, disc_style: str = "filled") -> None:
+    """Rotor discs, spin arrows, thrust axes, COM, base axes, scale bar, FRONT and labels."""
     import trimesh
 
     from reedtool.report.layout_picture import rotor_marks
@@ -433,15 +468,22 @@ def _decorate(view: ViewScene, robot, rotors) -> None:
               if np.all(np.isfinite(r.position_m)) and np.all(np.isfinite(r.axis))
               and np.linalg.norm(r.axis) > 0]
     # the disc radius `layout` draws: the rotor link's cylinder, else from the rotor gaps
-    radii = [mark.radius_m for mark in rotor_marks(robot, rotors)]
-    for rotor, radius in zip(rotors, radii):
+    marks = rotor_marks(robot, rotors)
+    for rotor, mark in zip(rotors, marks):
+        radius = mark.radius_m
         T_base_disc = _frame_along(np.asarray(rotor.position_m, dtype=float),
                                    np.asarray(rotor.axis, dtype=float))
         rgba = SPIN_RGBA[int(np.sign(rotor.turning_sign))]
         # the disc floats just above the rotor's own geometry, which it would hide
         lift_m = _height_above(scene, base, rotor.link, T_base_disc) + 0.004 * size_m
-        disc = _flat_disc(radius, lift_m)
+        disc = _ring(radius, lift_m) if disc_style == "outline" else _flat_disc(radius, lift_m)
         _add(scene, disc, f"rotor_disc/{rotor.name}", base, T_base_disc, rgba)
+        # the motor number just outside the disc's rim, on the side away from the centre
+        outward = np.asarray(rotor.position_m, dtype=float) * [1.0, 1.0, 0.0]
+        outward = outward / np.linalg.norm(outward) if np.linalg.norm(outward) > 1e-9 \
+            else np.array([1.0, 0.0, 0.0])
+        view.labels.append(Label(str(mark.number), T_base_disc[:3, 3] + 1.15 * radius * outward
+                                 + [0.0, 0.0, lift_m], "rotor"))
         if rotor.turning_sign != 0:
             dark = tuple(int(0.6 * c) for c in rgba[:3]) + (255,)
             _add(scene, _spin_arrow(radius, int(np.sign(rotor.turning_sign)), lift_m),
@@ -462,11 +504,28 @@ def _decorate(view: ViewScene, robot, rotors) -> None:
         T[:3, :3] = rotation               # maps +z onto the axis it draws
         _add(scene, _arrow(axis_length, 0.012 * axis_length), f"base_axes/{name}", base, T,
              rgba)
+    _front(view, rotors)
     low = view.framing.bounds_m[0]
     bar = trimesh.creation.box(extents=[view.framing.scale_bar_m, 0.01 * size_m, 0.01 * size_m])
     _add(scene, bar, "scale_bar", base,
          _translation([low[0] + 0.5 * view.framing.scale_bar_m, low[1] - 0.05 * size_m, low[2]]),
          (0, 0, 0, 255))
+
+
+def _front(view: ViewScene, rotors) -> None:
+    """A red arrow along +x, as long as the longest arm (from the base origin), just above
+    the body's top, and a FRONT label at its tip: which way the vehicle faces, at a glance."""
+    reach = [float(np.hypot(*np.asarray(r.position_m, dtype=float)[:2])) for r in rotors]
+    reach = [r for r in reach if math.isfinite(r) and r > 0]
+    size_m = float(np.max(view.framing.extent_m))
+    length_m = max(reach) if reach else 0.5 * size_m
+    top_m = float(view.framing.bounds_m[1][2]) + 0.02 * size_m
+    T = np.eye(4)
+    T[:3, :3] = [[0, 0, 1], [0, 1, 0], [-1, 0, 0]]          # +z onto +x
+    T[:3, 3] = [0.0, 0.0, top_m]
+    _add(view.scene, _arrow(length_m, 0.025 * length_m), "front_arrow", view.base_link, T,
+         FRONT_RGBA)
+    view.labels.append(Label("FRONT", np.array([1.08 * length_m, 0.0, top_m]), "front"))
 
 
 # -------------------------------------------------------------------- findings
@@ -507,7 +566,8 @@ def robot_bounds(scene, exclude=DECORATION_PREFIXES) -> np.ndarray | None:
 
 def build_scene(robot, T_base_link: dict[str, np.ndarray], rotors=(), *,
                 com_m: np.ndarray | None = None, collision: bool = False,
-                link_severity: dict[str, str] | None = None) -> ViewScene:
+                link_severity: dict[str, str] | None = None,
+                disc_style: str = "filled") -> ViewScene:
     """`robot` as a ViewScene: URDF/xacro through yourdfpy, SDF with `T_base_link` (the
     link poses reedtool computes), with a disc for each of `rotors`, the COM `com_m`, and
     the links of `link_severity` coloured by their worst finding."""
@@ -536,7 +596,7 @@ def build_scene(robot, T_base_link: dict[str, np.ndarray], rotors=(), *,
                      link_severity=dict(link_severity or {}), name=robot.name)
     if view.link_severity:
         _colour_findings(view)
-    _decorate(view, robot, rotors)
+    _decorate(view, robot, rotors, disc_style)
     return view
 
 
