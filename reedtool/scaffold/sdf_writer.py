@@ -17,12 +17,10 @@ from pathlib import Path, PurePosixPath
 import numpy as np
 from lxml import etree
 
+from reedtool.io.sdf import sdf_limit_text
 from reedtool.scaffold.gz_port import Element, GzPort, PortRow, _num, _pose_text
 
 SDF_VERSION = "1.9"
-# sdformat's "no limit" for a revolute joint (how sdformat writes a URDF continuous joint,
-# and what PX4's gz models use for rotor joints).
-UNBOUNDED = "1e+16"
 
 
 @dataclass
@@ -113,18 +111,100 @@ def mesh_targets(port: GzPort) -> dict[str, str]:
     return out
 
 
+SCOPE = "::"
+
+
+def scope_of(name: str) -> str:
+    """The nested model a scoped name lives in ("" for the top model): `gps0::link` ->
+    `gps0`. SDF 1.8+ refuses `::` in a name, so the port writes scopes as nested models."""
+    return name.rpartition(SCOPE)[0]
+
+
+def local_name(name: str, scope: str) -> str:
+    """`name` as written inside `scope` (a reference into a nested model keeps its `::`)."""
+    return name[len(scope) + len(SCOPE):] if scope and name.startswith(scope + SCOPE) else name
+
+
+def flat_name(name: str) -> str:
+    """A name without `::` for an element that cannot live in its nested model."""
+    return name.replace(SCOPE, "__")
+
+
+def _within(name: str, scope: str) -> bool:
+    return not scope or name.startswith(scope + SCOPE)
+
+
+def _common_scope(a: str, b: str) -> str:
+    parts = []
+    for x, y in zip(scope_of(a).split(SCOPE), scope_of(b).split(SCOPE)):
+        if x != y or not x:
+            break
+        parts.append(x)
+    return SCOPE.join(parts)
+
+
+class _Scopes:
+    """The top <model> and the nested <model>s the port's scoped names need, each posed
+    in its parent model at the first link written in it."""
+
+    def __init__(self, model, T_model_link: dict[str, np.ndarray]):
+        self.nodes = {"": model}
+        self.T_model_scope = {"": np.eye(4)}
+        self.T_model_link = T_model_link
+
+    def node(self, scope: str, T_model_first: np.ndarray):
+        if scope not in self.nodes:
+            parent = scope_of(scope)
+            parent_node = self.node(parent, T_model_first)
+            node = _sub(parent_node, "model", name=local_name(scope, parent))
+            T_parent_scope = np.linalg.inv(self.T_model_scope[parent]) @ T_model_first
+            if not np.array_equal(T_parent_scope, np.eye(4)):
+                _sub(node, "pose", _pose_text(T_parent_scope))
+            self.nodes[scope] = node
+            self.T_model_scope[scope] = T_model_first
+        return self.nodes[scope]
+
+    def pose_in_scope(self, scope: str, name: str) -> np.ndarray:
+        return np.linalg.inv(self.T_model_scope[scope]) @ self.T_model_link[name]
+
+
+def _link_poses(port: GzPort) -> dict[str, np.ndarray]:
+    """T_model_link of every port link (links are listed parents first)."""
+    out: dict[str, np.ndarray] = {}
+    for link in port.links:
+        out[link.name] = np.eye(4) if link.parent is None else \
+            out[link.parent] @ link.T_parent_link
+    return out
+
+
 def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
               extra_plugins: list[Element] = ()) -> tuple[bytes, dict[int, int]]:
-    """model.sdf, and the line of every Element written (by id) for the report."""
+    """model.sdf, and the line of every Element written (by id) for the report.
+
+    A scoped name (`gps0::link`, from an included or nested model of the source) is
+    written as a nested <model name="gps0"> holding <link name="link">; joints and
+    references outside it name it `gps0::link`, as SDF 1.8+ allows. No name is written
+    with `::` (libsdformat refuses it from SDF 1.8 on)."""
     root = etree.Element("sdf", version=SDF_VERSION)
     root.append(etree.Comment(f" {port.name}: ported from {source} by reedtool migrate. "
                               "Constants as the source wrote them; see the migrate report. "))
     model = _sub(root, "model", name=port.name)
+    T_model_link = _link_poses(port)
+    scopes = _Scopes(model, T_model_link)
     written: list[tuple[Element, object]] = []
+    nodes: dict[tuple[str, str], object] = {}
     for link in port.links:
-        node = _sub(model, "link", name=link.name)
-        if link.parent is not None:
-            _sub(node, "pose", _pose_text(link.T_parent_link), relative_to=link.parent)
+        scope = scope_of(link.name)
+        parent_node = scopes.node(scope, T_model_link[link.name])
+        node = _sub(parent_node, "link", name=local_name(link.name, scope))
+        nodes[("link", link.name)] = node
+        if link.parent is not None and scope_of(link.parent) == scope:
+            _sub(node, "pose", _pose_text(link.T_parent_link),
+                 relative_to=local_name(link.parent, scope))
+        elif link.parent is not None or scope:
+            T = scopes.pose_in_scope(scope, link.name)
+            if not np.array_equal(T, np.eye(4)):
+                _sub(node, "pose", _pose_text(T))
         _inertial(node, link.inertials)
         for kind, shapes in (("collision", link.collisions), ("visual", link.visuals)):
             names: set[str] = set()
@@ -132,6 +212,7 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
                 if shape.geometry is None:
                     continue
                 name = shape.name if shape.name and shape.name not in names else f"{kind}_{index}"
+                name = flat_name(name)
                 names.add(name)
                 element = _sub(node, kind, name=name)
                 if not np.array_equal(T_link_geom, np.eye(4)):
@@ -140,26 +221,39 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
         for sensor in link.sensors:
             written.append((sensor, _to_xml(sensor, node)))
     for frame in port.frames:
-        node = _sub(model, "frame", name=frame.name, attached_to=frame.attached_to)
-        _sub(node, "pose", _pose_text(frame.T_link_frame), relative_to=frame.attached_to)
+        # A frame lives in its own nested model when that model is written and holds the
+        # link it is attached to; else in the link's scope under a flat name.
+        scope = scope_of(frame.name)
+        if scope not in scopes.nodes or not _within(frame.attached_to, scope):
+            scope = scope_of(frame.attached_to)
+            name = flat_name(frame.name)
+        else:
+            name = local_name(frame.name, scope)
+        attached = local_name(frame.attached_to, scope)
+        node = _sub(scopes.nodes[scope], "frame", name=name, attached_to=attached)
+        _sub(node, "pose", _pose_text(frame.T_link_frame), relative_to=attached)
     for joint in port.joints:
+        scope = scope_of(joint.name)
+        if scope in scopes.nodes and _within(joint.parent, scope) and _within(joint.child, scope):
+            name = local_name(joint.name, scope)
+        else:
+            scope = _common_scope(joint.parent, joint.child)
+            name = flat_name(local_name(joint.name, scope))
         sdf_type = {"continuous": "revolute"}.get(joint.type, joint.type)
-        node = _sub(model, "joint", name=joint.name, type=sdf_type)
-        _sub(node, "parent", joint.parent)
-        _sub(node, "child", joint.child)
+        node = _sub(scopes.nodes[scope], "joint", name=name, type=sdf_type)
+        nodes[("joint", joint.name)] = node
+        _sub(node, "parent", local_name(joint.parent, scope))
+        _sub(node, "child", local_name(joint.child, scope))
         if joint.type != "fixed":
             axis = _sub(node, "axis")
             _sub(axis, "xyz", " ".join(_num(v) for v in joint.axis))
             limit = _sub(axis, "limit")
-            if joint.type == "continuous" or joint.limit is None:
-                _sub(limit, "lower", "-" + UNBOUNDED)
-                _sub(limit, "upper", UNBOUNDED)
-            else:
-                lower, upper, effort, velocity = joint.limit
-                for tag, value in (("lower", lower), ("upper", upper), ("effort", effort),
-                                   ("velocity", velocity)):
-                    if value is not None:
-                        _sub(limit, tag, _num(value))
+            values = (None, None, None, None) if joint.type == "continuous" or \
+                joint.limit is None else joint.limit
+            for tag, value in zip(("lower", "upper", "effort", "velocity"), values):
+                text = sdf_limit_text(tag, value)
+                if text is not None:
+                    _sub(limit, tag, text)
     for plugin in [*port.plugins, *extra_plugins]:
         written.append((plugin, _to_xml(plugin, model)))
     etree.indent(root, space="  ")
@@ -168,9 +262,8 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
     tree = root.getroottree()
     lines = {id(element): reread.xpath(tree.getpath(node))[0].sourceline
              for element, node in written}
-    for kind in ("link", "joint"):
-        for node in reread.iterfind(f"./model/{kind}"):
-            lines[(kind, node.get("name"))] = node.sourceline
+    for key, node in nodes.items():
+        lines[key] = reread.xpath(tree.getpath(node))[0].sourceline
     return data, lines
 
 
