@@ -3,9 +3,11 @@
 One call, `migrate(request)`: load the original with its arguments as every command does
 (assembly.assemble.load_robot_for: configuration, --launch, name:=value), plan the port
 (scaffold.gz_port), add what needs the whole vehicle (MulticopterVelocityControl gains,
-the PX4 airframe), write the directory all or nothing through io.fileio
-(scaffold.sdf_writer), read model.sdf back with reedtool's SDF reader and compare it with
-the original, both assembled as hover-test assembles them (assembly.port_proof).
+the PX4 airframe), stage the directory beside the target (scaffold.sdf_writer,
+scaffold.render.staged_tree), read model.sdf back there with reedtool's SDF reader and
+compare it with the original, both assembled as hover-test assembles them
+(assembly.port_proof), and only then rename it into place: a migrate that fails leaves
+nothing on disk.
 """
 
 from __future__ import annotations
@@ -72,15 +74,16 @@ def port_name(robot_name: str, given: str | None) -> str:
 
 def migrate(request: MigrateRequest) -> MigrateResult:
     from reedtool.assembly.assemble import load_robot_for
-    from reedtool.io.fileio import atomic_write_many, note_input
-    from reedtool.scaffold.render import check_target
+    from reedtool.io.fileio import note_input
+    from reedtool.scaffold.render import RenderedFile, check_target, staged_tree
 
     note_input(request.model)
     original, _mappings = load_robot_for(request.model, request.models)
     name = port_name(original.name, request.name)
     target = Path(request.output_dir) / name
     check_target(target, request.force,
-                 force_does="replace the files migrate writes; other files are left")
+                 force_does="replace the files migrate writes (other files are kept; the "
+                            "old directory is kept whole as NAME.bak)")
     source = str(request.model)
 
     port = plan_port(original, name, PortOptions(request.velocity_control, request.autopilot))
@@ -119,9 +122,17 @@ def migrate(request: MigrateRequest) -> MigrateResult:
             written.lines.get(row.target_key) if row.target_key is not None else None
         if line is not None:
             row.output = f"model.sdf:{line} {row.output}"
-    atomic_write_many([(target.joinpath(*f.path.parts), f.data) for f in written.files],
-                      force=request.force)
-    proof = prove(original, target / "model.sdf", port, request)
+    # All or nothing: the port is written into a hidden directory beside the target and
+    # read back there; only a port that could be read back is renamed into place.
+    files = [RenderedFile(f.path, f.data, 0o644) for f in written.files]
+    with staged_tree(target, files, force=request.force) as staged:
+        try:
+            proof = prove(original, staged.path / "model.sdf", port, request)
+        except ReedtoolError as exc:
+            raise ReedtoolError(
+                f"migrate could not read back the port it wrote ({exc.message}); nothing "
+                "was written", file=request.model,
+                hint="this is a reedtool bug: please report it with the model") from exc
     return MigrateResult(target, sorted(f.path for f in written.files), rows, proof, port,
                          source)
 
@@ -137,6 +148,7 @@ def prove(original, model_sdf: Path, port: GzPort, request: MigrateRequest):
     from reedtool.assembly.port_proof import (
         Proof,
         compare_findings,
+        compare_sensors,
         compare_structure,
         compare_vehicle,
     )
@@ -151,6 +163,7 @@ def prove(original, model_sdf: Path, port: GzPort, request: MigrateRequest):
     proof = Proof()
     fold = _fold_map(original, port)
     compare_structure(original, ported, fold, proof)
+    compare_sensors(original, ported, fold, proof, port.added_sensors)
     compare_vehicle(original, ported, proof, request.hover_config or HoverConfig(),
                     fly=request.fly)
     # A macro call writes many elements at one line: the macro line tells them apart.

@@ -230,6 +230,19 @@ class GzPort:
     options: "PortOptions" = None
     # --autopilot ardupilot: the velocity motor plugins ArduPilotPlugin drives, with their rows
     ardupilot_rotors: list[tuple[Plugin, PortRow]] = field(default_factory=list)
+    # Sensors the port adds that the source has not (an autopilot needs them): (link,
+    # sensor name, why). The proof notes them instead of calling them a difference.
+    added_sensors: list[tuple[str, str, str]] = field(default_factory=list)
+
+    def add_sensor(self, link: "PortLink", sensor: Element, why: str) -> None:
+        link.sensors.append(sensor)
+        self.added_sensors.append((link.name, sensor.attrib.get("name", ""), why))
+        system = SENSOR_SYSTEMS.get(sensor.attrib.get("type", ""))
+        if system is not None and system not in self.world_systems:
+            self.world_systems.append(system)
+        self.rows.append(PortRow(link.loc, f"(none: added) sensor {sensor.attrib.get('name')}",
+                                 "mapped", f"link {link.name}: <sensor type=\""
+                                 f"{sensor.attrib.get('type')}\">", why, target=sensor))
 
 
 @dataclass(frozen=True)
