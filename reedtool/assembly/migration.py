@@ -44,6 +44,7 @@ class MigrateRequest:
     urdf: bool = False                      # also the ROS 2 form, urdf/<name>.urdf
     hover_config: object | None = None      # sim.HoverConfig; None: hover-test's defaults
     fly: bool = True
+    copy_outside_files: bool = False        # copy meshes from outside the model's packages
 
 
 @dataclass
@@ -87,6 +88,9 @@ def migrate(request: MigrateRequest) -> MigrateResult:
     source = str(request.model)
 
     port = plan_port(original, name, PortOptions(request.velocity_control, request.autopilot))
+    port.outside_files = outside_files(port, request.model)
+    port.copy_outside_files = request.copy_outside_files
+    port.target_dir = target
     from reedtool.scaffold.sdf_writer import WrittenFile, port_files
 
     extra_plugins, extra_files = [], []
@@ -172,6 +176,22 @@ def prove(original, model_sdf: Path, port: GzPort, request: MigrateRequest):
     compare_findings(run_checks(original, selection), run_checks(ported, selection), proof,
                      dropped)
     return proof
+
+
+def outside_files(port: GzPort, model: Path) -> dict[str, str]:
+    """Mesh URI -> why its file lies outside the model's packages (io.meshes)."""
+    from reedtool.io.meshes import outside_reason
+
+    default_root = Path(model) if Path(model).is_dir() else Path(model).parent
+    out = {}
+    for link in port.links:
+        for _T, shape in [*link.visuals, *link.collisions]:
+            mesh = shape.geometry
+            if getattr(mesh, "uri", None) in port.meshes and mesh.uri not in out:
+                reason = outside_reason(mesh.uri, mesh.path, shape.loc.file, default_root)
+                if reason is not None:
+                    out[mesh.uri] = reason
+    return out
 
 
 def _fold_map(original, port: GzPort) -> dict:

@@ -33,10 +33,14 @@ def output_format(path: Path) -> str:
 @click.option("--findings", "show_findings", is_flag=True,
               help="Colour the links validate's findings name, by severity.")
 @ignore_option
+@click.option("--embed-outside-files", is_flag=True,
+              help="Also draw (so embed in the GLB/HTML) mesh files that lie outside the "
+                   "model's packages (an absolute file:// URI, a path climbing out with ..). "
+                   "Without it they are left out, with a note.")
 @click.option("--force", is_flag=True, help="Overwrite an existing output file.")
 def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name: str | None,
             launch_file: Path | None, output: Path, collision: bool, show_findings: bool,
-            ignore: tuple[str, ...], force: bool) -> int:
+            ignore: tuple[str, ...], embed_outside_files: bool, force: bool) -> int:
     """Show MODEL in 3-D: links where Gazebo puts them, rotor discs coloured by spin
     (blue ccw, orange cw), thrust axes, COM, base axes, a scale bar.
 
@@ -59,7 +63,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
     from reedtool.assembly.view import view_model
 
     view, findings = view_model(model, request, collision=collision,
-                                with_findings=show_findings)
+                                with_findings=show_findings,
+                                embed_outside_files=embed_outside_files)
     title = f"{view.name} ({'collision' if collision else 'visual'} geometry)"
     if fmt == "glb":
         from reedtool.report.scene import glb_bytes

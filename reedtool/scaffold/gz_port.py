@@ -233,6 +233,11 @@ class GzPort:
     # Sensors the port adds that the source has not (an autopilot needs them): (link,
     # sensor name, why). The proof notes them instead of calling them a difference.
     added_sensors: list[tuple[str, str, str]] = field(default_factory=list)
+    # Mesh URIs whose file lies outside the model's packages -> why (io.meshes.outside_reason);
+    # they are referenced where they are, not copied, unless copy_outside_files.
+    outside_files: dict[str, str] = field(default_factory=dict)
+    copy_outside_files: bool = False
+    target_dir: object = None      # the model directory being written (pathlib.Path)
 
     def add_sensor(self, link: "PortLink", sensor: Element, why: str) -> None:
         link.sensors.append(sensor)

@@ -2,7 +2,9 @@
 
     <name>/model.sdf          SDF 1.9: links, joints, folded-link frames, gz systems
     <name>/model.config       name, version, the SDF file
-    <name>/meshes/...         every mesh file the model uses, copied; URIs relative
+    <name>/meshes/...         every mesh file of the model's packages, copied; URIs
+                              relative (a file from outside them is referenced where it
+                              is, unless --copy-outside-files)
     <name>/worlds/<name>.sdf  physics, the world systems the model needs, the model included
 
 Numbers the port computes (poses, folded inertials) are written with the shortest text
@@ -95,11 +97,28 @@ def _geometry(parent, geometry, mesh_uris: dict[str, str]) -> None:
             _sub(mesh, "scale", " ".join(_num(v) for v in geometry.scale))
 
 
+def _reference_in_place(uri: str, path: Path, target_dir) -> str:
+    """A file left where it is, named as the source named it: an absolute reference stays
+    an absolute file:// URI, a relative one the same file relative to the new model
+    directory (so validate sees the same kind of reference on both sides)."""
+    import os
+
+    real = path.resolve()
+    if target_dir is None or uri.strip().startswith(("file://", "/")):
+        return real.as_uri()
+    return PurePosixPath(os.path.relpath(real, Path(target_dir).absolute())).as_posix()
+
+
 def mesh_targets(port: GzPort) -> dict[str, str]:
-    """Source mesh URI -> the relative URI in the port (meshes/<file>, names made unique)."""
+    """Source mesh URI -> the relative URI in the port (meshes/<file>, names made unique);
+    a file from outside the model's packages keeps its place (an absolute file:// URI)
+    unless the user asked to copy it (--copy-outside-files)."""
     out: dict[str, str] = {}
     used: set[str] = set()
     for uri, mesh in port.meshes.items():
+        if uri in port.outside_files and not port.copy_outside_files:
+            out[uri] = _reference_in_place(uri, Path(mesh.path), port.target_dir)
+            continue
         base = PurePosixPath(uri.split("://", 1)[-1]).name or "mesh"
         name, index = base, 1
         while name in used:
@@ -318,11 +337,19 @@ def port_files(port: GzPort, source: str, extra_plugins: list[Element] = (),
     rows: list[PortRow] = []
     files = []
     for uri, mesh in port.meshes.items():
+        outside = port.outside_files.get(uri)
+        if outside is not None and not port.copy_outside_files:
+            rows.append(PortRow(_mesh_loc(port, uri), f"mesh {uri}", "mapped", uris[uri],
+                                f"not copied: {outside}; referenced where it is (this "
+                                "machine only); pass --copy-outside-files to copy it into "
+                                "the port"))
+            continue
         if mesh.path is not None and Path(mesh.path).is_file():
             files.append(WrittenFile(PurePosixPath(uris[uri]),
                                      read_bytes(Path(mesh.path), what="mesh", max_bytes=None)))
             rows.append(PortRow(_mesh_loc(port, uri), f"mesh {uri}", "mapped", uris[uri],
-                                "copied; referenced relative to model.sdf"))
+                                "copied; referenced relative to model.sdf" + (
+                                    f" (--copy-outside-files: {outside})" if outside else "")))
         else:
             rows.append(PortRow(_mesh_loc(port, uri), f"mesh {uri}", "dropped", uris[uri],
                                 f"not found ({mesh.resolve_error or 'no file'}): referenced "
