@@ -177,11 +177,13 @@ def compare_structure(original: Robot, port: Robot, fold: dict, proof: Proof) ->
             check.numbers("joints", joint.name, "limits",
                           [joint.limit.lower or 0, joint.limit.upper or 0],
                           [other.limit.lower or 0, other.limit.upper or 0], 1.0)
+        if joint.type in ("revolute", "prismatic", "continuous"):
             for tag in ("effort", "velocity"):
                 # "No limit" is one notion whatever its spelling (-1 in SDF, DBL_MAX in
                 # URDF, absent): io.sdf.is_no_limit.
-                a, b = (math.inf if is_no_limit(getattr(limit, tag)) or getattr(limit, tag) < 0
-                        else getattr(limit, tag) for limit in (joint.limit, other.limit))
+                a, b = (math.inf if limit is None or is_no_limit(getattr(limit, tag))
+                        or getattr(limit, tag) < 0 else getattr(limit, tag)
+                        for limit in (joint.limit, other.limit))
                 if math.isinf(a) or math.isinf(b):
                     check.same("joints", joint.name, f"{tag} limit", a, b)
                 else:

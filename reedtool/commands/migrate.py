@@ -109,6 +109,11 @@ def render_text(result) -> str:
         lines.append(f"  hover-test: original {a['status']}, port {b['status']}")
     for note in proof.notes:
         lines.append(f"  note: {note}")
+    carried = [f for f in side.get("findings", {}).get("port", []) if " error:" in f]
+    if carried:
+        lines.append("  the port carries the original's errors (Gazebo Sim may refuse it; "
+                     "fix the source and migrate again):")
+        lines += [f"    {finding}" for finding in carried]
     if proof.equal:
         lines.append("EQUAL: the port reads back as the original")
     else:

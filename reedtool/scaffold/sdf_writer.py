@@ -267,8 +267,9 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
             axis = _sub(node, "axis")
             _sub(axis, "xyz", " ".join(_num(v) for v in joint.axis))
             limit = _sub(axis, "limit")
-            values = (None, None, None, None) if joint.type == "continuous" or \
-                joint.limit is None else joint.limit
+            values = (None, None, None, None) if joint.limit is None else joint.limit
+            if joint.type == "continuous":      # no position limit; effort/velocity kept
+                values = (None, None, *values[2:])
             for tag, value in zip(("lower", "upper", "effort", "velocity"), values):
                 text = sdf_limit_text(tag, value)
                 if text is not None:
