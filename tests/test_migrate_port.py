@@ -179,6 +179,35 @@ def test_typhoon_camera_gimbal_sonar_and_gps(tmp_path):
     assert any("sonar" in note for note in document["proof"]["notes"])
 
 
+def test_rotors_sensor_snippets_become_gz_sensors(tmp_path):
+    """RotorS-style <gazebo reference> sensors: depth -> depth_camera, ray -> gpu_lidar
+    with <lidar> (libsdformat checks the element), contact -> contact + its system; the
+    multicamera and the wireless receiver are dropped with reasons, their ROS plugins
+    too. Expected types written by hand from gz-sim's systems and sdformat's sensor.sdf."""
+    import sdformat_oracle
+
+    model = MODELS.parent / "pelican_sensors.xacro"
+    code, document, target = migrate(tmp_path, model)
+    assert code == 0, document["proof"]["differences"]
+    assert sdformat_oracle.libsdformat_error(target / "model.sdf", [target.parent]) is None
+    sdf = etree.parse(str(target / "model.sdf"))
+    written = {s.get("name"): s for s in sdf.iter("sensor")}
+    assert {name: s.get("type") for name, s in written.items()} == {
+        "vi_sensor_depth": "depth_camera", "lidar": "gpu_lidar", "bumper": "contact"}
+    assert written["lidar"].find("ray") is None
+    assert written["lidar"].findtext("lidar/noise/stddev") == "0.01"
+    assert written["lidar"].findtext("lidar/scan/horizontal/samples") == "720"
+    rows = {r["element"].split(" on link")[0]: r for r in document["elements"]}
+    for element in ("sensor vi_sensor_stereo (multicamera)", "sensor radio (wireless_receiver)"):
+        assert rows[element]["action"] == "dropped" and rows[element]["why"]
+    for name in ("stereo_camera_controller", "depth_controller", "laser"):
+        row = next(r for e, r in rows.items() if e.startswith(f"plugin {name} "))
+        assert row["action"] == "dropped" and "ros_gz_bridge" in row["why"]
+    world = etree.parse(str(target / "worlds" / f"{target.name}.sdf"))
+    assert {"gz-sim-sensors-system", "gz-sim-contact-system"} <= \
+        {p.get("filename") for p in world.iter("plugin")}
+
+
 def _prove_edited(tmp_path, model: Path, edit) -> set[tuple[str, str, str]]:
     """Port `model`, apply `edit` to the written model.sdf, and prove it again."""
     from reedtool.assembly.migration import MigrateRequest, prove

@@ -137,6 +137,7 @@ def migrate(request: MigrateRequest) -> MigrateResult:
                 f"migrate could not read back the port it wrote ({exc.message}); nothing "
                 "was written", file=request.model,
                 hint="this is a reedtool bug: please report it with the model") from exc
+        _name_the_target(proof, staged.path, target)
     return MigrateResult(target, sorted(f.path for f in written.files), rows, proof, port,
                          source)
 
@@ -176,6 +177,21 @@ def prove(original, model_sdf: Path, port: GzPort, request: MigrateRequest):
     compare_findings(run_checks(original, selection), run_checks(ported, selection), proof,
                      dropped)
     return proof
+
+
+def _name_the_target(proof, staged: Path, target: Path) -> None:
+    """The proof read the port in its staging directory; its messages name the target."""
+    def rename(value):
+        if isinstance(value, str):
+            return value.replace(str(staged), str(target))
+        if isinstance(value, list):
+            return [rename(v) for v in value]
+        if isinstance(value, dict):
+            return {k: rename(v) for k, v in value.items()}
+        return value
+
+    proof.notes = rename(proof.notes)
+    proof.side_by_side["findings"] = rename(proof.side_by_side.get("findings", {}))
 
 
 def outside_files(port: GzPort, model: Path) -> dict[str, str]:

@@ -509,10 +509,13 @@ def compare_sensors(original: Robot, port: Robot, fold: dict, proof: Proof,
         if sensor.plugin is not None:
             declared, reason = sensor.plugin.noise_not_carried
             got = _classic_imu_terms(match) if sensor.type == "imu" else {}
+            lost = [f"{key} {value:g}" for key, value in sensor.noise.items() if key in declared]
+            if lost:
+                proof.notes.append(f"sensor {subject}: not carried ({reason}): "
+                                   + ", ".join(lost))
             for key, value in sensor.noise.items():
                 if key in declared:
-                    proof.notes.append(f"sensor {subject}: {key} {value:g} not carried "
-                                       f"({reason})")
+                    continue
                 elif key in got:
                     check.numbers("sensors", subject, key, value, got[key], abs(value))
                 else:

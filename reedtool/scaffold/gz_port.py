@@ -77,9 +77,10 @@ PLUGIN_FAMILIES: tuple[Family, ...] = (
            "gz-sim-joint-position-controller-system (position servo)",
            "the same motor model in gz-sim; motorNumber becomes actuator_number, every "
            "constant carried as written"),
-    Family("multirotor-base", ("rotors_gazebo_multirotor_base_plugin",), "joint_states",
+    Family("multirotor-base", ("rotors_gazebo_multirotor_base_plugin",
+                               "gazebo_multirotor_base_plugin"), "joint_states",
            "gz-sim-joint-state-publisher-system",
-           "RotorS' base plugin publishes joint states; gz's JointStatePublisher does"),
+           "RotorS' (and PX4 Classic's) base plugin publishes joint states; gz's JointStatePublisher does"),
     Family("imu", ("rotors_gazebo_imu_plugin", "gazebo_imu_plugin", "gazebo_ros_imu_sensor",
                    "gazebo_ros_imu"), "imu",
            "<sensor type=\"imu\"> on the link + gz-sim-imu-system in the world",
@@ -113,6 +114,10 @@ PLUGIN_FAMILIES: tuple[Family, ...] = (
            "gz-sim-multicopter-control-system with --velocity-control",
            "gz's MulticopterVelocityControl flies the rotors from twist commands; without "
            "--velocity-control speed commands go to the motor models' commandSubTopic"),
+    Family("gimbal-controller", ("gazebo_gimbal_controller_plugin",), "drop", "",
+           "PX4 Classic's gimbal controller (MAVLink gimbal commands to joint PIDs): with "
+           "gz, PX4 drives a gimbal's joints through gz-sim-joint-position-controller-system "
+           "topics (as PX4-gazebo-models' gimbal does); add those by hand"),
     Family("bag", ("rotors_gazebo_bag_plugin",), "drop", "",
            "records ROS 1 bags; with ROS 2 record the ros_gz_bridge topics with ros2 bag"),
     Family("ros-control", ("gazebo_ros_control",), "drop", "",
@@ -470,6 +475,7 @@ def _classic_sensor(port: GzPort, reference: str | None, node: XmlNode, fold, by
             "out of the port; port it by hand if the model needs it"
         port.rows.append(PortRow(node.loc, label, action, "", why,
                                  covers=tuple(n.loc for n in node.iter())))
+        _sensor_plugins(port, node)
         return
     sensor = _copy(node, skip={"plugin"})
     sensor.attrib["type"] = kind.gz
@@ -484,6 +490,11 @@ def _classic_sensor(port: GzPort, reference: str | None, node: XmlNode, fold, by
                              f"link {link}: <sensor type=\"{kind.gz}\"{renamed}>",
                              f"{kind.why}; pose, rate and noise as written",
                              _carried_sensor(node), target=sensor))
+    _sensor_plugins(port, node)
+
+
+def _sensor_plugins(port: GzPort, node: XmlNode) -> None:
+    """One row for each Classic plugin inside a <sensor>: why it is not carried."""
     for inner in node.findall("plugin"):
         library = Plugin(inner.attrib.get("name"), inner.attrib.get("filename"), inner,
                          inner.loc).library
