@@ -360,3 +360,22 @@ def test_view_does_not_embed_outside_files(tmp_path, outside_model):
     triangles = (secret.stat().st_size - 84) // 50
     assert (tmp_path / "b.glb").stat().st_size - (tmp_path / "a.glb").stat().st_size >= \
         36 * triangles
+
+
+def test_the_sensor_table_in_the_docs_is_the_code_s():
+    """docs/migrate.md's sensor table lists every SensorKind: its spellings, its gz type
+    (or "dropped") and its system."""
+    from reedtool.scaffold.gz_sensors import SENSOR_KINDS
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "migrate.md").read_text()
+    table = text[text.index("| Classic / SDF `type=` |"):]
+    rows = [line for line in table.splitlines() if line.startswith("| `")]
+    for kind in SENSOR_KINDS:
+        row = next(r for r in rows if r.startswith("| " + ", ".join(f"`{t}`" for t in kind.types)
+                                                    + " |"))
+        cells = [c.strip() for c in row.split("|")[1:-1]]
+        if kind.gz is None:
+            assert cells[1].startswith("dropped") and not cells[2]
+        else:
+            assert cells[1].startswith(f"`{kind.gz}`") and cells[2] == f"`{kind.system[0]}`"
+    assert len(rows) == len(SENSOR_KINDS)

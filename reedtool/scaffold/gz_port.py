@@ -693,7 +693,10 @@ def _imu(port: GzPort, robot, plugin, family, fold, by_name) -> None:
                              f"link {link}: <sensor type=\"imu\" name=\"{sensor.attrib['name']}\">",
                              family.why + ("; noise stddev = density x sqrt(rate), bias and "
                                            "random walk as gz's bias_stddev and dynamic bias"
-                                           if carried else ""), carried, target=sensor))
+                                           if carried else "; the plugin names no noise: "
+                                           "the Classic plugin's built-in default noise is "
+                                           "not carried, the port's IMU is noiseless"),
+                             carried, target=sensor))
 
 
 def _odometry(port: GzPort, robot, plugin, family, fold, by_name) -> None:
