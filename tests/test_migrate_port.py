@@ -67,6 +67,23 @@ def drake_joints(path: Path, model_dirs) -> dict:
     return out
 
 
+def drake_body_poses(path: Path, model_dirs) -> dict:
+    """(model instance, body) -> its pose in the first body's frame, as Drake places the
+    bodies libsdformat read (every joint at zero)."""
+    import sdformat_oracle
+    from pydrake.multibody.tree import BodyIndex
+
+    error, plant = sdformat_oracle._load(path, model_dirs)
+    assert error is None, error
+    plant.Finalize()
+    context = plant.CreateDefaultContext()
+    bodies = [plant.get_body(BodyIndex(i)) for i in range(1, plant.num_bodies())]
+    X_world_base = plant.EvalBodyPoseInWorld(context, bodies[0])
+    return {(plant.GetModelInstanceName(b.model_instance()), b.name()):
+            (X_world_base.inverse() @ plant.EvalBodyPoseInWorld(context, b)).GetAsMatrix4()
+            for b in bodies}
+
+
 # ------------------------------------------------------------ what gz-sim loads
 
 def test_the_port_loads_in_libsdformat_with_every_body(ported):
@@ -80,6 +97,14 @@ def test_the_port_loads_in_libsdformat_with_every_body(ported):
         assert sdformat_oracle.libsdformat_error(path, [target.parent]) is None
     assert sdformat_oracle.body_count(target / "model.sdf", [target.parent]) == \
         sdformat_oracle.body_count(model, [MODELS])
+    # Every body where libsdformat puts it in the source, nested models included. The
+    # port writes poses composed from the source's (shortest round-trip text), so they
+    # agree to round-off: 1e-12 m and 1e-12 in each rotation entry.
+    source, port = drake_body_poses(model, [MODELS]), drake_body_poses(
+        target / "model.sdf", [target.parent])
+    assert source.keys() == port.keys()
+    for key, X in source.items():
+        np.testing.assert_allclose(port[key], X, rtol=0, atol=1e-12, err_msg=str(key))
 
 
 def test_no_name_holds_a_scope_delimiter(ported):
@@ -379,3 +404,68 @@ def test_the_sensor_table_in_the_docs_is_the_code_s():
         else:
             assert cells[1].startswith(f"`{kind.gz}`") and cells[2] == f"`{kind.system[0]}`"
     assert len(rows) == len(SENSOR_KINDS)
+
+
+NESTED_GIMBAL = """
+    <model name="gimbal">
+      <pose>0.05 0 -0.05 0 0 0</pose>
+      <link name="mount">
+        <inertial><mass>0.05</mass><inertia><ixx>1e-5</ixx><iyy>1e-5</iyy><izz>1e-5</izz>
+        </inertia></inertial>
+      </link>
+      <link name="camera">
+        <pose relative_to="mount">0.02 0 -0.01 0 0.3 0</pose>
+        <inertial><mass>0.03</mass><inertia><ixx>1e-5</ixx><iyy>1e-5</iyy><izz>1e-5</izz>
+        </inertia></inertial>
+        <sensor name="cam" type="camera"><update_rate>15</update_rate>
+          <camera><horizontal_fov>1.2</horizontal_fov><image><width>320</width>
+          <height>240</height></image></camera></sensor>
+      </link>
+      <link name="marker">
+        <inertial><mass>0.001</mass><inertia><ixx>1e-8</ixx><iyy>1e-8</iyy><izz>1e-8</izz>
+        </inertia></inertial>
+      </link>
+      <joint name="tilt" type="revolute">
+        <parent>mount</parent><child>camera</child>
+        <axis><xyz>0 1 0</xyz><limit><lower>-1</lower><upper>1</upper><effort>-1</effort>
+        <velocity>-1</velocity></limit></axis>
+      </joint>
+      <joint name="marker_joint" type="fixed"><parent>camera</parent><child>marker</child></joint>
+    </model>
+    <joint name="gimbal_joint" type="fixed">
+      <parent>base_link</parent><child>gimbal::mount</child>
+    </joint>
+"""
+
+
+def test_a_nested_model_with_its_own_joints(tmp_path):
+    """A nested model with three links and joints between them: written as a nested model
+    whose joints name its own links, posed relative to each other as the source poses
+    them; libsdformat loads it with the source's bodies and the proof is EQUAL (the camera
+    sensor on the nested link included)."""
+    import shutil
+
+    import sdformat_oracle
+
+    models = tmp_path / "models"
+    shutil.copytree(MODELS, models)
+    source = models / "iris_gps" / "model.sdf"
+    source.write_text(source.read_text().replace('    <plugin name="groundtruth_plugin"',
+                                                 NESTED_GIMBAL + '    <plugin name="groundtruth_plugin"', 1))
+    code, document, target = migrate(tmp_path / "out", source)
+    assert code == 0, document["proof"]["differences"]
+    sdf = etree.parse(str(target / "model.sdf"))
+    nested = sdf.find("./model/model[@name='gimbal']")
+    joint = nested.find("joint[@name='tilt']")
+    assert (joint.findtext("parent"), joint.findtext("child")) == ("mount", "camera")
+    assert nested.find("link[@name='camera']/sensor[@name='cam']") is not None
+    names = [el.get("name") for el in sdf.iter() if el.get("name") and el.tag != "plugin"]
+    assert not [n for n in names if "::" in n]
+    assert sdformat_oracle.libsdformat_error(target / "model.sdf", [target.parent]) is None
+    poses = drake_body_poses(source, [models])
+    assert ("iris::gimbal", "camera") in poses
+    ported = drake_body_poses(target / "model.sdf", [target.parent])
+    assert ported.keys() == poses.keys()
+    for key, X in poses.items():     # round-off of composed poses: 1e-12
+        np.testing.assert_allclose(ported[key], X, rtol=0, atol=1e-12, err_msg=str(key))
+    assert document["proof"]["compared"]["sensors"] > 0
