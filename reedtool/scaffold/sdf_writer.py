@@ -276,6 +276,11 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
                     _sub(limit, tag, text)
     for plugin in [*port.plugins, *extra_plugins]:
         written.append((plugin, _to_xml(plugin, model)))
+    scoped = [el.get("name") for el in root.iter() if isinstance(el.tag, str)
+              and el.tag != "plugin" and SCOPE in (el.get("name") or "")]
+    if scoped:
+        # libsdformat refuses these from SDF 1.8 on: never write a port Gazebo will not load.
+        raise RuntimeError(f"the port would name an element {scoped[0]!r}: a reedtool bug")
     etree.indent(root, space="  ")
     data = etree.tostring(root, xml_declaration=True, encoding="utf-8", pretty_print=True)
     reread = etree.fromstring(data)
