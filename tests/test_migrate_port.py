@@ -303,6 +303,51 @@ def test_velocity_minus_one_stays_no_limit(tmp_path):
     assert source["cgo3_camera_joint"][3] == 100.0
 
 
+def drake_joint_frames(path: Path, model_dirs) -> dict:
+    """joint name -> (origin, axis) in the first body's frame, as Drake places the joints
+    libsdformat read: where each axis line passes and which way it points."""
+    import sdformat_oracle
+    from pydrake.multibody.tree import BodyIndex, JointIndex
+
+    error, plant = sdformat_oracle._load(path, model_dirs)
+    assert error is None, error
+    plant.Finalize()
+    context = plant.CreateDefaultContext()
+    X_base_world = plant.EvalBodyPoseInWorld(context, plant.get_body(BodyIndex(1))).inverse()
+    out = {}
+    for i in range(plant.num_joints()):
+        joint = plant.get_joint(JointIndex(i))
+        if joint.type_name() == "revolute":
+            X = X_base_world @ joint.frame_on_child().CalcPoseInWorld(context)
+            out[joint.name()] = (X.translation(), X.rotation().matrix() @ joint.revolute_axis())
+    return out
+
+
+def test_joint_axes_pass_where_the_source_puts_them(tmp_path):
+    """typhoon's gimbal joints are posed away from their child links (PX4's file does
+    so): Drake finds every axis line through the same point and along the same direction
+    in the port as in the source (1e-12: composed poses)."""
+    code, document, target = migrate(tmp_path, TYPHOON)
+    assert code == 0, document["proof"]["differences"]
+    source = drake_joint_frames(TYPHOON, [MODELS])
+    port = drake_joint_frames(target / "model.sdf", [target.parent])
+    assert source.keys() == port.keys()
+    assert np.linalg.norm(source["cgo3_vertical_arm_joint"][0]
+                          - source["cgo3_mount_joint"][0]) > 0.05   # the case is there
+    for name, (origin, axis) in source.items():
+        np.testing.assert_allclose(port[name][0], origin, rtol=0, atol=1e-12, err_msg=name)
+        np.testing.assert_allclose(port[name][1], axis, rtol=0, atol=1e-12, err_msg=name)
+
+
+def test_the_proof_fails_when_a_joint_axis_moves(tmp_path):
+    def move_gimbal_axis(tree):
+        joint = tree.find(".//joint[@name='cgo3_camera_joint']")
+        joint.find("pose").text = "0 0 0 0 0 0"
+
+    assert ("joints", "cgo3_camera_joint", "T_child_jointframe") in \
+        _prove_edited(tmp_path, TYPHOON, move_gimbal_axis)
+
+
 # ------------------------------------------------------------ all or nothing
 
 def test_a_failed_migrate_leaves_nothing(tmp_path, monkeypatch):

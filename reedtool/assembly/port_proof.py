@@ -5,7 +5,8 @@ is compared against the vehicle's scale, not against itself):
 - links: every port link's mass, COM and inertia against the original link plus the
   links folded into it (combined with physics.inertia.combine, the one audited place);
   every link's pose in the base frame;
-- the joint tree: type, parent (after folding), child, axis, limits (position, effort,
+- the joint tree: type, parent (after folding), child, axis, the joint frame in the child
+  link (where the axis line passes), limits (position, effort,
   velocity; "no limit" equal to "no limit" whatever its spelling);
 - the whole robot: Pinocchio's mass, COM and inertia of each model;
 - rotors, matched by joint: position, thrust axis, spin, number, constants, time
@@ -173,6 +174,11 @@ def compare_structure(original: Robot, port: Robot, fold: dict, proof: Proof) ->
         check.same("joints", joint.name, "child", joint.child, other.child)
         if joint.type != "fixed":
             check.numbers("joints", joint.name, "axis", _unit(joint.axis), _unit(other.axis), 1.0)
+            # Where the axis line passes: the joint frame in the child link (SDF joints
+            # posed away from their child's origin).
+            check.numbers("joints", joint.name, "T_child_jointframe",
+                          _or_eye(joint.T_child_jointframe), _or_eye(other.T_child_jointframe),
+                          max(size_m, 1.0))
         if joint.type in ("revolute", "prismatic") and joint.limit and other.limit:
             check.numbers("joints", joint.name, "limits",
                           [joint.limit.lower or 0, joint.limit.upper or 0],
@@ -192,6 +198,10 @@ def compare_structure(original: Robot, port: Robot, fold: dict, proof: Proof) ->
     for joint in port.joints:
         if joint.name not in known:
             check.differ("joints", joint.name, "present", False, True)
+
+
+def _or_eye(T) -> np.ndarray:
+    return np.eye(4) if T is None else np.asarray(T, dtype=float)
 
 
 def _unit(v) -> np.ndarray:

@@ -25,9 +25,10 @@ Supported subset (SDF 1.6 to 1.11, the shape of Gazebo's own multirotor models):
 * URDF has no separate joint frame: the joint frame is the child link frame. So here
   `T_parent_joint` is the child link's pose in the parent link, and the axis is rotated
   from the frame it is expressed in (`expressed_in=`, 1.6's `<use_parent_model_frame>`,
-  default the SDF joint frame) into the child link frame. A joint pose with a translation
-  relative to its child moves the axis line to the child origin; zero-configuration
-  poses, which everything in reedtool uses, are exact.
+  default the SDF joint frame) into the child link frame. A joint posed away from its
+  child's origin keeps that pose as `Joint.T_child_jointframe` (the axis line passes
+  there; `migrate` writes it back); zero-configuration poses, which everything else in
+  reedtool uses, do not depend on it.
 * Joint types: `revolute` with no `<limit>` or with limits at +-1e16 (sdformat's
   "unbounded", which is how sdformat writes a URDF continuous joint) is `continuous`;
   revolute, prismatic, continuous and fixed map one to one; ball, universal, revolute2,
@@ -661,7 +662,12 @@ class _ModelReader:
         # T_parent_joint is written in the child link's <pose> (URDF writes it in <origin>).
         child_entry = self.frames.get(child or "")
         pose_el = child_entry.el.find("pose") if child_entry is not None else None
+        T_child_jointframe = None
+        if child in self.frames and el.find("pose") is not None:
+            T_child_jointframe = np.linalg.inv(self.T_model(child, el, scoped)) \
+                @ self.T_model(scoped, el, scoped)
         return Joint(name=scoped, type=joint_type, parent=parent, child=child,
+                     T_child_jointframe=T_child_jointframe,
                      T_parent_joint=T_parent_child, axis=axis, loc=self.loc(el), limit=limit,
                      axis_loc=self.loc(xyz_el) if xyz_el is not None else None,
                      origin_loc=self.loc(pose_el) if pose_el is not None else None)

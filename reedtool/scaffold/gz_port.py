@@ -212,6 +212,7 @@ class PortJoint:
     axis: np.ndarray
     limit: tuple[float | None, float | None, float | None, float | None] | None
     loc: SourceLoc
+    T_child_jointframe: np.ndarray | None = None   # SDF: the joint frame in the child link
 
 
 @dataclass
@@ -377,7 +378,8 @@ def _structure(robot: Robot):
                     joint.name, joint.type, survivor, child.name,
                     np.asarray(joint.axis, dtype=float),
                     None if limit is None else (limit.lower, limit.upper, limit.effort,
-                                                limit.velocity), joint.loc))
+                                                limit.velocity), joint.loc,
+                    joint.T_child_jointframe))
             queue.append(child.name)
     for link in robot.links:
         if link.name not in fold:

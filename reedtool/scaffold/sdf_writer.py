@@ -263,9 +263,17 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
         nodes[("joint", joint.name)] = node
         _sub(node, "parent", local_name(joint.parent, scope))
         _sub(node, "child", local_name(joint.child, scope))
+        child = local_name(joint.child, scope)
+        moved = joint.T_child_jointframe is not None and \
+            not np.array_equal(joint.T_child_jointframe, np.eye(4))
+        if moved:
+            # The joint frame where the source put it (the axis line passes there); the
+            # axis stays in the child link frame, as the plan holds it.
+            _sub(node, "pose", _pose_text(joint.T_child_jointframe), relative_to=child)
         if joint.type != "fixed":
             axis = _sub(node, "axis")
-            _sub(axis, "xyz", " ".join(_num(v) for v in joint.axis))
+            _sub(axis, "xyz", " ".join(_num(v) for v in joint.axis),
+                 **({"expressed_in": child} if moved else {}))
             limit = _sub(axis, "limit")
             values = (None, None, None, None) if joint.limit is None else joint.limit
             if joint.type == "continuous":      # no position limit; effort/velocity kept
