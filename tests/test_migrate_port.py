@@ -206,9 +206,10 @@ def test_typhoon_camera_gimbal_sonar_and_gps(tmp_path):
 
 def test_rotors_sensor_snippets_become_gz_sensors(tmp_path):
     """RotorS-style <gazebo reference> sensors: depth -> depth_camera, ray -> gpu_lidar
-    with <lidar> (libsdformat checks the element), contact -> contact + its system; the
-    multicamera and the wireless receiver are dropped with reasons, their ROS plugins
-    too. Expected types written by hand from gz-sim's systems and sdformat's sensor.sdf."""
+    with <lidar> (libsdformat checks the element), contact -> contact + its system, the
+    VI sensor's stereo multicamera -> one camera per <camera> at the camera's pose; the
+    wireless receiver is dropped with a reason, the ROS plugins too. Expected types
+    written by hand from gz-sim's systems and sdformat's sensor.sdf."""
     import sdformat_oracle
 
     model = MODELS.parent / "pelican_sensors.xacro"
@@ -218,13 +219,20 @@ def test_rotors_sensor_snippets_become_gz_sensors(tmp_path):
     sdf = etree.parse(str(target / "model.sdf"))
     written = {s.get("name"): s for s in sdf.iter("sensor")}
     assert {name: s.get("type") for name, s in written.items()} == {
+        "vi_sensor_stereo_left": "camera", "vi_sensor_stereo_right": "camera",
         "vi_sensor_depth": "depth_camera", "lidar": "gpu_lidar", "bumper": "contact"}
+    for side, y in (("left", 0.055), ("right", -0.055)):   # the fixture's camera poses
+        camera = written[f"vi_sensor_stereo_{side}"]
+        np.testing.assert_allclose([float(v) for v in camera.findtext("pose").split()],
+                                   [0.015, y, 0.0065, 0, 0, 0], rtol=0, atol=0)
+        assert camera.findtext("update_rate") == "20"
+        assert camera.findtext("camera/image/width") == "752"
     assert written["lidar"].find("ray") is None
     assert written["lidar"].findtext("lidar/noise/stddev") == "0.01"
     assert written["lidar"].findtext("lidar/scan/horizontal/samples") == "720"
     rows = {r["element"].split(" on link")[0]: r for r in document["elements"]}
-    for element in ("sensor vi_sensor_stereo (multicamera)", "sensor radio (wireless_receiver)"):
-        assert rows[element]["action"] == "dropped" and rows[element]["why"]
+    radio = rows["sensor radio (wireless_receiver)"]
+    assert radio["action"] == "dropped" and radio["why"]
     for name in ("stereo_camera_controller", "depth_controller", "laser"):
         row = next(r for e, r in rows.items() if e.startswith(f"plugin {name} "))
         assert row["action"] == "dropped" and "ros_gz_bridge" in row["why"]

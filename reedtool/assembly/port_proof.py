@@ -420,7 +420,7 @@ def sensor_inventory(robot: Robot) -> tuple[list[SensorRecord], list[str]]:
     from reedtool.frames import make_T, rpy_to_matrix
     from reedtool.physics.rotors import resolve_name
     from reedtool.scaffold.gz_port import family_of
-    from reedtool.scaffold.gz_sensors import sensor_kind
+    from reedtool.scaffold.gz_sensors import sensor_kind, split_name
 
     records: list[SensorRecord] = []
     dropped: list[str] = []
@@ -437,9 +437,18 @@ def sensor_inventory(robot: Robot) -> tuple[list[SensorRecord], list[str]]:
             pose = (_floats(node.findtext("pose")) or []) + [0.0] * 6
             rate = _floats(node.findtext("update_rate"))
             link = resolve_name(block.reference, robot.link_map) or block.reference
-            records.append(SensorRecord(name, kind.gz, link,
-                                        make_T(rpy_to_matrix(pose[3:6]), pose[:3]),
-                                        rate[0] if rate else None,
+            T = make_T(rpy_to_matrix(pose[3:6]), pose[:3])
+            if kind.split:
+                # A Classic multicamera is one camera per <camera>, each at its own pose.
+                for index, camera in enumerate(node.findall("camera")):
+                    own = (_floats(camera.findtext("pose")) or []) + [0.0] * 6
+                    wrapper = type(node)("sensor", {}, None, [camera], node.loc)
+                    records.append(SensorRecord(
+                        split_name(name, camera.attrib.get("name"), index), kind.gz, link,
+                        T @ make_T(rpy_to_matrix(own[3:6]), own[:3]),
+                        rate[0] if rate else None, _noise_of(wrapper, {})))
+                continue
+            records.append(SensorRecord(name, kind.gz, link, T, rate[0] if rate else None,
                                         _noise_of(node, kind.renames)))
     for _block, plugin in robot.plugins():
         family = family_of(plugin)

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from reedtool.model import Collision, Inertial, Plugin, Robot, SourceLoc, Visual, XmlNode
-from reedtool.scaffold.gz_sensors import SENSOR_KINDS, sensor_kind, sensor_plugin_why
+from reedtool.scaffold.gz_sensors import SENSOR_KINDS, sensor_kind, sensor_plugin_why, split_name
 
 # ------------------------------------------------------------- mapping table
 
@@ -479,20 +479,54 @@ def _classic_sensor(port: GzPort, reference: str | None, node: XmlNode, fold, by
                                  covers=tuple(n.loc for n in node.iter())))
         _sensor_plugins(port, node)
         return
+    if kind.system not in port.world_systems:
+        port.world_systems.append(kind.system)
+    renamed = "" if sensor_type == kind.gz else f" (Classic '{sensor_type}')"
+    if kind.split:
+        _split_sensor(port, node, kind, link, T, label)
+        _sensor_plugins(port, node)
+        return
     sensor = _copy(node, skip={"plugin"})
     sensor.attrib["type"] = kind.gz
     for child in sensor.children:
         child.tag = kind.renames.get(child.tag, child.tag)
     _place_sensor(sensor, T)
     by_name[link].sensors.append(sensor)
-    if kind.system not in port.world_systems:
-        port.world_systems.append(kind.system)
-    renamed = "" if sensor_type == kind.gz else f" (Classic '{sensor_type}')"
     port.rows.append(PortRow(node.loc, label, "mapped",
                              f"link {link}: <sensor type=\"{kind.gz}\"{renamed}>",
                              f"{kind.why}; pose, rate and noise as written",
                              _carried_sensor(node), target=sensor))
     _sensor_plugins(port, node)
+
+
+def _split_sensor(port: GzPort, node: XmlNode, kind, link: str, T: np.ndarray,
+                  label: str) -> None:
+    """A Classic multicamera: one gz camera sensor per <camera>, each posed at the
+    sensor's pose composed with its camera's <pose>."""
+    from reedtool.frames import make_T, rpy_to_matrix
+
+    def T_of(element) -> np.ndarray:
+        pose = element.find("pose")
+        values = ([float(v) for v in (pose.text or "").split()] if pose is not None else [])
+        values = (values + [0.0] * 6)[:6]
+        return make_T(rpy_to_matrix(values[3:]), values[:3])
+
+    T_link_sensor = T_of(node)
+    port_link = next(candidate for candidate in port.links if candidate.name == link)
+    for index, camera in enumerate(node.findall("camera")):
+        name = split_name(node.attrib.get("name", "camera"), camera.attrib.get("name"), index)
+        sensor = _copy(node, skip={"plugin", "camera", "pose"})
+        sensor.attrib.update({"name": name, "type": kind.gz})
+        own = _copy(camera, skip={"pose"})
+        own.attrib.pop("name", None)
+        sensor.children.append(own)
+        sensor.children.insert(0, Element("pose", {}, _pose_text(T_link_sensor @ T_of(camera))))
+        _place_sensor(sensor, T)
+        port_link.sensors.append(sensor)
+        port.rows.append(PortRow(camera.loc, f"{label} <camera name="
+                                 f"{camera.attrib.get('name', index)!r}>", "mapped",
+                                 f"link {link}: <sensor type=\"{kind.gz}\" name=\"{name}\">",
+                                 kind.why, _carried_sensor(node), target=sensor))
 
 
 def _sensor_plugins(port: GzPort, node: XmlNode) -> None:

@@ -31,6 +31,9 @@ class SensorKind:
     system: tuple[str, str] | None  # (filename, name) of the world system it needs
     why: str                        # for the report
     renames: dict[str, str] = field(default_factory=dict)  # child tag -> gz child tag
+    # Classic's multicamera: one gz sensor per <camera> child, named SENSOR_CAMERA and posed
+    # at the sensor's pose composed with the camera's.
+    split: bool = False
 
 
 SENSOR_KINDS: tuple[SensorKind, ...] = (
@@ -77,9 +80,10 @@ SENSOR_KINDS: tuple[SensorKind, ...] = (
     SensorKind(("logical_camera",), "logical_camera",
                ("gz-sim-logical-camera-system", "gz::sim::systems::LogicalCamera"),
                "gz's logical camera, run by the LogicalCamera system"),
-    SensorKind(("multicamera",), None, None,
-               "gz-sim has no multicamera: write one camera sensor per <camera> (a stereo "
-               "pair is two cameras) by hand"),
+    SensorKind(("multicamera",), "camera", SENSORS_SYSTEM,
+               "gz-sim has no multicamera: each <camera> becomes a camera sensor "
+               "SENSOR_CAMERA, posed at the sensor's pose composed with the camera's",
+               split=True),
     SensorKind(("sonar",), None, None,
                "gz-sim has no sonar sensor: a gpu_lidar with a few narrow rays is its usual "
                "stand-in; add one by hand"),
@@ -128,3 +132,8 @@ SENSOR_PLUGINS: dict[str, str] = {
 
 def sensor_plugin_why(library: str) -> str | None:
     return SENSOR_PLUGINS.get(library)
+
+
+def split_name(sensor_name: str, camera_name: str | None, index: int) -> str:
+    """The gz camera sensor one <camera> of a Classic multicamera becomes."""
+    return f"{sensor_name}_{camera_name or index}"
