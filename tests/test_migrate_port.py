@@ -38,7 +38,7 @@ def migrate(out: Path, model: Path, *options) -> tuple[int, dict, Path]:
     return code, document, Path(document["target"])
 
 
-@pytest.fixture(scope="module", params=["iris_gps", "typhoon_hexa", "x500"])
+@pytest.fixture(scope="module", params=["iris_gps", "iris_nested", "typhoon_hexa", "x500"])
 def ported(request, tmp_path_factory):
     model = MODELS / request.param / "model.sdf"
     code, document, target = migrate(tmp_path_factory.mktemp(request.param), model)
@@ -116,6 +116,23 @@ def test_no_name_holds_a_scope_delimiter(ported):
     assert names and not [n for n in names if "::" in n]
 
 
+def test_a_nested_vehicle_keeps_its_motor_systems_inside_it(tmp_path):
+    """PX4 Classic's iris_* variants include the iris whole: its motor systems go into the
+    nested model, naming its joints as that model sees them (gz-sim's systems look names
+    up in their own model only), and the proof reads the same rotors back."""
+    code, document, target = migrate(tmp_path, MODELS / "iris_nested" / "model.sdf")
+    assert code == 0, document["proof"]["differences"]
+    sdf = etree.parse(str(target / "model.sdf"))
+    iris = sdf.find("./model/model[@name='iris']")
+    motors = iris.findall("plugin[@filename='gz-sim-multicopter-motor-model-system']")
+    assert sorted(m.findtext("jointName") for m in motors) == \
+        [f"rotor_{i}_joint" for i in range(4)]
+    assert all(iris.find(f"joint[@name='{m.findtext('jointName')}']") is not None
+               for m in motors)
+    assert not sdf.findall("./model/plugin[@filename='gz-sim-multicopter-motor-model-system']")
+    assert iris.find("model[@name='gps0']/link/sensor[@type='navsat']") is not None
+
+
 def test_the_included_gps_is_a_nested_model(tmp_path):
     code, _document, target = migrate(tmp_path, IRIS_GPS)
     assert code == 0
@@ -139,10 +156,19 @@ def test_the_included_gps_is_a_nested_model(tmp_path):
 def source_sensors(model: Path) -> list[tuple[str, str]]:
     """(name, type) of every <sensor> in the model file and the model files it includes,
     read with lxml from the files themselves."""
-    out = []
-    for path in (model, *(MODELS / uri.text.split("://", 1)[1] / "model.sdf"
-                          for uri in etree.parse(str(model)).iterfind(".//include/uri"))):
-        out += [(s.get("name"), s.get("type")) for s in etree.parse(str(path)).iter("sensor")]
+    tree = etree.parse(str(model))
+    out = [(s.get("name"), s.get("type")) for s in tree.iter("sensor")]
+    for uri in tree.iterfind(".//include/uri"):
+        out += source_sensors(MODELS / uri.text.split("://", 1)[1] / "model.sdf")
+    return out
+
+
+def source_plugins(model: Path) -> list[str]:
+    """The name of every model-level <plugin> in the model file and those it includes."""
+    tree = etree.parse(str(model))
+    out = [p.get("name") for p in tree.iter("plugin") if p.getparent().tag == "model"]
+    for uri in tree.iterfind(".//include/uri"):
+        out += source_plugins(MODELS / uri.text.split("://", 1)[1] / "model.sdf")
     return out
 
 
@@ -160,9 +186,8 @@ def test_every_sensor_is_mapped_or_dropped_with_a_reason(ported):
             gz_type = {"gps": "navsat", "depth": "depth_camera", "ray": "gpu_lidar"}.get(
                 sensor_type, sensor_type)
             assert (name, gz_type) in written
-    plugins = [p for path in [model] for p in etree.parse(str(path)).iter("plugin")]
-    for plugin in plugins:
-        assert any(f"plugin {plugin.get('name')} " in r["element"] for r in rows)
+    for name in source_plugins(model):
+        assert any(f"plugin {name} " in r["element"] for r in rows), name
 
 
 def test_x500_keeps_its_four_sensors_as_written(tmp_path):

@@ -187,6 +187,40 @@ class _Scopes:
         return np.linalg.inv(self.T_model_scope[scope]) @ self.T_model_link[name]
 
 
+# Plugin parameters that name a joint or link of the plugin's own model (io.sdf reads a
+# nested model's plugin with them scoped).
+_SCOPED_PARAMS = ("jointName", "linkName", "joint_name", "link_name", "bodyName", "body_name")
+
+
+def _named(element: Element):
+    for child in element.children:
+        if child.tag in _SCOPED_PARAMS and child.text and child.text.strip():
+            yield child
+        yield from _named(child)
+
+
+def _plugin_scope(plugin: Element, nested: dict) -> str:
+    """The nested model a plugin belongs in: the deepest one written that holds every
+    joint and link it names (gz-sim's systems look names up in their own model only:
+    PX4 Classic's iris_* variants include the iris, motor plugins and all)."""
+    names = [child.text.strip() for child in _named(plugin)]
+    if not names:
+        return ""
+    scopes = [scope for scope in nested if scope and all(n.startswith(scope + SCOPE)
+                                                         for n in names)]
+    return max(scopes, key=len, default="")
+
+
+def _unscoped(plugin: Element, scope: str) -> Element:
+    """A copy of `plugin` whose joint and link names are written inside `scope`."""
+    import copy
+
+    out = copy.deepcopy(plugin)
+    for child in _named(out):
+        child.text = local_name(child.text.strip(), scope)
+    return out
+
+
 def _link_poses(port: GzPort) -> dict[str, np.ndarray]:
     """T_model_link of every port link (links are listed parents first)."""
     out: dict[str, np.ndarray] = {}
@@ -283,7 +317,9 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
                 if text is not None:
                     _sub(limit, tag, text)
     for plugin in [*port.plugins, *extra_plugins]:
-        written.append((plugin, _to_xml(plugin, model)))
+        scope = _plugin_scope(plugin, scopes.nodes)
+        written.append((plugin, _to_xml(_unscoped(plugin, scope) if scope else plugin,
+                                        scopes.nodes[scope])))
     scoped = [el.get("name") for el in root.iter() if isinstance(el.tag, str)
               and el.tag != "plugin" and SCOPE in (el.get("name") or "")]
     if scoped:
