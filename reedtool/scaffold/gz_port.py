@@ -80,7 +80,8 @@ PLUGIN_FAMILIES: tuple[Family, ...] = (
     Family("multirotor-base", ("rotors_gazebo_multirotor_base_plugin",
                                "gazebo_multirotor_base_plugin"), "joint_states",
            "gz-sim-joint-state-publisher-system",
-           "RotorS' (and PX4 Classic's) base plugin publishes joint states; gz's JointStatePublisher does"),
+           "RotorS' (and PX4 Classic's) base plugin publishes joint states; gz's "
+           "JointStatePublisher does"),
     Family("imu", ("rotors_gazebo_imu_plugin", "gazebo_imu_plugin", "gazebo_ros_imu_sensor",
                    "gazebo_ros_imu"), "imu",
            "<sensor type=\"imu\"> on the link + gz-sim-imu-system in the world",
@@ -105,7 +106,7 @@ PLUGIN_FAMILIES: tuple[Family, ...] = (
     Family("barometer", ("gazebo_barometer_plugin",), "sensor:air_pressure",
            "<sensor type=\"air_pressure\"> + gz-sim-air-pressure-system", "gz's barometer",
            sensor="air_pressure", noise_not_carried=(
-               ("baroDriftPaPerSec", "baroRndSeed"),
+               ("baroDriftPaPerSec",),
                "PX4 Classic's barometer drift has no air_pressure counterpart")),
     Family("mavlink", ("rotors_gazebo_mavlink_interface", "gazebo_mavlink_interface"), "drop",
            "", "PX4's gz bridge (and ArduPilot's plugin) replace the MAVLink interface in "

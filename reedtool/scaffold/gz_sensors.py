@@ -127,6 +127,8 @@ SENSOR_PLUGINS: dict[str, str] = {
     "gazebo_geotagged_images_plugin": "PX4 Classic's geotagging of camera images: no gz-sim "
                                       "counterpart",
     "gazebo_aruco_plugin": "PX4 Classic's ArUco marker detector: no gz-sim counterpart",
+    "RayPlugin": "Gazebo Classic's example ray plugin (it only reads the ranges): the gz "
+                 "lidar publishes them on its topic",
 }
 
 
