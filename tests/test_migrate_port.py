@@ -547,3 +547,28 @@ def test_a_nested_model_with_its_own_joints(tmp_path):
     for key, X in poses.items():     # round-off of composed poses: 1e-12
         np.testing.assert_allclose(ported[key], X, rtol=0, atol=1e-12, err_msg=str(key))
     assert document["proof"]["compared"]["sensors"] > 0
+
+
+def test_a_navsat_world_has_spherical_coordinates(tmp_path):
+    """gz-sim's NavSat system publishes nothing without <spherical_coordinates>: the world
+    of a port with a navsat has them, at the GPS plugin's home when it names one, else at
+    PX4 Classic's default home (common.h: 47.397742 deg, 8.545594 deg, 488 m)."""
+    import shutil
+
+    def where(target):
+        world = etree.parse(str(target / "worlds" / f"{target.name}.sdf"))
+        node = world.find("./world/spherical_coordinates")
+        return tuple(float(node.findtext(tag)) for tag in ("latitude_deg", "longitude_deg",
+                                                           "elevation"))
+
+    _code, _document, target = migrate(tmp_path / "a", IRIS_GPS)
+    assert where(target) == (47.397742, 8.545594, 488.0)
+    models = tmp_path / "models"
+    shutil.copytree(MODELS, models)
+    gps = models / "gps" / "model.sdf"
+    gps.write_text(gps.read_text().replace(
+        "<gpsNoise>true</gpsNoise>",
+        "<gpsNoise>true</gpsNoise><homeLatitude>-35.363261</homeLatitude>"
+        "<homeLongitude>149.16523</homeLongitude>"))
+    _code, _document, target = migrate(tmp_path / "b", models / "iris_gps" / "model.sdf")
+    assert where(target) == (-35.363261, 149.16523, 488.0)

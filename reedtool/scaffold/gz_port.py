@@ -52,6 +52,10 @@ SENSOR_SYSTEMS = {kind.gz: kind.system for kind in SENSOR_KINDS if kind.gz is no
 # Where PX4's gz bridge sends motor speeds, below the model instance's name, as PX4's own
 # gz models subscribe.
 PX4_MOTOR_TOPIC = "command/motor_speed"
+# Where a navsat sensor is on Earth when the source names no home: PX4 Classic's default
+# home (common.h kDefaultHomeLatitude/Longitude/Altitude), where its GPS plugin put it.
+# gz-sim's NavSat system publishes nothing without the world's <spherical_coordinates>.
+DEFAULT_HOME = (47.397742, 8.545594, 488.0)    # latitude deg, longitude deg, elevation m
 # The IMU update rate the port writes: RotorS' noise densities become per-sample
 # standard deviations at this rate (sigma = density * sqrt(rate)).
 IMU_RATE_HZ = 250.0
@@ -245,6 +249,9 @@ class GzPort:
     outside_files: dict[str, str] = field(default_factory=dict)
     copy_outside_files: bool = False
     target_dir: object = None      # the model directory being written (pathlib.Path)
+    # (latitude deg, longitude deg, elevation m) of the world's <spherical_coordinates>,
+    # from the source's GPS plugin (homeLatitude, ...) when it names one
+    home: tuple[float, float, float] | None = None
 
     def add_sensor(self, link: "PortLink", sensor: Element, why: str) -> None:
         link.sensors.append(sensor)
@@ -530,9 +537,20 @@ def _split_sensor(port: GzPort, node: XmlNode, kind, link: str, T: np.ndarray,
                                  kind.why, _carried_sensor(node), target=sensor))
 
 
+def _note_home(port: GzPort, plugin_node: XmlNode) -> None:
+    """A Classic GPS plugin's home (degrees, metres) for the world's spherical coordinates."""
+    values = [plugin_node.findtext(tag) for tag in ("homeLatitude", "homeLongitude",
+                                                     "homeAltitude")]
+    if port.home is None and any(v is not None for v in values) \
+            and all(v is None or _is_number(v) for v in values):
+        port.home = tuple(float(v) if v is not None else default
+                          for v, default in zip(values, DEFAULT_HOME))
+
+
 def _sensor_plugins(port: GzPort, node: XmlNode) -> None:
     """One row for each Classic plugin inside a <sensor>: why it is not carried."""
     for inner in node.findall("plugin"):
+        _note_home(port, inner)
         library = Plugin(inner.attrib.get("name"), inner.attrib.get("filename"), inner,
                          inner.loc).library
         why = sensor_plugin_why(library)
@@ -782,6 +800,7 @@ def _sensor(port: GzPort, robot, plugin, family, fold, by_name) -> None:
                  if plugin.param(tag)), None)
     sensor.add("update_rate", rate or "50")
     by_name[link].sensors.append(sensor)
+    _note_home(port, plugin.node)
     if SENSOR_SYSTEMS[kind] not in port.world_systems:
         port.world_systems.append(SENSOR_SYSTEMS[kind])
     names, reason = family.noise_not_carried

@@ -358,6 +358,19 @@ def world_sdf(port: GzPort) -> bytes:
     _sub(world, "gravity", "0 0 -9.80665")
     for filename, name in port.world_systems:
         _sub(world, "plugin", filename=filename, name=name)
+    if any(sensor.attrib.get("type") == "navsat" for link in port.links
+           for sensor in link.sensors):
+        # gz-sim's NavSat system publishes nothing without it.
+        from reedtool.scaffold.gz_port import DEFAULT_HOME
+
+        latitude, longitude, elevation = port.home or DEFAULT_HOME
+        where = _sub(world, "spherical_coordinates")
+        _sub(where, "surface_model", "EARTH_WGS84")
+        _sub(where, "world_frame_orientation", "ENU")
+        _sub(where, "latitude_deg", _num(latitude))
+        _sub(where, "longitude_deg", _num(longitude))
+        _sub(where, "elevation", _num(elevation))
+        _sub(where, "heading_deg", "0")
     light = _sub(world, "light", type="directional", name="sun")
     _sub(light, "cast_shadows", "true")
     _sub(light, "pose", "0 0 10 0 0 0")
