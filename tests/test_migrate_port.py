@@ -445,6 +445,10 @@ def test_migrate_leaves_outside_files_where_they_are(tmp_path, outside_model):
     assert (target / uris[1]).resolve() == secret.resolve()
     rows = [r for r in document["elements"] if r["element"].startswith("mesh ")]
     assert len(rows) == 2 and all("--copy-outside-files" in r["why"] for r in rows)
+    # The ROS 2 form names the same file (package:// cannot climb out of the package).
+    _code, _document, target = migrate(tmp_path / "ros", model, "--urdf")
+    urdf = etree.parse(str(target / "urdf" / f"{target.name}.urdf"))
+    assert {m.get("filename") for m in urdf.iter("mesh")} == {secret.resolve().as_uri()}
     code, document, target = migrate(tmp_path / "out2", model, "--copy-outside-files")
     assert code == 0
     assert (target / "meshes" / "secret.stl").read_bytes() == secret.read_bytes()
