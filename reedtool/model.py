@@ -164,6 +164,9 @@ class Joint:
     limit: JointLimit | None = None
     axis_loc: SourceLoc | None = None
     origin_loc: SourceLoc | None = None
+    # SDF only: the joint frame in the child link frame, when the file poses the joint
+    # away from the child's origin (the axis line passes there). URDF has no such frame.
+    T_child_jointframe: np.ndarray | None = None
 
     @property
     def moves(self) -> bool:

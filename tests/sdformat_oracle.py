@@ -13,7 +13,8 @@ reedtool writes; `DRAKE_ONLY_REFUSALS` names them, and a caller that meets one m
 both up in its package map, where every model folder is added under its own name. Drake
 resolves an include's URI to a file only, where libsdformat also takes a model folder and
 reads its model.config; an `<include>` of a folder is pointed at the file its model.config
-names before Drake reads it (`_includes_as_files`), the one change made to any file.
+names before Drake reads it (`_includes_as_files`, through nested includes too), the one
+change made to any file.
 
 Importing this module imports Drake (about a second); import it inside the tests that
 use it, not at collection.
@@ -62,8 +63,13 @@ def _model_file(model_dir: Path) -> str | None:
     return (best.text or "").strip() or None
 
 
-def _includes_as_files(path: Path, package_map) -> str:
-    """The file's text with each `<include>` of a model folder pointed at its SDF file."""
+def _includes_as_files(path: Path, package_map, staged: list | None = None) -> str:
+    """The file's text with each `<include>` of a model folder pointed at its SDF file.
+
+    An included file that itself includes model folders (PX4 Classic's iris_* variants
+    include the iris, which includes the GPS) is staged the same way beside itself, as
+    `.drake-NAME`, and named by its absolute file:// URI; `staged` collects those files
+    for the caller to remove."""
     tree = etree.parse(str(path))
     for uri in tree.iter("uri"):
         if uri.getparent() is None or uri.getparent().tag != "include":
@@ -76,17 +82,29 @@ def _includes_as_files(path: Path, package_map) -> str:
         if sub.strip("/") or not package_map.Contains(name):
             continue
         model_file = _model_file(Path(package_map.GetPath(name)))
-        if model_file:
-            uri.text = f"{scheme}://{name}/{model_file}"
+        if not model_file:
+            continue
+        uri.text = f"{scheme}://{name}/{model_file}"
+        included = Path(package_map.GetPath(name)) / model_file
+        if staged is not None and included.is_file():
+            inner = _includes_as_files(included, package_map, staged)
+            if inner != etree.tostring(etree.parse(str(included)), encoding="unicode"):
+                copy = included.with_name(f".drake-{included.name}")
+                copy.write_text(inner)
+                staged.append(copy)
+                uri.text = copy.resolve().as_uri()
     return etree.tostring(tree, encoding="unicode")
 
 
 def _load(path: Path | str, model_dirs) -> tuple[str | None, MultibodyPlant]:
     path = Path(path)
     parser, plant = _parser(model_dirs)
+    inner: list[Path] = []
     try:
-        text = _includes_as_files(path, parser.package_map())
+        text = _includes_as_files(path, parser.package_map(), inner)
     except etree.XMLSyntaxError as exc:
+        for copy in inner:
+            copy.unlink(missing_ok=True)
         return f"{path}: not XML: {exc}", plant
     # Written beside the original, so relative mesh URIs resolve as they would there.
     staged = path.with_name(f".drake-{path.name}")
@@ -94,9 +112,15 @@ def _load(path: Path | str, model_dirs) -> tuple[str | None, MultibodyPlant]:
     try:
         parser.AddModels(str(staged))
     except Exception as exc:  # noqa: BLE001 - pydrake raises RuntimeError for every refusal
-        return str(exc).replace(str(staged), str(path)), plant
+        message = str(exc).replace(str(staged), str(path))
+        for copy in inner:
+            message = message.replace(str(copy.resolve()), str(copy.with_name(
+                copy.name[len(".drake-"):])))
+        return message, plant
     finally:
         staged.unlink()
+        for copy in inner:
+            copy.unlink(missing_ok=True)
     return None, plant
 
 

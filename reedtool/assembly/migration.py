@@ -3,9 +3,11 @@
 One call, `migrate(request)`: load the original with its arguments as every command does
 (assembly.assemble.load_robot_for: configuration, --launch, name:=value), plan the port
 (scaffold.gz_port), add what needs the whole vehicle (MulticopterVelocityControl gains,
-the PX4 airframe), write the directory all or nothing through io.fileio
-(scaffold.sdf_writer), read model.sdf back with reedtool's SDF reader and compare it with
-the original, both assembled as hover-test assembles them (assembly.port_proof).
+the PX4 airframe), stage the directory beside the target (scaffold.sdf_writer,
+scaffold.render.staged_tree), read model.sdf back there with reedtool's SDF reader and
+compare it with the original, both assembled as hover-test assembles them
+(assembly.port_proof), and only then rename it into place: a migrate that fails leaves
+nothing on disk.
 """
 
 from __future__ import annotations
@@ -42,6 +44,7 @@ class MigrateRequest:
     urdf: bool = False                      # also the ROS 2 form, urdf/<name>.urdf
     hover_config: object | None = None      # sim.HoverConfig; None: hover-test's defaults
     fly: bool = True
+    copy_outside_files: bool = False        # copy meshes from outside the model's packages
 
 
 @dataclass
@@ -72,18 +75,22 @@ def port_name(robot_name: str, given: str | None) -> str:
 
 def migrate(request: MigrateRequest) -> MigrateResult:
     from reedtool.assembly.assemble import load_robot_for
-    from reedtool.io.fileio import atomic_write_many, note_input
-    from reedtool.scaffold.render import check_target
+    from reedtool.io.fileio import note_input
+    from reedtool.scaffold.render import RenderedFile, check_target, staged_tree
 
     note_input(request.model)
     original, _mappings = load_robot_for(request.model, request.models)
     name = port_name(original.name, request.name)
     target = Path(request.output_dir) / name
     check_target(target, request.force,
-                 force_does="replace the files migrate writes; other files are left")
+                 force_does="replace the files migrate writes (other files are kept; the "
+                            "old directory is kept whole as NAME.bak)")
     source = str(request.model)
 
     port = plan_port(original, name, PortOptions(request.velocity_control, request.autopilot))
+    port.outside_files = outside_files(port, request.model)
+    port.copy_outside_files = request.copy_outside_files
+    port.target_dir = target
     from reedtool.scaffold.sdf_writer import WrittenFile, port_files
 
     extra_plugins, extra_files = [], []
@@ -119,9 +126,18 @@ def migrate(request: MigrateRequest) -> MigrateResult:
             written.lines.get(row.target_key) if row.target_key is not None else None
         if line is not None:
             row.output = f"model.sdf:{line} {row.output}"
-    atomic_write_many([(target.joinpath(*f.path.parts), f.data) for f in written.files],
-                      force=request.force)
-    proof = prove(original, target / "model.sdf", port, request)
+    # All or nothing: the port is written into a hidden directory beside the target and
+    # read back there; only a port that could be read back is renamed into place.
+    files = [RenderedFile(f.path, f.data, 0o644) for f in written.files]
+    with staged_tree(target, files, force=request.force) as staged:
+        try:
+            proof = prove(original, staged.path / "model.sdf", port, request)
+        except ReedtoolError as exc:
+            raise ReedtoolError(
+                f"migrate could not read back the port it wrote ({exc.message}); nothing "
+                "was written", file=request.model,
+                hint="this is a reedtool bug: please report it with the model") from exc
+        _name_the_target(proof, staged.path, target)
     return MigrateResult(target, sorted(f.path for f in written.files), rows, proof, port,
                          source)
 
@@ -137,6 +153,7 @@ def prove(original, model_sdf: Path, port: GzPort, request: MigrateRequest):
     from reedtool.assembly.port_proof import (
         Proof,
         compare_findings,
+        compare_sensors,
         compare_structure,
         compare_vehicle,
     )
@@ -151,6 +168,7 @@ def prove(original, model_sdf: Path, port: GzPort, request: MigrateRequest):
     proof = Proof()
     fold = _fold_map(original, port)
     compare_structure(original, ported, fold, proof)
+    compare_sensors(original, ported, fold, proof, port.added_sensors)
     compare_vehicle(original, ported, proof, request.hover_config or HoverConfig(),
                     fly=request.fly)
     # A macro call writes many elements at one line: the macro line tells them apart.
@@ -159,6 +177,37 @@ def prove(original, model_sdf: Path, port: GzPort, request: MigrateRequest):
     compare_findings(run_checks(original, selection), run_checks(ported, selection), proof,
                      dropped)
     return proof
+
+
+def _name_the_target(proof, staged: Path, target: Path) -> None:
+    """The proof read the port in its staging directory; its messages name the target."""
+    def rename(value):
+        if isinstance(value, str):
+            return value.replace(str(staged), str(target))
+        if isinstance(value, list):
+            return [rename(v) for v in value]
+        if isinstance(value, dict):
+            return {k: rename(v) for k, v in value.items()}
+        return value
+
+    proof.notes = rename(proof.notes)
+    proof.side_by_side["findings"] = rename(proof.side_by_side.get("findings", {}))
+
+
+def outside_files(port: GzPort, model: Path) -> dict[str, str]:
+    """Mesh URI -> why its file lies outside the model's packages (io.meshes)."""
+    from reedtool.io.meshes import outside_reason
+
+    default_root = Path(model) if Path(model).is_dir() else Path(model).parent
+    out = {}
+    for link in port.links:
+        for _T, shape in [*link.visuals, *link.collisions]:
+            mesh = shape.geometry
+            if getattr(mesh, "uri", None) in port.meshes and mesh.uri not in out:
+                reason = outside_reason(mesh.uri, mesh.path, shape.loc.file, default_root)
+                if reason is not None:
+                    out[mesh.uri] = reason
+    return out
 
 
 def _fold_map(original, port: GzPort) -> dict:

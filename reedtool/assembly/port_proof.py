@@ -5,13 +5,22 @@ is compared against the vehicle's scale, not against itself):
 - links: every port link's mass, COM and inertia against the original link plus the
   links folded into it (combined with physics.inertia.combine, the one audited place);
   every link's pose in the base frame;
-- the joint tree: type, parent (after folding), child, axis, limits;
+- the joint tree: type, parent (after folding), child, axis, the joint frame in the child
+  link (where the axis line passes), limits (position, effort,
+  velocity; "no limit" equal to "no limit" whatever its spelling);
 - the whole robot: Pinocchio's mass, COM and inertia of each model;
 - rotors, matched by joint: position, thrust axis, spin, number, constants, time
   constants, drag coefficients, role;
 - the hover trim (thrusts and speeds) and the hover-test verdict, both flown with the
   same settings;
-- validate's findings: an error or warning code on one side only is a difference.
+- validate's findings: an error or warning code on one side only is a difference;
+- sensors (`compare_sensors`): each sensor of the original (a link's <sensor>, or a
+  Classic plugin simulating one) present in the port with the same type, on the link it
+  was folded into, at the same pose in that link, with the same update rate and noise
+  (a Classic IMU plugin's noise density against the port's stddev / sqrt(rate)). A sensor
+  the port drops with a reason, one it adds with a reason (an autopilot's IMU), and plugin
+  noise the port declares not carried, are notes;
+  a sensor that vanished, moved or changed is a difference.
 """
 
 from __future__ import annotations
@@ -117,6 +126,7 @@ class _Comparer:
 
 def compare_structure(original: Robot, port: Robot, fold: dict, proof: Proof) -> None:
     """Links, poses and joints; `fold` maps every original link to (port link, T)."""
+    from reedtool.io.sdf import is_no_limit
     from reedtool.physics.inertia import combine_inertials
     from reedtool.physics.kinematics import link_poses
 
@@ -164,14 +174,34 @@ def compare_structure(original: Robot, port: Robot, fold: dict, proof: Proof) ->
         check.same("joints", joint.name, "child", joint.child, other.child)
         if joint.type != "fixed":
             check.numbers("joints", joint.name, "axis", _unit(joint.axis), _unit(other.axis), 1.0)
+            # Where the axis line passes: the joint frame in the child link (SDF joints
+            # posed away from their child's origin).
+            check.numbers("joints", joint.name, "T_child_jointframe",
+                          _or_eye(joint.T_child_jointframe), _or_eye(other.T_child_jointframe),
+                          max(size_m, 1.0))
         if joint.type in ("revolute", "prismatic") and joint.limit and other.limit:
             check.numbers("joints", joint.name, "limits",
                           [joint.limit.lower or 0, joint.limit.upper or 0],
                           [other.limit.lower or 0, other.limit.upper or 0], 1.0)
+        if joint.type in ("revolute", "prismatic", "continuous"):
+            for tag in ("effort", "velocity"):
+                # "No limit" is one notion whatever its spelling (-1 in SDF, DBL_MAX in
+                # URDF, absent): io.sdf.is_no_limit.
+                a, b = (math.inf if limit is None or is_no_limit(getattr(limit, tag))
+                        or getattr(limit, tag) < 0 else getattr(limit, tag)
+                        for limit in (joint.limit, other.limit))
+                if math.isinf(a) or math.isinf(b):
+                    check.same("joints", joint.name, f"{tag} limit", a, b)
+                else:
+                    check.numbers("joints", joint.name, f"{tag} limit", a, b, abs(a))
     known = {j.name for j in original.joints}
     for joint in port.joints:
         if joint.name not in known:
             check.differ("joints", joint.name, "present", False, True)
+
+
+def _or_eye(T) -> np.ndarray:
+    return np.eye(4) if T is None else np.asarray(T, dtype=float)
 
 
 def _unit(v) -> np.ndarray:
@@ -341,3 +371,190 @@ def compare_findings(original: list, port: list, proof: Proof, dropped=()) -> No
                      if f.severity in ("error", "warning")],
         "port": [f"{f.code} {f.severity}: {f.message}" for f in port
                  if f.severity in ("error", "warning")]}
+
+
+# ------------------------------------------------------------------ sensors
+
+@dataclass
+class SensorRecord:
+    """One sensor as its model states it: a <sensor> of a link, or a model-level Classic
+    plugin that simulates one (noise then in the plugin's own terms)."""
+
+    name: str
+    type: str                      # gz spelling (scaffold.gz_sensors)
+    link: str
+    T_link_sensor: np.ndarray
+    rate_hz: float | None
+    noise: dict[str, float]
+    plugin: object = None          # the Family of a plugin sensor, else None
+
+
+def _floats(text: str | None) -> list[float] | None:
+    try:
+        return [float(v) for v in (text or "").split()]
+    except ValueError:
+        return None
+
+
+def _noise_of(node, renames: dict[str, str]) -> dict[str, float]:
+    """Every number inside a <noise> of the sensor, keyed by its path with the type
+    container spelled as gz spells it (`gps/...` -> `navsat/...`)."""
+    out: dict[str, float] = {}
+
+    def walk(element, path: tuple[str, ...]) -> None:
+        for child in element.children:
+            tag = renames.get(child.tag, child.tag) if not path else child.tag
+            here = (*path, tag)
+            if child.children:
+                walk(child, here)
+            elif "noise" in here:
+                values = _floats(child.text)
+                if values is not None and len(values) == 1:
+                    out["/".join(here)] = values[0]
+    walk(node, ())
+    return out
+
+
+def sensor_inventory(robot: Robot) -> tuple[list[SensorRecord], list[str]]:
+    """(the sensors the model simulates, those a gz port drops and why)."""
+    from reedtool.frames import make_T, rpy_to_matrix
+    from reedtool.physics.rotors import resolve_name
+    from reedtool.scaffold.gz_port import family_of
+    from reedtool.scaffold.gz_sensors import sensor_kind, split_name
+
+    records: list[SensorRecord] = []
+    dropped: list[str] = []
+    for block in robot.gazebo:
+        for node in block.elements:
+            if node.tag != "sensor" or block.reference is None:
+                continue
+            name, sensor_type = node.attrib.get("name", "?"), node.attrib.get("type", "")
+            kind = sensor_kind(sensor_type)
+            if kind is None or kind.gz is None:
+                dropped.append(f"{name} ({sensor_type}) on {block.reference}: "
+                               f"{kind.why if kind else 'no gz-sim counterpart known'}")
+                continue
+            pose = (_floats(node.findtext("pose")) or []) + [0.0] * 6
+            rate = _floats(node.findtext("update_rate"))
+            link = resolve_name(block.reference, robot.link_map) or block.reference
+            T = make_T(rpy_to_matrix(pose[3:6]), pose[:3])
+            if kind.split:
+                # A Classic multicamera is one camera per <camera>, each at its own pose.
+                for index, camera in enumerate(node.findall("camera")):
+                    own = (_floats(camera.findtext("pose")) or []) + [0.0] * 6
+                    wrapper = type(node)("sensor", {}, None, [camera], node.loc)
+                    records.append(SensorRecord(
+                        split_name(name, camera.attrib.get("name"), index), kind.gz, link,
+                        T @ make_T(rpy_to_matrix(own[3:6]), own[:3]),
+                        rate[0] if rate else None, _noise_of(wrapper, {})))
+                continue
+            records.append(SensorRecord(name, kind.gz, link, T, rate[0] if rate else None,
+                                        _noise_of(node, kind.renames)))
+    for _block, plugin in robot.plugins():
+        family = family_of(plugin)
+        if family is None or family.sensor is None:
+            continue
+        link_name = plugin.param("linkName") or plugin.param("bodyName")
+        link = resolve_name(link_name, robot.link_map) if link_name else None
+        rate = next((_floats(plugin.param(tag)) for tag in ("pubRate", "updateRate",
+                                                            "update_rate")
+                     if plugin.param(tag)), None)
+        noise = {child.tag: _floats(child.text)[0] for child in plugin.node.children
+                 if any(key in child.tag for key in ("Noise", "noise", "RandomWalk",
+                                                     "randomWalk", "BiasCorrelationTime",
+                                                     "biasCorrelationTime", "TurnOnBiasSigma",
+                                                     "Drift"))
+                 and _floats(child.text) and len(_floats(child.text)) == 1}
+        records.append(SensorRecord(plugin.name or family.key, family.sensor,
+                                    link or robot.base_link, np.eye(4),
+                                    rate[0] if rate else None, noise, family))
+    return records, dropped
+
+
+# A Classic IMU plugin's terms from a gz IMU sensor: RotorS' and PX4's discrete noise is
+# sigma = density * sqrt(rate); the bias terms are gz's bias and dynamic bias.
+_IMU_TERMS = (("gyroscope", "angular_velocity"), ("accelerometer", "linear_acceleration"))
+
+
+def _classic_imu_terms(sensor: SensorRecord) -> dict[str, float]:
+    out: dict[str, float] = {}
+    for prefix, group in _IMU_TERMS:
+        for suffix, key in (("NoiseDensity", "stddev"), ("TurnOnBiasSigma", "bias_stddev"),
+                            ("RandomWalk", "dynamic_bias_stddev"),
+                            ("BiasCorrelationTime", "dynamic_bias_correlation_time")):
+            values = {sensor.noise.get(f"imu/{group}/{axis}/noise/{key}") for axis in "xyz"}
+            if None in values or len(values) != 1:
+                continue     # absent, or the axes differ: no single Classic number
+            value = values.pop()
+            if suffix == "NoiseDensity":
+                if not sensor.rate_hz:
+                    continue
+                value = value / math.sqrt(sensor.rate_hz)
+            out[prefix + suffix] = value
+    return out
+
+
+def compare_sensors(original: Robot, port: Robot, fold: dict, proof: Proof,
+                    added=()) -> None:
+    """Every sensor of the original against the port's: present, type, link (after
+    folding), pose in that link, update rate, noise. A sensor the port drops by the table
+    (scaffold.gz_sensors) is a note, as the report lists it; one that vanishes or moves is
+    a difference."""
+    check = _Comparer(proof)
+    size_m = max(_size_m(original), 1.0)
+    mine, dropped = sensor_inventory(original)
+    theirs, _ = sensor_inventory(port)
+    proof.notes += [f"sensor {text}: dropped by the port (see the report)" for text in dropped]
+    unmatched = list(theirs)
+    rows = []
+    for sensor in mine:
+        survivor, T_fold = fold.get(sensor.link, (sensor.link, np.eye(4)))
+        subject = f"{sensor.name} ({sensor.type})"
+        candidates = [s for s in unmatched if s.type == sensor.type]
+        match = next((s for s in candidates if s.name == sensor.name), None) or \
+            next((s for s in candidates if s.link == survivor), None)
+        proof.compared["sensors"] = proof.compared.get("sensors", 0) + 1
+        if match is None:
+            check.differ("sensors", subject, "present", True, False)
+            continue
+        unmatched.remove(match)
+        check.same("sensors", subject, "link", survivor, match.link)
+        check.numbers("sensors", subject, "T_link_sensor", T_fold @ sensor.T_link_sensor,
+                      match.T_link_sensor, size_m)
+        if sensor.rate_hz is not None:
+            check.numbers("sensors", subject, "update_rate_hz", sensor.rate_hz,
+                          match.rate_hz if match.rate_hz is not None else math.nan,
+                          sensor.rate_hz)
+        if sensor.plugin is not None:
+            declared, reason = sensor.plugin.noise_not_carried
+            got = _classic_imu_terms(match) if sensor.type == "imu" else {}
+            lost = [f"{key} {value:g}" for key, value in sensor.noise.items() if key in declared]
+            if lost:
+                proof.notes.append(f"sensor {subject}: not carried ({reason}): "
+                                   + ", ".join(lost))
+            for key, value in sensor.noise.items():
+                if key in declared:
+                    continue
+                elif key in got:
+                    check.numbers("sensors", subject, key, value, got[key], abs(value))
+                else:
+                    check.differ("sensors", subject, key, value, None)
+        else:
+            for key in sorted(set(sensor.noise) | set(match.noise)):
+                a, b = sensor.noise.get(key), match.noise.get(key)
+                if a is None or b is None:
+                    check.differ("sensors", subject, key, a, b)
+                else:
+                    check.numbers("sensors", subject, key, a, b, abs(a))
+        rows.append({"sensor": sensor.name, "type": sensor.type,
+                     "link": [sensor.link, match.link], "port_name": match.name,
+                     "rate_hz": [sensor.rate_hz, match.rate_hz]})
+    added = {(link, name): why for link, name, why in added}
+    for sensor in unmatched:
+        why = added.get((sensor.link, sensor.name))
+        if why is not None:
+            proof.notes.append(f"sensor {sensor.name} ({sensor.type}) on {sensor.link}: added "
+                               f"by the port: {why}")
+        else:
+            check.differ("sensors", f"{sensor.name} ({sensor.type})", "present", False, True)
+    proof.side_by_side["sensors"] = rows

@@ -75,14 +75,40 @@ def view_robot(robot, *, collision: bool = False, findings=None, disc_style: str
                        link_severity=link_severities(robot, findings) if findings else None)
 
 
+def withhold_outside_meshes(robot, model: Path) -> list[str]:
+    """Leave out of the picture every mesh file outside the model's packages (an absolute
+    file:// URI, a path climbing out with ..): the page or GLB would carry a copy of it.
+    Returns the URIs withheld; each is drawn as not shown, with the reason in the notes."""
+    from reedtool.io.meshes import outside_reason
+    from reedtool.model import Mesh
+
+    default_root = Path(model) if Path(model).is_dir() else Path(model).parent
+    withheld = []
+    for link in robot.links:
+        for shape in [*link.visuals, *link.collisions]:
+            mesh = shape.geometry
+            if not isinstance(mesh, Mesh):
+                continue
+            reason = outside_reason(mesh.uri, mesh.path, shape.loc.file, default_root)
+            if reason is not None:
+                mesh.path = None
+                mesh.resolve_error = f"{reason}: not embedded; pass --embed-outside-files"
+                withheld.append(mesh.uri)
+    return withheld
+
+
 def view_model(model: Path, request: ModelRequest, *, collision: bool = False,
-               with_findings: bool = False, disc_style: str = "filled"):
+               with_findings: bool = False, disc_style: str = "filled",
+               embed_outside_files: bool = False):
     """`model` with its arguments (configuration, --launch, name:=value) -> (ViewScene,
-    validate's findings on it, or None without `with_findings`)."""
+    validate's findings on it, or None without `with_findings`). A mesh file from outside
+    the model's packages is not drawn (so not embedded) unless `embed_outside_files`."""
     from reedtool.assembly.assemble import load_robot_for
     from reedtool.assembly.validation import validation_findings
 
     robot, _ = load_robot_for(model, request, require_sound=False)
     findings = validation_findings(model, robot, request) if with_findings else None
+    if not embed_outside_files:
+        withhold_outside_meshes(robot, model)
     return view_robot(robot, collision=collision, findings=findings,
                       disc_style=disc_style), findings

@@ -36,14 +36,19 @@ SCHEMA = "reedtool.migrate/1"
               help="Also write the autopilot's files: a PX4 gz airframe (px4/), or an "
                    "ArduPilot .parm (ardupilot/) with the ArduPilotPlugin and LiftDrag blades "
                    "driving the rotors in place of the motor models.")
+@click.option("--copy-outside-files", is_flag=True,
+              help="Also copy mesh files that lie outside the model's packages (an absolute "
+                   "file:// URI, a path climbing out with ..) into the port. Without it they "
+                   "are referenced where they are and listed in the report.")
 @click.option("--force", is_flag=True,
-              help="Write into an existing output directory, replacing the files migrate writes.")
+              help="Write into an existing output directory, replacing the files migrate "
+                   "writes (the old directory is kept as NAME.bak).")
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
               show_default=True, help="Output format.")
 def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
             model_name: str | None, launch_file: Path | None, to: str, output_dir: Path,
             name: str | None, urdf: bool, velocity_control: bool, autopilot: str | None,
-            force: bool, fmt: str) -> int:
+            copy_outside_files: bool, force: bool, fmt: str) -> int:
     """Port MODEL to a Gazebo Sim model directory OUTPUT_DIR/NAME, then read it back and
     compare it with the original: links, joints, masses, inertias, poses, rotors, hover
     trim, hover-test verdict and validate's findings.
@@ -57,7 +62,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
     model, request = one_model_request("migrate", inputs, package_paths, model_name,
                                        launch_file)
     result = migrate(MigrateRequest(model, output_dir, request, name, velocity_control,
-                                    autopilot, force, urdf))
+                                    autopilot, force, urdf,
+                                    copy_outside_files=copy_outside_files))
     if fmt == "json":
         from reedtool.report.json_format import envelope
 
@@ -103,6 +109,11 @@ def render_text(result) -> str:
         lines.append(f"  hover-test: original {a['status']}, port {b['status']}")
     for note in proof.notes:
         lines.append(f"  note: {note}")
+    carried = [f for f in side.get("findings", {}).get("port", []) if " error:" in f]
+    if carried:
+        lines.append("  the port carries the original's errors (Gazebo Sim may refuse it; "
+                     "fix the source and migrate again):")
+        lines += [f"    {finding}" for finding in carried]
     if proof.equal:
         lines.append("EQUAL: the port reads back as the original")
     else:

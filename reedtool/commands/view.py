@@ -68,11 +68,15 @@ def output_format(path: Path) -> str:
               default="filled", show_default=True,
               help="Rotor discs filled, or as outlines so the frame and motor mounts show.")
 @ignore_option
+@click.option("--embed-outside-files", is_flag=True,
+              help="Also draw (so embed in the GLB/HTML) mesh files that lie outside the "
+                   "model's packages (an absolute file:// URI, a path climbing out with ..). "
+                   "Without it they are left out, with a note.")
 @click.option("--force", is_flag=True, help="Overwrite an existing output file.")
 def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name: str | None,
             launch_file: Path | None, output: Path, collision: bool, show_findings: bool,
             views_text: str | None, size_text: str | None, disc_style: str,
-            ignore: tuple[str, ...], force: bool) -> int:
+            ignore: tuple[str, ...], embed_outside_files: bool, force: bool) -> int:
     """Show MODEL in 3-D: links where Gazebo puts them, rotor discs coloured by spin
     (blue ccw, orange cw), thrust axes, COM, base axes, a scale bar.
 
@@ -100,7 +104,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
     from reedtool.assembly.view import view_model
 
     view, findings = view_model(model, request, collision=collision,
-                                with_findings=show_findings, disc_style=disc_style)
+                                with_findings=show_findings, disc_style=disc_style,
+                                embed_outside_files=embed_outside_files)
     title = f"{view.name} ({'collision' if collision else 'visual'} geometry)"
     if fmt == "glb":
         from reedtool.report.scene import glb_bytes

@@ -177,3 +177,49 @@ def format_problem(uri: str, simulator: str) -> str | None:
         return f"{which} does not load {suffix} meshes (gz-sim does)"
     return (f"{which} does not load {suffix} files (it loads "
             f"{', '.join(s.lstrip('.').upper() for s in allowed)})")
+
+
+# ------------------------------------------------------------ files from outside
+
+# What marks the root of a model's own files: a ROS package or a Gazebo model directory.
+PACKAGE_MARKERS = ("package.xml", "model.config")
+
+
+def package_root(file: str | Path) -> Path | None:
+    """The ROS package or Gazebo model directory holding `file` (the nearest ancestor with
+    a package.xml or model.config), None when there is none."""
+    for directory in Path(file).resolve().parents:
+        if any((directory / marker).is_file() for marker in PACKAGE_MARKERS):
+            return directory
+    return None
+
+
+def outside_reason(uri: str, path: Path | None, referencing_file: str | Path,
+                   default_root: Path) -> str | None:
+    """Why the mesh file `path` (resolved from `uri`, named in `referencing_file`) lies
+    outside the model's packages, or None when it is one of the model's own files.
+
+    `package://` and `model://` references stay inside the package they name unless they
+    climb out of it with `..`; any other reference (absolute, `file://`, relative) is
+    inside when the file lies in the package or model directory of the file naming it,
+    else in `default_root` (the model directory the user gave)."""
+    import posixpath
+    from urllib.parse import unquote
+
+    if path is None:
+        return None
+    text = unquote(uri.strip())
+    for scheme in ("package://", "model://"):
+        if text.startswith(scheme):
+            _name, _, rel = text[len(scheme):].partition("/")
+            normal = posixpath.normpath(rel) if rel else ""
+            if normal == ".." or normal.startswith("../") or rel.startswith("/"):
+                return f"'{uri}' climbs out of its package"
+            return None
+    root = package_root(referencing_file) or Path(default_root).resolve()
+    real = Path(path).resolve()
+    if real == root or root in real.parents:
+        return None
+    how = "an absolute reference" if text.startswith(("file://", "/")) else \
+        "a relative path that climbs out"
+    return f"{how} to {real}, outside the model's package {root}"

@@ -25,9 +25,10 @@ Supported subset (SDF 1.6 to 1.11, the shape of Gazebo's own multirotor models):
 * URDF has no separate joint frame: the joint frame is the child link frame. So here
   `T_parent_joint` is the child link's pose in the parent link, and the axis is rotated
   from the frame it is expressed in (`expressed_in=`, 1.6's `<use_parent_model_frame>`,
-  default the SDF joint frame) into the child link frame. A joint pose with a translation
-  relative to its child moves the axis line to the child origin; zero-configuration
-  poses, which everything in reedtool uses, are exact.
+  default the SDF joint frame) into the child link frame. A joint posed away from its
+  child's origin keeps that pose as `Joint.T_child_jointframe` (the axis line passes
+  there; `migrate` writes it back); zero-configuration poses, which everything else in
+  reedtool uses, do not depend on it.
 * Joint types: `revolute` with no `<limit>` or with limits at +-1e16 (sdformat's
   "unbounded", which is how sdformat writes a URDF continuous joint) is `continuous`;
   revolute, prismatic, continuous and fixed map one to one; ball, universal, revolute2,
@@ -44,7 +45,9 @@ Supported subset (SDF 1.6 to 1.11, the shape of Gazebo's own multirotor models):
   polylines are kept as "no geometry".
 * `<plugin>` elements under a `<model>` (or a nested one) become one GazeboBlock(reference=None), so
   rotor discovery reads gz-sim MulticopterMotorModel systems exactly as it reads URDF
-  `<gazebo>` plugins.
+  `<gazebo>` plugins. The `<sensor>`s of a link become a GazeboBlock(reference=LINK)
+  holding them (plugins inside a sensor stay inside it), as URDF's `<gazebo
+  reference="LINK"><sensor>` is read.
 
 `Robot.urdf_xml` is set to an equivalent URDF (links, inertials, primitive geometry,
 joints) so URDF-only consumers such as the Pinocchio cross-check see the same model.
@@ -100,6 +103,29 @@ _SCOPED_PLUGIN_PARAMS = {"jointName", "linkName", "joint_name", "link_name", "bo
                          "body_name"}
 # sdformat writes "no limit" as +-1e16; anything beyond this is unbounded.
 UNBOUNDED_LIMIT = 1e15
+# What sdformat's joint.sdf says "no limit" is: lower/upper default to -+1e16, and an
+# effort or velocity limit is "not enforced if negative" (default -1).
+SDF_NO_POSITION_LIMIT = 1e16
+
+
+def is_no_limit(value: float | None) -> bool:
+    """The one notion of "no limit" the readers leave in a JointLimit: absent (None) or
+    infinite (SDF's negative effort/velocity, URDF's DBL_MAX, beyond MAX_MAGNITUDE)."""
+    return value is None or not math.isfinite(value)
+
+
+def sdf_limit_text(tag: str, value: float | None) -> str | None:
+    """The text SDF writes for a model's joint limit `tag` (lower, upper, effort,
+    velocity), or None to leave the element out. "No limit" is never written as `inf`:
+    lower/upper become sdformat's -+1e16, effort/velocity are left out (sdformat's
+    default -1, not enforced)."""
+    if tag in ("effort", "velocity"):
+        return None if is_no_limit(value) or value < 0 else repr(float(value))
+    if is_no_limit(value) or abs(value) >= UNBOUNDED_LIMIT:
+        sign = -1.0 if (value is not None and value < 0) or (value is None and tag == "lower") \
+            else 1.0
+        return f"{sign * SDF_NO_POSITION_LIMIT:g}"
+    return "0" if value == 0 else repr(float(value))
 _SDF_VERSION = re.compile(r"<sdf\b[^>]*\bversion\s*=\s*[\"']([\d.]+)[\"']")
 SDF_DEFAULT_MASS_KG = 1.0
 
@@ -249,6 +275,7 @@ class _ModelReader:
         self.model_els: dict[str, etree._Element] = {}              # scope "a::" -> <model>
         self.attached_to: dict[str, str] = {}                       # frame -> what it is on
         self.canonical: str | None = None
+        self.sensor_blocks: list[GazeboBlock] = []                   # <sensor>s per link
 
     # ------------------------------------------------------------ helpers
     def loc(self, el: etree._Element) -> SourceLoc:
@@ -473,6 +500,7 @@ class _ModelReader:
                 block.plugins.append(Plugin(name=el.get("name"), filename=el.get("filename"),
                                             node=node, loc=node.loc))
             robot.gazebo.append(block)
+        robot.gazebo += self.sensor_blocks
         self._tolerated_issues()
         robot.parse_issues = self.issues
         return robot
@@ -521,6 +549,12 @@ class _ModelReader:
                 geometry=self._geometry(c.find("geometry"), scoped),
                 T_link_geom=self._T_link_X(scoped, scope, c.find("pose"), scoped),
                 loc=self.loc(c), name=c.get("name")))
+        sensors = _children(el, "sensor")
+        if sensors:
+            # As URDF writes them: a <gazebo reference="LINK"> block holding the sensors.
+            block = GazeboBlock(reference=scoped, loc=self.loc(sensors[0]))
+            block.elements += [self._node(sensor) for sensor in sensors]
+            self.sensor_blocks.append(block)
         return link
 
     def _inertial(self, link: str, scope: str, el: etree._Element) -> Inertial:
@@ -628,7 +662,12 @@ class _ModelReader:
         # T_parent_joint is written in the child link's <pose> (URDF writes it in <origin>).
         child_entry = self.frames.get(child or "")
         pose_el = child_entry.el.find("pose") if child_entry is not None else None
+        T_child_jointframe = None
+        if child in self.frames and el.find("pose") is not None:
+            T_child_jointframe = np.linalg.inv(self.T_model(child, el, scoped)) \
+                @ self.T_model(scoped, el, scoped)
         return Joint(name=scoped, type=joint_type, parent=parent, child=child,
+                     T_child_jointframe=T_child_jointframe,
                      T_parent_joint=T_parent_child, axis=axis, loc=self.loc(el), limit=limit,
                      axis_loc=self.loc(xyz_el) if xyz_el is not None else None,
                      origin_loc=self.loc(pose_el) if pose_el is not None else None)

@@ -182,6 +182,15 @@ def _mesh_paths(robot, collision: bool) -> dict[str, object]:
     return paths
 
 
+def _mesh_errors(robot) -> dict[str, str]:
+    """Mesh URI -> why it has no file (not found, or withheld: assembly.view)."""
+    from reedtool.model import Mesh
+
+    return {shape.geometry.uri.strip(): shape.geometry.resolve_error
+            for link in robot.links for shape in [*link.visuals, *link.collisions]
+            if isinstance(shape.geometry, Mesh) and shape.geometry.resolve_error}
+
+
 def _yourdfpy_scene(robot, collision: bool, T_base_link: dict, notes: list[str]):
     """URDF/xacro: yourdfpy's scene (link tree, primitives, colours), meshes added by us."""
     import io
@@ -232,8 +241,9 @@ def _yourdfpy_scene(robot, collision: bool, T_base_link: dict, notes: list[str])
                 continue
             path = urdf._filename_handler(fname=geometry.mesh.filename)
             if paths.get(geometry.mesh.filename) is None:
+                why = _mesh_errors(robot).get(geometry.mesh.filename.strip()) or "not found"
                 notes.append(f"link '{link.name}': mesh '{geometry.mesh.filename}' not shown "
-                             f"(not found)")
+                             f"({why})")
                 continue
             mesh = _read_mesh(path, geometry.mesh.scale, link.name, notes)
             if mesh is None:

@@ -233,8 +233,6 @@ def ardupilot_port(robot, port: GzPort) -> tuple[list[Element], str]:
 def _imu_name(port: GzPort) -> str:
     """`link::sensor` of the port's first IMU, adding one on the root link if it has none
     (ArduPilotPlugin needs an IMU)."""
-    from reedtool.scaffold.gz_port import SENSOR_SYSTEMS
-
     for link in port.links:
         for sensor in link.sensors:
             if sensor.attrib.get("type") == "imu":
@@ -243,9 +241,8 @@ def _imu_name(port: GzPort) -> str:
     sensor = Element("sensor", {"name": "imu_sensor", "type": "imu"})
     sensor.add("always_on", "true")
     sensor.add("update_rate", "1000")
-    root.sensors.append(sensor)
-    if SENSOR_SYSTEMS["imu"] not in port.world_systems:
-        port.world_systems.append(SENSOR_SYSTEMS["imu"])
+    port.add_sensor(root, sensor, "ArduPilotPlugin reads an IMU and the model has none: "
+                                  "one added on the root link")
     return f"{root.name}::imu_sensor"
 
 

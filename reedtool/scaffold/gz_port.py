@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from reedtool.model import Collision, Inertial, Plugin, Robot, SourceLoc, Visual, XmlNode
+from reedtool.scaffold.gz_sensors import SENSOR_KINDS, sensor_kind, sensor_plugin_why, split_name
 
 # ------------------------------------------------------------- mapping table
 
@@ -46,24 +47,15 @@ ARDUPILOT_SYSTEM = ("ArduPilotPlugin", "ArduPilotPlugin")
 WORLD_PHYSICS = ("gz-sim-physics-system", "gz::sim::systems::Physics")
 WORLD_USER_COMMANDS = ("gz-sim-user-commands-system", "gz::sim::systems::UserCommands")
 WORLD_SCENE = ("gz-sim-scene-broadcaster-system", "gz::sim::systems::SceneBroadcaster")
-SENSOR_SYSTEMS = {
-    "imu": ("gz-sim-imu-system", "gz::sim::systems::Imu"),
-    "navsat": ("gz-sim-navsat-system", "gz::sim::systems::NavSat"),
-    "magnetometer": ("gz-sim-magnetometer-system", "gz::sim::systems::Magnetometer"),
-    "air_pressure": ("gz-sim-air-pressure-system", "gz::sim::systems::AirPressure"),
-    "altimeter": ("gz-sim-altimeter-system", "gz::sim::systems::Altimeter"),
-    # Rendering sensors (cameras, lidars) all run in the Sensors system.
-    "camera": ("gz-sim-sensors-system", "gz::sim::systems::Sensors"),
-    "depth_camera": ("gz-sim-sensors-system", "gz::sim::systems::Sensors"),
-    "rgbd_camera": ("gz-sim-sensors-system", "gz::sim::systems::Sensors"),
-    "gpu_lidar": ("gz-sim-sensors-system", "gz::sim::systems::Sensors"),
-}
-# Classic sensor types gz spells differently.
-SENSOR_TYPE_RENAMES = {"ray": "gpu_lidar", "gpu_ray": "gpu_lidar", "depth": "depth_camera",
-                       "gps": "navsat"}
+# The gz-sim system each gz sensor type needs (scaffold.gz_sensors holds the full table).
+SENSOR_SYSTEMS = {kind.gz: kind.system for kind in SENSOR_KINDS if kind.gz is not None}
 # Where PX4's gz bridge sends motor speeds, below the model instance's name, as PX4's own
 # gz models subscribe.
 PX4_MOTOR_TOPIC = "command/motor_speed"
+# Where a navsat sensor is on Earth when the source names no home: PX4 Classic's default
+# home (common.h kDefaultHomeLatitude/Longitude/Altitude), where its GPS plugin put it.
+# gz-sim's NavSat system publishes nothing without the world's <spherical_coordinates>.
+DEFAULT_HOME = (47.397742, 8.545594, 488.0)    # latitude deg, longitude deg, elevation m
 # The IMU update rate the port writes: RotorS' noise densities become per-sample
 # standard deviations at this rate (sigma = density * sqrt(rate)).
 IMU_RATE_HZ = 250.0
@@ -78,6 +70,9 @@ class Family:
     action: str                    # how plan_port handles it (see _HANDLERS)
     gz: str                        # what it becomes, for the report ("" when dropped)
     why: str                       # the reason, for the report
+    sensor: str | None = None      # the gz sensor type it simulates, if any
+    # its noise parameters (as the plugin names them) the port does not carry, and why
+    noise_not_carried: tuple[tuple[str, ...], str] = ((), "")
 
 
 PLUGIN_FAMILIES: tuple[Family, ...] = (
@@ -86,24 +81,37 @@ PLUGIN_FAMILIES: tuple[Family, ...] = (
            "gz-sim-joint-position-controller-system (position servo)",
            "the same motor model in gz-sim; motorNumber becomes actuator_number, every "
            "constant carried as written"),
-    Family("multirotor-base", ("rotors_gazebo_multirotor_base_plugin",), "joint_states",
+    Family("multirotor-base", ("rotors_gazebo_multirotor_base_plugin",
+                               "gazebo_multirotor_base_plugin"), "joint_states",
            "gz-sim-joint-state-publisher-system",
-           "RotorS' base plugin publishes joint states; gz's JointStatePublisher does"),
+           "RotorS' (and PX4 Classic's) base plugin publishes joint states; gz's "
+           "JointStatePublisher does"),
     Family("imu", ("rotors_gazebo_imu_plugin", "gazebo_imu_plugin", "gazebo_ros_imu_sensor",
                    "gazebo_ros_imu"), "imu",
            "<sensor type=\"imu\"> on the link + gz-sim-imu-system in the world",
            "gz simulates IMUs as sensors; noise densities become per-sample deviations "
-           f"at {IMU_RATE_HZ:g} Hz"),
+           f"at {IMU_RATE_HZ:g} Hz", sensor="imu"),
     Family("odometry", ("rotors_gazebo_odometry_plugin", "gazebo_odometry_plugin",
                         "gazebo_groundtruth_plugin", "gazebo_ros_p3d"), "odometry",
            "gz-sim-odometry-publisher-system",
            "ground-truth odometry of the model in gz"),
     Family("gps", ("gazebo_gps_plugin",), "sensor:navsat",
-           "<sensor type=\"navsat\"> + gz-sim-navsat-system", "gz's GNSS sensor"),
+           "<sensor type=\"navsat\"> + gz-sim-navsat-system", "gz's GNSS sensor",
+           sensor="navsat", noise_not_carried=(
+               ("gpsXYRandomWalk", "gpsZRandomWalk", "gpsXYNoiseDensity", "gpsZNoiseDensity",
+                "gpsVXYNoiseDensity", "gpsVZNoiseDensity"),
+               "PX4 Classic's random-walk GNSS model has no navsat counterpart")),
     Family("magnetometer", ("gazebo_magnetometer_plugin",), "sensor:magnetometer",
-           "<sensor type=\"magnetometer\"> + gz-sim-magnetometer-system", "gz's magnetometer"),
+           "<sensor type=\"magnetometer\"> + gz-sim-magnetometer-system", "gz's magnetometer",
+           sensor="magnetometer", noise_not_carried=(
+               ("noiseDensity", "randomWalk", "biasCorrelationTime"),
+               "PX4 Classic's magnetometer noise is in gauss with its own bias model; gz's "
+               "is per axis in tesla: set <magnetometer><x><noise> by hand")),
     Family("barometer", ("gazebo_barometer_plugin",), "sensor:air_pressure",
-           "<sensor type=\"air_pressure\"> + gz-sim-air-pressure-system", "gz's barometer"),
+           "<sensor type=\"air_pressure\"> + gz-sim-air-pressure-system", "gz's barometer",
+           sensor="air_pressure", noise_not_carried=(
+               ("baroDriftPaPerSec",),
+               "PX4 Classic's barometer drift has no air_pressure counterpart")),
     Family("mavlink", ("rotors_gazebo_mavlink_interface", "gazebo_mavlink_interface"), "drop",
            "", "PX4's gz bridge (and ArduPilot's plugin) replace the MAVLink interface in "
                "gz-sim; --autopilot px4 writes the airframe it reads"),
@@ -111,6 +119,10 @@ PLUGIN_FAMILIES: tuple[Family, ...] = (
            "gz-sim-multicopter-control-system with --velocity-control",
            "gz's MulticopterVelocityControl flies the rotors from twist commands; without "
            "--velocity-control speed commands go to the motor models' commandSubTopic"),
+    Family("gimbal-controller", ("gazebo_gimbal_controller_plugin",), "drop", "",
+           "PX4 Classic's gimbal controller (MAVLink gimbal commands to joint PIDs): with "
+           "gz, PX4 drives a gimbal's joints through gz-sim-joint-position-controller-system "
+           "topics (as PX4-gazebo-models' gimbal does); add those by hand"),
     Family("bag", ("rotors_gazebo_bag_plugin",), "drop", "",
            "records ROS 1 bags; with ROS 2 record the ros_gz_bridge topics with ros2 bag"),
     Family("ros-control", ("gazebo_ros_control",), "drop", "",
@@ -205,6 +217,7 @@ class PortJoint:
     axis: np.ndarray
     limit: tuple[float | None, float | None, float | None, float | None] | None
     loc: SourceLoc
+    T_child_jointframe: np.ndarray | None = None   # SDF: the joint frame in the child link
 
 
 @dataclass
@@ -228,6 +241,27 @@ class GzPort:
     options: "PortOptions" = None
     # --autopilot ardupilot: the velocity motor plugins ArduPilotPlugin drives, with their rows
     ardupilot_rotors: list[tuple[Plugin, PortRow]] = field(default_factory=list)
+    # Sensors the port adds that the source has not (an autopilot needs them): (link,
+    # sensor name, why). The proof notes them instead of calling them a difference.
+    added_sensors: list[tuple[str, str, str]] = field(default_factory=list)
+    # Mesh URIs whose file lies outside the model's packages -> why (io.meshes.outside_reason);
+    # they are referenced where they are, not copied, unless copy_outside_files.
+    outside_files: dict[str, str] = field(default_factory=dict)
+    copy_outside_files: bool = False
+    target_dir: object = None      # the model directory being written (pathlib.Path)
+    # (latitude deg, longitude deg, elevation m) of the world's <spherical_coordinates>,
+    # from the source's GPS plugin (homeLatitude, ...) when it names one
+    home: tuple[float, float, float] | None = None
+
+    def add_sensor(self, link: "PortLink", sensor: Element, why: str) -> None:
+        link.sensors.append(sensor)
+        self.added_sensors.append((link.name, sensor.attrib.get("name", ""), why))
+        system = SENSOR_SYSTEMS.get(sensor.attrib.get("type", ""))
+        if system is not None and system not in self.world_systems:
+            self.world_systems.append(system)
+        self.rows.append(PortRow(link.loc, f"(none: added) sensor {sensor.attrib.get('name')}",
+                                 "mapped", f"link {link.name}: <sensor type=\""
+                                 f"{sensor.attrib.get('type')}\">", why, target=sensor))
 
 
 @dataclass(frozen=True)
@@ -352,7 +386,8 @@ def _structure(robot: Robot):
                     joint.name, joint.type, survivor, child.name,
                     np.asarray(joint.axis, dtype=float),
                     None if limit is None else (limit.lower, limit.upper, limit.effort,
-                                                limit.velocity), joint.loc))
+                                                limit.velocity), joint.loc,
+                    joint.T_child_jointframe))
             queue.append(child.name)
     for link in robot.links:
         if link.name not in fold:
@@ -422,38 +457,146 @@ def _gazebo_element(port: GzPort, reference: str | None, node: XmlNode, fold, by
                                  "fixed joint whose links carry mass"))
         return
     if node.tag == "sensor":
-        link, T = _resolve_link(reference, fold, by_name)
-        if link is None:
-            port.rows.append(PortRow(node.loc, label, "dropped", "",
-                                     f"its reference '{reference}' is not a link of the model"))
-            return
-        sensor = _copy(node, skip={"plugin"})
-        kind = SENSOR_TYPE_RENAMES.get(sensor.attrib.get("type", ""), sensor.attrib.get("type", ""))
-        sensor.attrib["type"] = kind
-        _place_sensor(sensor, T)
-        by_name[link].sensors.append(sensor)
-        system = SENSOR_SYSTEMS.get(kind)
-        if system is not None and system not in port.world_systems:
-            port.world_systems.append(system)
-        why = "a sensor type gz-sim simulates" if system is not None else \
-            f"gz-sim has no system reedtool knows for sensor type '{kind}'"
-        port.rows.append(PortRow(node.loc, label, "mapped",
-                                 f"link {link}: <sensor type=\"{kind}\">", why +
-                                 ("; its Classic <plugin> children are dropped"
-                                  if node.find("plugin") is not None else ""), target=sensor))
+        _classic_sensor(port, reference, node, fold, by_name, label)
         return
     port.rows.append(PortRow(node.loc, label, "dropped", "",
                              "a Classic-only setting (OGRE material scripts, ODE contact "
                              "parameters): gz-sim does not read it; set its gz form by hand"))
 
 
+def _classic_sensor(port: GzPort, reference: str | None, node: XmlNode, fold, by_name,
+                    label: str) -> None:
+    """A <sensor> of a link: its gz form from scaffold.gz_sensors' table (type and child
+    names as gz spells them, posed on the link it survives in), or a row saying why not;
+    then one row for each Classic plugin inside it."""
+    sensor_type = node.attrib.get("type", "")
+    label = f"sensor {node.attrib.get('name', '?')} ({sensor_type or '?'}) on link {reference}"
+    kind = sensor_kind(sensor_type)
+    link, T = _resolve_link(reference, fold, by_name)
+    if link is None:
+        port.rows.append(PortRow(node.loc, label, "dropped", "",
+                                 f"its link '{reference}' is not a link of the model",
+                                 covers=tuple(n.loc for n in node.iter())))
+        return
+    if kind is None or kind.gz is None:
+        action = "unknown" if kind is None else "dropped"
+        why = kind.why if kind is not None else \
+            f"a sensor type ('{sensor_type}') reedtool knows no gz-sim counterpart for: kept " \
+            "out of the port; port it by hand if the model needs it"
+        port.rows.append(PortRow(node.loc, label, action, "", why,
+                                 covers=tuple(n.loc for n in node.iter())))
+        _sensor_plugins(port, node)
+        return
+    if kind.system not in port.world_systems:
+        port.world_systems.append(kind.system)
+    renamed = "" if sensor_type == kind.gz else f" (Classic '{sensor_type}')"
+    if kind.split:
+        _split_sensor(port, node, kind, link, T, label)
+        _sensor_plugins(port, node)
+        return
+    sensor = _copy(node, skip={"plugin"})
+    sensor.attrib["type"] = kind.gz
+    for child in sensor.children:
+        child.tag = kind.renames.get(child.tag, child.tag)
+    _place_sensor(sensor, T)
+    by_name[link].sensors.append(sensor)
+    port.rows.append(PortRow(node.loc, label, "mapped",
+                             f"link {link}: <sensor type=\"{kind.gz}\"{renamed}>",
+                             f"{kind.why}; pose, rate and noise as written",
+                             _carried_sensor(node), target=sensor))
+    _sensor_plugins(port, node)
+
+
+def _split_sensor(port: GzPort, node: XmlNode, kind, link: str, T: np.ndarray,
+                  label: str) -> None:
+    """A Classic multicamera: one gz camera sensor per <camera>, each posed at the
+    sensor's pose composed with its camera's <pose>."""
+    from reedtool.frames import make_T, rpy_to_matrix
+
+    def T_of(element) -> np.ndarray:
+        pose = element.find("pose")
+        values = ([float(v) for v in (pose.text or "").split()] if pose is not None else [])
+        values = (values + [0.0] * 6)[:6]
+        return make_T(rpy_to_matrix(values[3:]), values[:3])
+
+    T_link_sensor = T_of(node)
+    port_link = next(candidate for candidate in port.links if candidate.name == link)
+    for index, camera in enumerate(node.findall("camera")):
+        name = split_name(node.attrib.get("name", "camera"), camera.attrib.get("name"), index)
+        sensor = _copy(node, skip={"plugin", "camera", "pose"})
+        sensor.attrib.update({"name": name, "type": kind.gz})
+        own = _copy(camera, skip={"pose"})
+        own.attrib.pop("name", None)
+        sensor.children.append(own)
+        sensor.children.insert(0, Element("pose", {}, _pose_text(T_link_sensor @ T_of(camera))))
+        _place_sensor(sensor, T)
+        port_link.sensors.append(sensor)
+        port.rows.append(PortRow(camera.loc, f"{label} <camera name="
+                                 f"{camera.attrib.get('name', index)!r}>", "mapped",
+                                 f"link {link}: <sensor type=\"{kind.gz}\" name=\"{name}\">",
+                                 kind.why, _carried_sensor(node), target=sensor))
+
+
+def _note_home(port: GzPort, plugin_node: XmlNode) -> None:
+    """A Classic GPS plugin's home (degrees, metres) for the world's spherical coordinates."""
+    values = [plugin_node.findtext(tag) for tag in ("homeLatitude", "homeLongitude",
+                                                     "homeAltitude")]
+    if port.home is None and any(v is not None for v in values) \
+            and all(v is None or _is_number(v) for v in values):
+        port.home = tuple(float(v) if v is not None else default
+                          for v, default in zip(values, DEFAULT_HOME))
+
+
+def _sensor_plugins(port: GzPort, node: XmlNode) -> None:
+    """One row for each Classic plugin inside a <sensor>: why it is not carried."""
+    for inner in node.findall("plugin"):
+        _note_home(port, inner)
+        library = Plugin(inner.attrib.get("name"), inner.attrib.get("filename"), inner,
+                         inner.loc).library
+        why = sensor_plugin_why(library)
+        plugin_label = f"plugin {inner.attrib.get('name') or '?'} " \
+                       f"({inner.attrib.get('filename') or '?'}) in sensor " \
+                       f"{node.attrib.get('name', '?')}"
+        numbers = {child.tag: (child.text or "").strip() for child in inner.children
+                   if _is_number((child.text or "").strip())}
+        if why is None:
+            port.rows.append(PortRow(inner.loc, plugin_label, "unknown", "",
+                                     "a Classic sensor plugin reedtool knows no gz-sim "
+                                     "counterpart for: kept out of the port; the sensor "
+                                     "itself is carried",
+                                     covers=tuple(n.loc for n in inner.iter())))
+        else:
+            port.rows.append(PortRow(inner.loc, plugin_label, "dropped", "",
+                                     why + ("; left with it: " + ", ".join(
+                                         f"{k} {v}" for k, v in numbers.items())
+                                         if numbers else ""),
+                                     covers=tuple(n.loc for n in inner.iter())))
+
+
+def _carried_sensor(node: XmlNode) -> dict[str, str]:
+    out = {}
+    for key in ("update_rate", "pose"):
+        text = node.findtext(key)
+        if text is not None:
+            out[key] = " ".join(text.split())
+    return out
+
+
 def _place_sensor(sensor: Element, T_link_sensor: np.ndarray) -> None:
+    """Pose the sensor in the port link: `T_link_sensor` (where its source link sits in
+    the port link, when folded) composed with its own <pose>."""
+    from reedtool.frames import make_T, rpy_to_matrix
+
     if np.allclose(T_link_sensor, np.eye(4), rtol=0, atol=0):
         return
     pose = sensor.find("pose")
+    T = T_link_sensor
     if pose is not None:
+        values = [float(v) for v in (pose.text or "").split()] or [0.0] * 6
+        values = (values + [0.0] * 6)[:6]
+        T = T_link_sensor @ make_T(rpy_to_matrix(values[3:]), values[:3])
         sensor.children.remove(pose)
-    sensor.children.insert(0, Element("pose", {}, _pose_text(T_link_sensor)))
+    sensor.children.insert(0, Element("pose", {}, _pose_text(T)))
 
 
 def _gz_plugin(system: tuple[str, str], name: str | None = None) -> Element:
@@ -605,7 +748,10 @@ def _imu(port: GzPort, robot, plugin, family, fold, by_name) -> None:
                              f"link {link}: <sensor type=\"imu\" name=\"{sensor.attrib['name']}\">",
                              family.why + ("; noise stddev = density x sqrt(rate), bias and "
                                            "random walk as gz's bias_stddev and dynamic bias"
-                                           if carried else ""), carried, target=sensor))
+                                           if carried else "; the plugin names no noise: "
+                                           "the Classic plugin's built-in default noise is "
+                                           "not carried, the port's IMU is noiseless"),
+                             carried, target=sensor))
 
 
 def _odometry(port: GzPort, robot, plugin, family, fold, by_name) -> None:
@@ -640,18 +786,31 @@ def _is_number(text: str) -> bool:
 
 
 def _sensor(port: GzPort, robot, plugin, family, fold, by_name) -> None:
+    """A model-level Classic sensor plugin (PX4's magnetometer, barometer, GPS): a gz
+    sensor on the link the plugin names, else the root link."""
     kind = family.action.split(":")[1]
-    link, T = fold[robot.base_link]
+    link_name = plugin.param("linkName") or plugin.param("bodyName")
+    link, T = _resolve_link(link_name, fold, by_name)
+    if link is None:
+        link, T = fold[robot.base_link]
     sensor = Element("sensor", {"name": plugin.name or kind, "type": kind})
+    _place_sensor(sensor, T)
     sensor.add("always_on", "true")
-    sensor.add("update_rate", plugin.param("updateRate") or plugin.param("update_rate") or "50")
+    rate = next((plugin.param(tag) for tag in ("pubRate", "updateRate", "update_rate")
+                 if plugin.param(tag)), None)
+    sensor.add("update_rate", rate or "50")
     by_name[link].sensors.append(sensor)
+    _note_home(port, plugin.node)
     if SENSOR_SYSTEMS[kind] not in port.world_systems:
         port.world_systems.append(SENSOR_SYSTEMS[kind])
+    names, reason = family.noise_not_carried
+    lost = {tag: plugin.param(tag) for tag in names if plugin.param(tag) is not None}
+    why = family.why + ("" if rate else "; no rate in the plugin: 50 Hz")
+    if lost:
+        why += f"; noise not carried ({reason}): " + ", ".join(f"{k} {v}" for k, v in lost.items())
     port.rows.append(PortRow(plugin.loc, _plugin_label(plugin), "mapped",
-                             f"link {link}: <sensor type=\"{kind}\">",
-                             family.why + "; its noise parameters are not carried",
-                             target=sensor))
+                             f"link {link}: <sensor type=\"{kind}\">", why,
+                             {"update_rate": rate} if rate else {}, target=sensor))
 
 
 def _covers(plugin: Plugin) -> tuple[SourceLoc, ...]:

@@ -19,6 +19,7 @@ not generate are kept), and the swap is two renames: the old tree is kept whole 
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import tempfile
@@ -120,9 +121,26 @@ def check_target(target: Path, force: bool, *,
 
 def write_tree(target: Path, files: list[RenderedFile], *, force: bool = False) -> Path | None:
     """Write `files` as the directory `target`, atomically. Returns the backup dir, if any."""
+    with staged_tree(target, files, force=force) as staged:
+        pass
+    return staged.backup
+
+
+@dataclass
+class StagedTree:
+    path: Path                 # the hidden directory holding the new tree until the swap
+    backup: Path | None = None
+
+
+@contextlib.contextmanager
+def staged_tree(target: Path, files: list[RenderedFile], *, force: bool = False):
+    """Stage `files` as the new tree of `target` in a hidden directory beside it, let the
+    caller look at it (migrate reads its port back there), then swap it into place. If the
+    caller raises, the staging directory is removed and `target` is untouched."""
     target = Path(target).absolute()
     check_target(target, force)
     parent = target.parent
+    created = [p for p in (parent, *parent.parents) if not p.exists()]
     try:
         parent.mkdir(parents=True, exist_ok=True)
         staging = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".reedtool-tmp",
@@ -130,38 +148,54 @@ def write_tree(target: Path, files: list[RenderedFile], *, force: bool = False) 
     except OSError as exc:
         raise os_error(exc, parent, action="create a directory in") from exc
     replacing = target.is_dir() and any(target.iterdir())
+    staged = StagedTree(staging)
+    swapped = False
     try:
-        if replacing:
-            # Start from a copy of the old tree so files reedtool does not generate survive.
-            shutil.rmtree(staging)
-            shutil.copytree(target, staging, symlinks=True)
-        for item in files:
-            dest = staging.joinpath(*item.path.parts)
-            dest.parent.mkdir(parents=True, exist_ok=True)
-            if dest.is_symlink() or dest.is_file():
-                dest.unlink()
-            dest.write_bytes(item.data)
-            os.chmod(dest, item.mode)
-        os.chmod(staging, 0o777 & ~_umask())
-        backup = None
-        if replacing:
-            backup = free_backup_name(target)
-            os.rename(target, backup)
-            try:
-                os.rename(staging, target)
-            except OSError:
-                os.rename(backup, target)  # put the old tree back
-                raise
-        else:
-            os.rename(staging, target)     # POSIX rename also replaces an empty directory
-        return backup
-    except OSError as exc:
-        error = os_error(exc, target, action="write package")
-        error.hint = f"{error.hint}; nothing was changed" if error.hint else "nothing was changed"
-        raise error from exc
+        try:
+            if replacing:
+                # Start from a copy of the old tree so files reedtool does not generate survive.
+                shutil.rmtree(staging)
+                shutil.copytree(target, staging, symlinks=True)
+            for item in files:
+                dest = staging.joinpath(*item.path.parts)
+                dest.parent.mkdir(parents=True, exist_ok=True)
+                if dest.is_symlink() or dest.is_file():
+                    dest.unlink()
+                dest.write_bytes(item.data)
+                os.chmod(dest, item.mode)
+            os.chmod(staging, 0o777 & ~_umask())
+        except OSError as exc:
+            error = os_error(exc, target, action="write package")
+            error.hint = f"{error.hint}; nothing was changed" if error.hint else \
+                "nothing was changed"
+            raise error from exc
+        yield staged
+        try:
+            if replacing:
+                staged.backup = free_backup_name(target)
+                os.rename(target, staged.backup)
+                try:
+                    os.rename(staging, target)
+                except OSError:
+                    os.rename(staged.backup, target)  # put the old tree back
+                    raise
+            else:
+                os.rename(staging, target)     # POSIX rename also replaces an empty directory
+            swapped = True
+        except OSError as exc:
+            error = os_error(exc, target, action="write package")
+            error.hint = f"{error.hint}; nothing was changed" if error.hint else \
+                "nothing was changed"
+            raise error from exc
     finally:
         if staging.exists():
             shutil.rmtree(staging, ignore_errors=True)
+        if not swapped:
+            for directory in created:      # innermost first: the ones this call made
+                try:
+                    directory.rmdir()
+                except OSError:
+                    break
 
 
 def _umask() -> int:

@@ -2,7 +2,9 @@
 
     <name>/model.sdf          SDF 1.9: links, joints, folded-link frames, gz systems
     <name>/model.config       name, version, the SDF file
-    <name>/meshes/...         every mesh file the model uses, copied; URIs relative
+    <name>/meshes/...         every mesh file of the model's packages, copied; URIs
+                              relative (a file from outside them is referenced where it
+                              is, unless --copy-outside-files)
     <name>/worlds/<name>.sdf  physics, the world systems the model needs, the model included
 
 Numbers the port computes (poses, folded inertials) are written with the shortest text
@@ -17,12 +19,10 @@ from pathlib import Path, PurePosixPath
 import numpy as np
 from lxml import etree
 
+from reedtool.io.sdf import sdf_limit_text
 from reedtool.scaffold.gz_port import Element, GzPort, PortRow, _num, _pose_text
 
 SDF_VERSION = "1.9"
-# sdformat's "no limit" for a revolute joint (how sdformat writes a URDF continuous joint,
-# and what PX4's gz models use for rotor joints).
-UNBOUNDED = "1e+16"
 
 
 @dataclass
@@ -97,11 +97,28 @@ def _geometry(parent, geometry, mesh_uris: dict[str, str]) -> None:
             _sub(mesh, "scale", " ".join(_num(v) for v in geometry.scale))
 
 
+def _reference_in_place(uri: str, path: Path, target_dir) -> str:
+    """A file left where it is, named as the source named it: an absolute reference stays
+    an absolute file:// URI, a relative one the same file relative to the new model
+    directory (so validate sees the same kind of reference on both sides)."""
+    import os
+
+    real = path.resolve()
+    if target_dir is None or uri.strip().startswith(("file://", "/")):
+        return real.as_uri()
+    return PurePosixPath(os.path.relpath(real, Path(target_dir).absolute())).as_posix()
+
+
 def mesh_targets(port: GzPort) -> dict[str, str]:
-    """Source mesh URI -> the relative URI in the port (meshes/<file>, names made unique)."""
+    """Source mesh URI -> the relative URI in the port (meshes/<file>, names made unique);
+    a file from outside the model's packages keeps its place (an absolute file:// URI)
+    unless the user asked to copy it (--copy-outside-files)."""
     out: dict[str, str] = {}
     used: set[str] = set()
     for uri, mesh in port.meshes.items():
+        if uri in port.outside_files and not port.copy_outside_files:
+            out[uri] = _reference_in_place(uri, Path(mesh.path), port.target_dir)
+            continue
         base = PurePosixPath(uri.split("://", 1)[-1]).name or "mesh"
         name, index = base, 1
         while name in used:
@@ -113,18 +130,134 @@ def mesh_targets(port: GzPort) -> dict[str, str]:
     return out
 
 
+SCOPE = "::"
+
+
+def scope_of(name: str) -> str:
+    """The nested model a scoped name lives in ("" for the top model): `gps0::link` ->
+    `gps0`. SDF 1.8+ refuses `::` in a name, so the port writes scopes as nested models."""
+    return name.rpartition(SCOPE)[0]
+
+
+def local_name(name: str, scope: str) -> str:
+    """`name` as written inside `scope` (a reference into a nested model keeps its `::`)."""
+    return name[len(scope) + len(SCOPE):] if scope and name.startswith(scope + SCOPE) else name
+
+
+def flat_name(name: str) -> str:
+    """A name without `::` for an element that cannot live in its nested model."""
+    return name.replace(SCOPE, "__")
+
+
+def _within(name: str, scope: str) -> bool:
+    return not scope or name.startswith(scope + SCOPE)
+
+
+def _common_scope(a: str, b: str) -> str:
+    parts = []
+    for x, y in zip(scope_of(a).split(SCOPE), scope_of(b).split(SCOPE)):
+        if x != y or not x:
+            break
+        parts.append(x)
+    return SCOPE.join(parts)
+
+
+class _Scopes:
+    """The top <model> and the nested <model>s the port's scoped names need, each posed
+    in its parent model at the first link written in it."""
+
+    def __init__(self, model, T_model_link: dict[str, np.ndarray]):
+        self.nodes = {"": model}
+        self.T_model_scope = {"": np.eye(4)}
+        self.T_model_link = T_model_link
+
+    def node(self, scope: str, T_model_first: np.ndarray):
+        if scope not in self.nodes:
+            parent = scope_of(scope)
+            parent_node = self.node(parent, T_model_first)
+            node = _sub(parent_node, "model", name=local_name(scope, parent))
+            T_parent_scope = np.linalg.inv(self.T_model_scope[parent]) @ T_model_first
+            if not np.array_equal(T_parent_scope, np.eye(4)):
+                _sub(node, "pose", _pose_text(T_parent_scope))
+            self.nodes[scope] = node
+            self.T_model_scope[scope] = T_model_first
+        return self.nodes[scope]
+
+    def pose_in_scope(self, scope: str, name: str) -> np.ndarray:
+        return np.linalg.inv(self.T_model_scope[scope]) @ self.T_model_link[name]
+
+
+# Plugin parameters that name a joint or link of the plugin's own model (io.sdf reads a
+# nested model's plugin with them scoped).
+_SCOPED_PARAMS = ("jointName", "linkName", "joint_name", "link_name", "bodyName", "body_name")
+
+
+def _named(element: Element):
+    for child in element.children:
+        if child.tag in _SCOPED_PARAMS and child.text and child.text.strip():
+            yield child
+        yield from _named(child)
+
+
+def _plugin_scope(plugin: Element, nested: dict) -> str:
+    """The nested model a plugin belongs in: the deepest one written that holds every
+    joint and link it names (gz-sim's systems look names up in their own model only:
+    PX4 Classic's iris_* variants include the iris, motor plugins and all)."""
+    names = [child.text.strip() for child in _named(plugin)]
+    if not names:
+        return ""
+    scopes = [scope for scope in nested if scope and all(n.startswith(scope + SCOPE)
+                                                         for n in names)]
+    return max(scopes, key=len, default="")
+
+
+def _unscoped(plugin: Element, scope: str) -> Element:
+    """A copy of `plugin` whose joint and link names are written inside `scope`."""
+    import copy
+
+    out = copy.deepcopy(plugin)
+    for child in _named(out):
+        child.text = local_name(child.text.strip(), scope)
+    return out
+
+
+def _link_poses(port: GzPort) -> dict[str, np.ndarray]:
+    """T_model_link of every port link (links are listed parents first)."""
+    out: dict[str, np.ndarray] = {}
+    for link in port.links:
+        out[link.name] = np.eye(4) if link.parent is None else \
+            out[link.parent] @ link.T_parent_link
+    return out
+
+
 def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
               extra_plugins: list[Element] = ()) -> tuple[bytes, dict[int, int]]:
-    """model.sdf, and the line of every Element written (by id) for the report."""
+    """model.sdf, and the line of every Element written (by id) for the report.
+
+    A scoped name (`gps0::link`, from an included or nested model of the source) is
+    written as a nested <model name="gps0"> holding <link name="link">; joints and
+    references outside it name it `gps0::link`, as SDF 1.8+ allows. No name is written
+    with `::` (libsdformat refuses it from SDF 1.8 on)."""
     root = etree.Element("sdf", version=SDF_VERSION)
     root.append(etree.Comment(f" {port.name}: ported from {source} by reedtool migrate. "
                               "Constants as the source wrote them; see the migrate report. "))
     model = _sub(root, "model", name=port.name)
+    T_model_link = _link_poses(port)
+    scopes = _Scopes(model, T_model_link)
     written: list[tuple[Element, object]] = []
+    nodes: dict[tuple[str, str], object] = {}
     for link in port.links:
-        node = _sub(model, "link", name=link.name)
-        if link.parent is not None:
-            _sub(node, "pose", _pose_text(link.T_parent_link), relative_to=link.parent)
+        scope = scope_of(link.name)
+        parent_node = scopes.node(scope, T_model_link[link.name])
+        node = _sub(parent_node, "link", name=local_name(link.name, scope))
+        nodes[("link", link.name)] = node
+        if link.parent is not None and scope_of(link.parent) == scope:
+            _sub(node, "pose", _pose_text(link.T_parent_link),
+                 relative_to=local_name(link.parent, scope))
+        elif link.parent is not None or scope:
+            T = scopes.pose_in_scope(scope, link.name)
+            if not np.array_equal(T, np.eye(4)):
+                _sub(node, "pose", _pose_text(T))
         _inertial(node, link.inertials)
         for kind, shapes in (("collision", link.collisions), ("visual", link.visuals)):
             names: set[str] = set()
@@ -132,6 +265,7 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
                 if shape.geometry is None:
                     continue
                 name = shape.name if shape.name and shape.name not in names else f"{kind}_{index}"
+                name = flat_name(name)
                 names.add(name)
                 element = _sub(node, kind, name=name)
                 if not np.array_equal(T_link_geom, np.eye(4)):
@@ -140,37 +274,65 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
         for sensor in link.sensors:
             written.append((sensor, _to_xml(sensor, node)))
     for frame in port.frames:
-        node = _sub(model, "frame", name=frame.name, attached_to=frame.attached_to)
-        _sub(node, "pose", _pose_text(frame.T_link_frame), relative_to=frame.attached_to)
+        # A frame lives in its own nested model when that model is written and holds the
+        # link it is attached to; else in the link's scope under a flat name.
+        scope = scope_of(frame.name)
+        if scope not in scopes.nodes or not _within(frame.attached_to, scope):
+            scope = scope_of(frame.attached_to)
+            name = flat_name(frame.name)
+        else:
+            name = local_name(frame.name, scope)
+        attached = local_name(frame.attached_to, scope)
+        node = _sub(scopes.nodes[scope], "frame", name=name, attached_to=attached)
+        _sub(node, "pose", _pose_text(frame.T_link_frame), relative_to=attached)
     for joint in port.joints:
+        scope = scope_of(joint.name)
+        if scope in scopes.nodes and _within(joint.parent, scope) and _within(joint.child, scope):
+            name = local_name(joint.name, scope)
+        else:
+            scope = _common_scope(joint.parent, joint.child)
+            name = flat_name(local_name(joint.name, scope))
         sdf_type = {"continuous": "revolute"}.get(joint.type, joint.type)
-        node = _sub(model, "joint", name=joint.name, type=sdf_type)
-        _sub(node, "parent", joint.parent)
-        _sub(node, "child", joint.child)
+        node = _sub(scopes.nodes[scope], "joint", name=name, type=sdf_type)
+        nodes[("joint", joint.name)] = node
+        _sub(node, "parent", local_name(joint.parent, scope))
+        _sub(node, "child", local_name(joint.child, scope))
+        child = local_name(joint.child, scope)
+        moved = joint.T_child_jointframe is not None and \
+            not np.array_equal(joint.T_child_jointframe, np.eye(4))
+        if moved:
+            # The joint frame where the source put it (the axis line passes there); the
+            # axis stays in the child link frame, as the plan holds it.
+            _sub(node, "pose", _pose_text(joint.T_child_jointframe), relative_to=child)
         if joint.type != "fixed":
             axis = _sub(node, "axis")
-            _sub(axis, "xyz", " ".join(_num(v) for v in joint.axis))
+            _sub(axis, "xyz", " ".join(_num(v) for v in joint.axis),
+                 **({"expressed_in": child} if moved else {}))
             limit = _sub(axis, "limit")
-            if joint.type == "continuous" or joint.limit is None:
-                _sub(limit, "lower", "-" + UNBOUNDED)
-                _sub(limit, "upper", UNBOUNDED)
-            else:
-                lower, upper, effort, velocity = joint.limit
-                for tag, value in (("lower", lower), ("upper", upper), ("effort", effort),
-                                   ("velocity", velocity)):
-                    if value is not None:
-                        _sub(limit, tag, _num(value))
+            values = (None, None, None, None) if joint.limit is None else joint.limit
+            if joint.type == "continuous":      # no position limit; effort/velocity kept
+                values = (None, None, *values[2:])
+            for tag, value in zip(("lower", "upper", "effort", "velocity"), values):
+                text = sdf_limit_text(tag, value)
+                if text is not None:
+                    _sub(limit, tag, text)
     for plugin in [*port.plugins, *extra_plugins]:
-        written.append((plugin, _to_xml(plugin, model)))
+        scope = _plugin_scope(plugin, scopes.nodes)
+        written.append((plugin, _to_xml(_unscoped(plugin, scope) if scope else plugin,
+                                        scopes.nodes[scope])))
+    scoped = [el.get("name") for el in root.iter() if isinstance(el.tag, str)
+              and el.tag != "plugin" and SCOPE in (el.get("name") or "")]
+    if scoped:
+        # libsdformat refuses these from SDF 1.8 on: never write a port Gazebo will not load.
+        raise RuntimeError(f"the port would name an element {scoped[0]!r}: a reedtool bug")
     etree.indent(root, space="  ")
     data = etree.tostring(root, xml_declaration=True, encoding="utf-8", pretty_print=True)
     reread = etree.fromstring(data)
     tree = root.getroottree()
     lines = {id(element): reread.xpath(tree.getpath(node))[0].sourceline
              for element, node in written}
-    for kind in ("link", "joint"):
-        for node in reread.iterfind(f"./model/{kind}"):
-            lines[(kind, node.get("name"))] = node.sourceline
+    for key, node in nodes.items():
+        lines[key] = reread.xpath(tree.getpath(node))[0].sourceline
     return data, lines
 
 
@@ -196,6 +358,19 @@ def world_sdf(port: GzPort) -> bytes:
     _sub(world, "gravity", "0 0 -9.80665")
     for filename, name in port.world_systems:
         _sub(world, "plugin", filename=filename, name=name)
+    if any(sensor.attrib.get("type") == "navsat" for link in port.links
+           for sensor in link.sensors):
+        # gz-sim's NavSat system publishes nothing without it.
+        from reedtool.scaffold.gz_port import DEFAULT_HOME
+
+        latitude, longitude, elevation = port.home or DEFAULT_HOME
+        where = _sub(world, "spherical_coordinates")
+        _sub(where, "surface_model", "EARTH_WGS84")
+        _sub(where, "world_frame_orientation", "ENU")
+        _sub(where, "latitude_deg", _num(latitude))
+        _sub(where, "longitude_deg", _num(longitude))
+        _sub(where, "elevation", _num(elevation))
+        _sub(where, "heading_deg", "0")
     light = _sub(world, "light", type="directional", name="sun")
     _sub(light, "cast_shadows", "true")
     _sub(light, "pose", "0 0 10 0 0 0")
@@ -225,11 +400,19 @@ def port_files(port: GzPort, source: str, extra_plugins: list[Element] = (),
     rows: list[PortRow] = []
     files = []
     for uri, mesh in port.meshes.items():
+        outside = port.outside_files.get(uri)
+        if outside is not None and not port.copy_outside_files:
+            rows.append(PortRow(_mesh_loc(port, uri), f"mesh {uri}", "mapped", uris[uri],
+                                f"not copied: {outside}; referenced where it is (this "
+                                "machine only); pass --copy-outside-files to copy it into "
+                                "the port"))
+            continue
         if mesh.path is not None and Path(mesh.path).is_file():
             files.append(WrittenFile(PurePosixPath(uris[uri]),
                                      read_bytes(Path(mesh.path), what="mesh", max_bytes=None)))
             rows.append(PortRow(_mesh_loc(port, uri), f"mesh {uri}", "mapped", uris[uri],
-                                "copied; referenced relative to model.sdf"))
+                                "copied; referenced relative to model.sdf" + (
+                                    f" (--copy-outside-files: {outside})" if outside else "")))
         else:
             rows.append(PortRow(_mesh_loc(port, uri), f"mesh {uri}", "dropped", uris[uri],
                                 f"not found ({mesh.resolve_error or 'no file'}): referenced "

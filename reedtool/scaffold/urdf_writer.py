@@ -51,7 +51,15 @@ def ros2_urdf(robot, port: GzPort, mesh_uris: dict[str, str],
                               "reedtool migrate (model.sdf is the same model). "))
 
     def mesh_uri(uri: str) -> str:
-        return f"package://{port.name}/{mesh_uris[uri]}"
+        target = mesh_uris[uri]
+        if target.startswith("file://"):
+            return target            # a file from outside, left where it is
+        if target.startswith("../") and port.target_dir is not None:
+            # package:// cannot climb out of the package: the same file, absolutely.
+            from pathlib import Path
+
+            return (Path(port.target_dir).absolute() / target).resolve().as_uri()
+        return f"package://{port.name}/{target}"
 
     for link in robot.links:
         node = etree.SubElement(root, "link", name=link.name)
