@@ -87,7 +87,7 @@ def snippet_text(imported, package: str, name: str, collision_name: str | None) 
 
 
 def run_import(mesh: Path, package_dir: Path, *, name: str | None = None, units: str = "auto",
-               from_frame: str = "flu", mass_kg: float | None = None,
+               from_frame: str = "auto", mass_kg: float | None = None,
                density_kg_m3: float | None = None, recenter: str = "none",
                collision: str = "same", snippet_file: Path | None = None,
                force: bool = False, progress=None) -> ImportOutcome:
@@ -97,7 +97,8 @@ def run_import(mesh: Path, package_dir: Path, *, name: str | None = None, units:
     from reedtool.io.stl import stl_bytes
     from reedtool.physics.mesh_import import import_mesh
 
-    axis_convention(from_frame)  # an unknown frame is the error to report, not a refusal
+    if from_frame.strip().lower() != "auto":
+        axis_convention(from_frame)  # an unknown frame is the error to report, not a refusal
     from reedtool.errors import check_plausible
 
     if mass_kg is not None:
@@ -203,10 +204,12 @@ class _StageBar:
 @click.option("--name", default=None, help="Output name (default: the mesh file's stem).")
 @click.option("--units", default="auto", show_default=True,
               type=click.Choice(["auto", "mm", "cm", "m", "in"]),
-              help="Units of the STL; auto guesses from the size and says why.")
-@click.option("--from-frame", default="flu", show_default=True, metavar="FRAME",
+              help="Units of the STL; auto judges by the size and the mass (density), "
+                   "says why, and refuses naming the choices when more than one unit fits.")
+@click.option("--from-frame", default="auto", show_default=True, metavar="FRAME",
               help="Axes of the STL: ned, frd, flu, enu, nwu, y-up, z-up, or x/y/z letters "
-                   "from f/b, l/r, u/d (e.g. luf).")
+                   "from f/b, l/r, u/d (e.g. luf). auto: FLU, unless the mesh's extents say "
+                   "it stands on another axis (then it is refused, naming the choices).")
 @click.option("--mass", "mass_kg", type=float, default=None, help="Mass of the part [kg].")
 @click.option("--density", "density_kg_m3", type=float, default=None,
               help="Density [kg/m^3] (default 1000 when neither --mass nor --density is given).")
