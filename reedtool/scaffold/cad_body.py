@@ -130,6 +130,14 @@ def load_cad_body(spec, *, units: str = "auto", frame: str | None = None,
     check_geometry(spec)
     body = CadBody(imported, props, centre_m, centre_how, mounts, on_mounts, offsets, note)
     body.trim, body.total_com_m = hover_trim(spec, props)
+    if not body.trim.feasible:
+        # A model that cannot hover is not written: validate would refuse it (R307).
+        raise ReedtoolError(
+            f"the rotors about {centre_how.split(' (')[0]} cannot hold this body level: "
+            f"its centre of mass is at {_mm(props.com_m)} in the CAD frame; "
+            f"{body.trim.message}", file=spec.mesh,
+            hint="pass --center com (rotors about the COM), --center x,y,z, or move the CAD "
+                 "origin to the motor centre and export again")
     return body
 
 
