@@ -243,19 +243,29 @@ def test_the_same_body_in_any_unit_and_axes_gives_the_same_model(tmp_path, unit,
     mesh = tmp_path / f"body_{unit}_{axes}.stl"
     EX.write(mesh, V, F)
     extra = ("--mesh-frame", flag) if flag else ()
-    code, out = new_package(tmp_path, "q", mesh, *extra)
+    arm = ("--arm-length", "176.8 mm")    # the seed's command line
+    code, out = new_package(tmp_path / "first", "q", mesh, *extra)
+    if unit == "in":
+        # 15.1 units across at 1.2 kg: an inch body (0.38 m, 4,860 kg/m^3) or a cm one
+        # (0.15 m, 79,600 kg/m^3, a frame under a heavy body): asked, not guessed.
+        assert code == 2 and "fit in and cm" in out and "--mesh-units in or" in out, out
+    else:
+        assert code == 0, out
+    # With the arm length, the unit that puts the mesh's mounts under the rotors decides.
+    code, out = new_package(tmp_path / "a", "q", mesh, *extra, *arm)
     assert code == 0, out
     assert f"units: {unit} (" in out
-    urdf = expanded_urdf(tmp_path / "q")
+    assert "every rotor is on its mount" in out
+    urdf = expanded_urdf(tmp_path / "a" / "q")
     # The reference: the mm/NED seed body as written by new-package, built once here.
     ref_dir = tmp_path / "ref"
-    code, ref_out = new_package(ref_dir, "q", SEED_BODY, "--mesh-frame", "ned")
+    code, ref_out = new_package(ref_dir, "q", SEED_BODY, "--mesh-frame", "ned", *arm)
     assert code == 0, ref_out
     ref = expanded_urdf(ref_dir / "q")
     # float32 in any of these units spaces values near 0.2 m by <= 3e-8 m; rotor positions
     # are written to 1e-7 m: 2e-7 m holds both.
     np.testing.assert_allclose(rotor_origins(urdf), rotor_origins(ref), atol=2e-7)
-    np.testing.assert_allclose(read_stl(tmp_path / "q" / "meshes" / "body.stl").triangles,
+    np.testing.assert_allclose(read_stl(tmp_path / "a" / "q" / "meshes" / "body.stl").triangles,
                                read_stl(ref_dir / "q" / "meshes" / "body.stl").triangles,
                                atol=1e-7)
 

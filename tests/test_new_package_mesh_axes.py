@@ -47,7 +47,7 @@ def test_a_y_up_body_is_refused_without_mesh_frame_and_names_the_choices(tmp_pat
 
 def test_the_named_frame_is_taken_and_reported(tmp_path):
     mesh = box_stl(tmp_path / "body.stl", (0, 0, 0), (300, 60, 350))
-    code, out = new_package(tmp_path, "yup", mesh, "--mesh-frame", "y-up")
+    code, out = new_package(tmp_path, "yup", mesh, "--mesh-frame", "y-up", "--center", "com")
     assert code == 0, out
     assert "  units: mm (largest extent 350 units; as mm: 0.35 m across" in out
     assert "  frame: Y-UP → FLU" in out
@@ -61,7 +61,7 @@ def test_the_named_frame_is_taken_and_reported(tmp_path):
 
 def test_keeping_flu_on_purpose_is_allowed(tmp_path):
     mesh = box_stl(tmp_path / "body.stl", (0, 0, 0), (300, 60, 350))
-    code, out = new_package(tmp_path, "tall", mesh, "--mesh-frame", "flu")
+    code, out = new_package(tmp_path, "tall", mesh, "--mesh-frame", "flu", "--center", "com")
     assert code == 0, out
     assert "350 mm tall and 60 mm along y" in out   # said, not refused: the user chose
 

@@ -51,6 +51,9 @@ class ImportOutcome:
     mesh_file: Path
     collision_file: Path | None
     snippet: str
+    body_edit: object | None = None   # scaffold.package_body.BodyEdit for the package's model
+    body_written: bool = False        # the edit was written (--set-body)
+    body_backup: Path | None = None
 
 
 def snippet_text(imported, package: str, name: str, collision_name: str | None) -> str:
@@ -90,8 +93,12 @@ def run_import(mesh: Path, package_dir: Path, *, name: str | None = None, units:
                from_frame: str = "auto", mass_kg: float | None = None,
                density_kg_m3: float | None = None, recenter: str = "none",
                collision: str = "same", snippet_file: Path | None = None,
-               force: bool = False, progress=None) -> ImportOutcome:
-    """Import `mesh` into `package_dir`: the whole command without its printing."""
+               force: bool = False, progress=None, set_body: bool = False) -> ImportOutcome:
+    """Import `mesh` into `package_dir`: the whole command without its printing.
+
+    When the package's model is one new-package wrote (scaffold.package_body), the edit
+    that makes the mesh its body is planned: written with `set_body` (a numbered backup
+    of the model file first), else returned for its lines to be printed."""
     from reedtool.frames import axis_convention
     from reedtool.io.fileio import atomic_write_many, check_writable
     from reedtool.io.stl import stl_bytes
@@ -121,9 +128,23 @@ def run_import(mesh: Path, package_dir: Path, *, name: str | None = None, units:
         raise ReedtoolError("the output would overwrite the input mesh", file=mesh,
                             hint="pass a different --name")
 
-    imported = import_mesh(mesh, units=units, from_frame=from_frame, mass_kg=mass_kg,
+    from reedtool.scaffold.package_body import find_body_model, package_mass_kg
+
+    body_model = find_body_model(package_dir)
+    if set_body and body_model is None:
+        raise ReedtoolError("--set-body: no model in DIR/urdf/ declares the body properties "
+                            "(mesh_file and body_inertia) new-package writes", file=package_dir,
+                            hint="set the body by hand from the snippet, or create the package "
+                                 "with `reedtool new-package`")
+    # The body's mass is the package's unless given: it is what the model flies with.
+    body_mass = None
+    if body_model is not None and mass_kg is None and density_kg_m3 is None:
+        body_mass = package_mass_kg(body_model)
+    imported = import_mesh(mesh, units=units, from_frame=from_frame,
+                           mass_kg=mass_kg if body_mass is None else body_mass,
                            density_kg_m3=density_kg_m3, recenter=recenter,
-                           collision=collision, progress=progress)
+                           collision=collision, progress=progress,
+                           role="body" if body_model is not None else "part")
     if progress:
         progress("writing")
     header = f"reedtool import-stl {mesh.name}: metres, FLU"
@@ -135,9 +156,23 @@ def run_import(mesh: Path, package_dir: Path, *, name: str | None = None, units:
                            collision_file.stem if collision_file is not None else None)
     if snippet_file is not None:
         outputs.append((snippet_file, snippet.encode("utf-8")))
+    edit = None
+    if body_model is not None:
+        from reedtool.scaffold.package_body import check_edit, plan_body_edit
+
+        edit = plan_body_edit(body_model, package, name, imported.mass,
+                              set_mass=mass_kg is not None or density_kg_m3 is not None)
+        check_edit(edit, imported.mass)
     # All or nothing: a snippet that cannot be written must not leave the meshes behind.
     atomic_write_many(outputs, force=force)
-    return ImportOutcome(imported, package, mesh_file, collision_file, snippet)
+    backup = None
+    if set_body:
+        from reedtool.io.fileio import atomic_write_text
+
+        backup = atomic_write_text(edit.file, edit.new_text, force=True, backup=True,
+                                   encoding=edit.encoding, in_place=True)
+    return ImportOutcome(imported, package, mesh_file, collision_file, snippet, edit,
+                         set_body, backup)
 
 
 def _vector(v) -> str:
@@ -181,6 +216,17 @@ def report_lines(outcome: ImportOutcome) -> list[str]:
     if outcome.collision_file is not None and imp.collision_m is not None:
         lines.append(f"wrote {outcome.collision_file} ({imp.collision.kind}, "
                      f"{len(imp.collision_m)} triangles)")
+    edit = outcome.body_edit
+    if edit is not None:
+        if outcome.body_written:
+            lines.append(f"set the body of {edit.file} to this mesh (backup: "
+                         f"{outcome.body_backup}):")
+        else:
+            lines.append(f"to make it the body of {edit.file}, change these lines (or pass "
+                         "--set-body to write them, keeping a backup):")
+        lines.extend(f"  {line}" for line in edit.lines)
+        lines.append("  the rotors stay where the model puts them; `reedtool new-package "
+                     "--mesh` places them on the body's motor mounts")
     return lines
 
 
@@ -221,8 +267,13 @@ class _StageBar:
 @click.option("--snippet", "snippet_file", type=click.Path(path_type=Path, dir_okay=False),
               default=None, help="Write the URDF/xacro snippet here instead of printing it.")
 @click.option("--force", is_flag=True, help="Overwrite existing output files.")
+@click.option("--set-body", is_flag=True,
+              help="Make the mesh the body of the package's model (a package new-package "
+                   "wrote): set mesh_file, body_com_xyz, body_inertia (and mass, with "
+                   "--mass or --density) in its xacro file, keeping a numbered backup. "
+                   "Without it those lines are printed.")
 def command(mesh, package_dir, name, units, from_frame, mass_kg, density_kg_m3, recenter,
-            collision, snippet_file, force) -> int:
+            collision, snippet_file, force, set_body=False) -> int:
     """Import a CAD STL into a package: metres, FLU axes, inertia about the COM.
 
     Writes DIR/meshes/NAME.stl (binary, metres, FLU), optionally NAME_collision.stl, and
@@ -234,7 +285,7 @@ def command(mesh, package_dir, name, units, from_frame, mass_kg, density_kg_m3, 
            and mesh.stat().st_size >= PROGRESS_MIN_BYTES)
     kwargs = dict(name=name, units=units, from_frame=from_frame, mass_kg=mass_kg,
                   density_kg_m3=density_kg_m3, recenter=recenter, collision=collision,
-                  snippet_file=snippet_file, force=force)
+                  snippet_file=snippet_file, force=force, set_body=set_body)
     if big:
         with click.progressbar(length=len(STAGES) - 1, label="import-stl", file=sys.stderr) as bar:
             outcome = run_import(mesh, package_dir, progress=_StageBar(bar), **kwargs)

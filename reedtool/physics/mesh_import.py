@@ -87,6 +87,7 @@ def import_mesh(path: str | Path, *, units: str = "auto", from_frame: str = "aut
                 mass_kg: float | None = None, density_kg_m3: float | None = None,
                 recenter: str = "none", collision: str = "same", progress=None,
                 arm_radial_m: float | None = None, role: str = "part",
+                mount_count: int | None = None,
                 flags: tuple[str, str] = ("--units", "--from-frame")) -> ImportedMesh:
     """Read a CAD mesh (STL, COLLADA .dae, OBJ) and return it in metres and FLU with its
     mass properties. A .dae's <unit> is honoured (COLLADA node transforms applied).
@@ -94,7 +95,9 @@ def import_mesh(path: str | Path, *, units: str = "auto", from_frame: str = "aut
     `units` and `from_frame` may be "auto": physics.mesh_units decides from the size, the
     mass (density) and `arm_radial_m` (centre to rotor axis), or refuses naming the
     choices and `flags` (the command's own option names). `role` is "body" for a
-    vehicle's body (tighter size bounds), else "part".
+    vehicle's body (tighter size bounds), else "part". `mount_count` motor mounts, when
+    the mesh has them where the arm length puts rotors, settle a unit size and density
+    leave open.
     `progress(stage_name)` is called before each stage, for a progress bar.
     """
     step = progress or (lambda _stage: None)
@@ -124,9 +127,27 @@ def import_mesh(path: str | Path, *, units: str = "auto", from_frame: str = "aut
         raise ReedtoolError(exc.message, file=path, hint=exc.hint) from exc
     cues = UnitCues(float(np.max(check.extent)), float(raw.volume_m3), mass_kg,
                     arm_radial_m, role)
-    choice = mesh_units.choose_units(units, cues,
-                                     declared_m=read.metres_per_unit if read.unit_declared
-                                     else None, flag=flags[0], file=path)
+    declared = read.metres_per_unit if read.unit_declared else None
+    try:
+        choice = mesh_units.choose_units(units, cues, declared_m=declared, flag=flags[0],
+                                         file=path)
+    except ReedtoolError:
+        if not (mount_count and arm_radial_m and units == "auto"):
+            raise
+        # Sizes and density leave more than one unit: the motor mounts settle it, if the
+        # mesh has them, as the unit that puts them under the rotors of the arm length.
+        frame, _ = mesh_units.choose_axes(from_frame, read.triangles, flag=flags[1],
+                                          file=path, shown_unit=(1.0, "file units"))
+        from reedtool.physics.motor_mounts import find_mounts
+
+        found = find_mounts(read.triangles @ frame.R_flu_src.T, mount_count).mounts
+        if not found:
+            raise
+        centre = np.mean([m.xy_m for m in found], axis=0)
+        radial = float(np.mean([np.linalg.norm(m.xy_m - centre) for m in found]))
+        cues = UnitCues(cues.largest_extent, cues.volume, mass_kg, arm_radial_m, role, radial)
+        choice = mesh_units.choose_units(units, cues, declared_m=declared, flag=flags[0],
+                                         file=path)
     frame, axes = mesh_units.choose_axes(from_frame, read.triangles * choice.metres_per_unit,
                                          flag=flags[1], file=path)
 

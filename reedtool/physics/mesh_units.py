@@ -38,16 +38,23 @@ UNITS_M = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254}
 SIZE_M = {"part": (0.01, 5.0), "body": (0.03, 3.0)}
 
 # Mean density of a mesh filled uniformly with the declared mass [kg/m^3].
-# Upper: a body cannot average more than its densest material; nothing in a flying machine
-#   is denser than lead (11,340) except tungsten ballast, so a body is bounded by lead; a
-#   part (a tungsten weight, 19,300) by osmium, the densest matter at room conditions
-#   (22,590).
 # Lower: a closed shell filled uniformly counts the air inside as body. A DJI Phantom 4
 #   (1.38 kg, shell about 0.29 x 0.29 x 0.19 m, half of it air around the shell: ~8 L)
 #   averages ~170 kg/m^3; a Matrice 300 body (3.6 kg without battery, ~0.43 x 0.43 x 0.2 m,
 #   half filled: ~18 L) ~200. Ten times emptier than those is 17; the bound is 10, still
 #   above expanded-polystyrene foam's 10-30 for the shell alone.
-DENSITY_KG_M3 = {"part": (10.0, 22_590.0), "body": (10.0, 11_340.0)}
+# Upper, a part (its own mass): osmium, the densest matter at room conditions (22,590).
+# Upper, a body: the mesh may be the frame alone while the mass is the whole body's
+#   (battery, motors, electronics on it). A 450-class frame's two 2 mm carbon plates are
+#   about 40 cm^3 under a 1.5 kg body: 37,500 kg/m^3; 1e5 leaves room for lighter frames
+#   under heavier bodies. The window is still 1e4 wide, less than the 16,387 between mm
+#   and inch: density alone always tells those two apart.
+DENSITY_KG_M3 = {"part": (10.0, 22_590.0), "body": (10.0, 1e5)}
+
+# Motor mounts found in the mesh (physics.motor_mounts) against the arm length given: the
+# unit that puts the mounts under the rotors. Units differ by 2.54x at least; a rotor
+# circle within 15 % of the mounts' is the same circle, not another unit's.
+MOUNTS_TO_ARM = 0.15
 
 # Rotor circle radius (centre to rotor axis) over the body's half-span (largest extent / 2).
 # Lower: a body may reach past its rotors (a VTOL's wing spans 2 m over rotors 0.5 m out:
@@ -78,6 +85,7 @@ class UnitCues:
     mass_kg: float | None = None
     arm_radial_m: float | None = None
     role: str = "part"               # "part" | "body"
+    mount_radial: float | None = None  # motor mounts' distance from their centre, file units
 
 
 def _fmt(value: float) -> str:
@@ -106,6 +114,12 @@ def judge_unit(unit: str, cues: UnitCues) -> tuple[bool, str, str]:
         if not alow <= ratio <= ahigh:
             failures.append(f"rotors {_fmt(ratio)} half-spans out, a body's are "
                             f"{alow:g}-{ahigh:g}")
+    if cues.mount_radial is not None and cues.arm_radial_m:
+        mounts_m = cues.mount_radial * s
+        parts.append(f"motor mounts {_fmt(mounts_m)} m out")
+        if abs(mounts_m / cues.arm_radial_m - 1.0) > MOUNTS_TO_ARM:
+            failures.append(f"motor mounts {_fmt(mounts_m)} m out, the rotors "
+                            f"{_fmt(cues.arm_radial_m)} m")
     return not failures, ", ".join(parts), failures[0] if failures else ""
 
 
@@ -183,24 +197,27 @@ def _conventions_with(source_axis: int, letter: str, assumed: str) -> tuple[str,
     return tuple(dict.fromkeys(named + codes[:1]))
 
 
-def read_axes(vertices_flu_m: np.ndarray, frame: AxisConvention) -> AxisReading:
+def read_axes(vertices_flu_m: np.ndarray, frame: AxisConvention,
+              shown_unit: tuple[float, str] = (1000.0, "mm")) -> AxisReading:
     """Does the mesh (vertices already turned to FLU by `frame`, in metres, CAD origin kept)
     sit as a body does: thinnest extent up, not hanging wholly below its origin? Otherwise,
-    the conventions that fit its extents."""
+    the conventions that fit its extents. Sizes are shown times shown_unit[0], named
+    shown_unit[1]. The verdict does not depend on the unit."""
+    factor, mm = shown_unit
     vertices = np.asarray(vertices_flu_m, dtype=float).reshape(-1, 3)
     low, high = vertices.min(axis=0), vertices.max(axis=0)
     size = high - low
     R = frame.R_flu_src
     names = "xyz"
     thinnest = int(np.argmin(size))
-    shown = " x ".join(f"{s * 1000:.4g}" for s in size)
+    shown = " x ".join(f"{s * factor:.4g}" for s in size)
     label = frame.name.upper()
     if thinnest != 2 and size[2] > TALLER_THAN_THINNEST * size[thinnest]:
         source_axis = int(np.argmax(np.abs(R[thinnest])))   # the source axis on FLU `thinnest`
         return AxisReading(
             _conventions_with(source_axis, "u", frame.code),
-            f"read as {label} the body is {shown} mm (x, y, z in FLU): "
-            f"{size[2] * 1000:.4g} mm tall and {size[thinnest] * 1000:.4g} mm along "
+            f"read as {label} the body is {shown} {mm} (x, y, z in FLU): "
+            f"{size[2] * factor:.4g} {mm} tall and {size[thinnest] * factor:.4g} {mm} along "
             f"{names[thinnest]}; a body is thinnest in height, so its source "
             f"{names[source_axis]} axis is most likely up")
     if low[2] < 0 and high[2] <= ORIGIN_SLACK * size[2]:
@@ -208,23 +225,24 @@ def read_axes(vertices_flu_m: np.ndarray, frame: AxisConvention) -> AxisReading:
         return AxisReading(
             _conventions_with(source_axis, "d", frame.code),
             f"read as {label} the body lies wholly below its origin "
-            f"(z from {low[2] * 1000:.4g} to {high[2] * 1000:.4g} mm): a part drawn upward "
+            f"(z from {low[2] * factor:.4g} to {high[2] * factor:.4g} {mm}): a part drawn upward "
             f"from its CAD origin in a {names[source_axis]}-down export")
     where = ("above its origin" if low[2] >= -ORIGIN_SLACK * size[2] else
              "across its origin in height (no sign of which way is up: the convention "
              "given or assumed decides)")
-    return AxisReading((), f"read as {label} the body is {shown} mm (x, y, z in FLU), "
+    return AxisReading((), f"read as {label} the body is {shown} {mm} (x, y, z in FLU), "
                            f"thinnest in height, as a body is, and lies {where}")
 
 
 def choose_axes(given: str, vertices_src: np.ndarray, *, flag: str = "--from-frame",
-                file=None) -> tuple[AxisConvention, AxisReading]:
+                file=None, shown_unit: tuple[float, str] = (1000.0, "mm")
+                ) -> tuple[AxisConvention, AxisReading]:
     """The mesh's axis convention: `given`, or under "auto" FLU unless the extents say the
     mesh stands on another axis (then refused, naming the conventions that fit)."""
     auto = given.strip().lower() == "auto"
     frame = axis_convention("flu" if auto else given)
     vertices = np.asarray(vertices_src, dtype=float).reshape(-1, 3) @ frame.R_flu_src.T
-    reading = read_axes(vertices, frame)
+    reading = read_axes(vertices, frame, shown_unit)
     if auto and reading.suggested:
         choices = " or ".join(f"{flag} {name}" for name in reading.suggested)
         raise ReedtoolError(

@@ -84,9 +84,12 @@ def load_cad_body(spec, *, units: str = "auto", frame: str | None = None,
     multirotor = spec.kind == "multirotor"
     arm_given = multirotor and spec.origin.get("arm_length") != "default"
     arm_radial = (spec["arm_length"] * spec.frame.radial_per_arm_length) if arm_given else None
+    coaxial = multirotor and any(slot.level < 0 for slot in spec.frame.rotors)
     imported = import_mesh(spec.mesh, units=units, from_frame=frame or "auto",
                            mass_kg=spec["mass"], role="body" if multirotor else "part",
-                           arm_radial_m=arm_radial, flags=("--mesh-units", "--mesh-frame"))
+                           arm_radial_m=arm_radial, flags=("--mesh-units", "--mesh-frame"),
+                           mount_count=spec.frame.rotor_count if multirotor and not coaxial
+                           else None)
     props = imported.mass
     _size_body_box(spec, imported)
     vertices = imported.triangles_m.reshape(-1, 3)
@@ -96,7 +99,6 @@ def load_cad_body(spec, *, units: str = "auto", frame: str | None = None,
         return CadBody(imported, props, np.zeros(3), "the CAD origin", MountReading((), ""),
                        False, [], "")
 
-    coaxial = any(slot.level < 0 for slot in spec.frame.rotors)
     mounts = (MountReading((), "a coaxial frame: rotors are placed by the arm length")
               if coaxial else find_mounts(imported.triangles_m, spec.frame.rotor_count))
     slots = _mount_slots(spec, mounts) if mounts.mounts else None
