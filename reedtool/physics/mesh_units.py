@@ -112,8 +112,8 @@ def judge_unit(unit: str, cues: UnitCues) -> tuple[bool, str, str]:
         alow, ahigh = ARM_OVER_HALF_SPAN
         parts.append(f"rotors {_fmt(cues.arm_radial_m)} m out = {_fmt(ratio)} half-spans")
         if not alow <= ratio <= ahigh:
-            failures.append(f"rotors {_fmt(ratio)} half-spans out, a body's are "
-                            f"{alow:g}-{ahigh:g}")
+            failures.append(f"rotors {_fmt(ratio)} half-spans out, where a body puts "
+                            f"them {alow:g}-{ahigh:g}")
     if cues.mount_radial is not None and cues.arm_radial_m:
         mounts_m = cues.mount_radial * s
         parts.append(f"motor mounts {_fmt(mounts_m)} m out")

@@ -159,7 +159,7 @@ def _resolve_centre(choice, props, mounts) -> tuple[np.ndarray, str]:
     if isinstance(choice, np.ndarray):
         return choice, "given with --center"
     if choice == "com":
-        return np.array(props.com_m, dtype=float), "the body's centre of mass (--center com)"
+        return np.array(props.com_m, dtype=float), "the body COM (--center com)"
     if choice == "mounts":
         if not mounts.mounts:
             raise ReedtoolError(f"--center mounts: {mounts.reason}",

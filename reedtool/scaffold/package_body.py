@@ -76,6 +76,7 @@ def plan_body_edit(model_file: Path, package: str, mesh_name: str, props,
         set_properties,
     )
     from reedtool.physics.inertia import fmt_number
+    from reedtool.scaffold.package_spec import com_text
 
     text, encoding = read_xml_file(model_file, what="xacro file")
     values = {"mesh_file": f"package://{package}/meshes/{mesh_name}.stl"}
@@ -83,17 +84,17 @@ def plan_body_edit(model_file: Path, package: str, mesh_name: str, props,
         values["use_mesh_file"] = "true"
     com = np.asarray(props.com_m, dtype=float)
     if property_value_span(text, "body_com_xyz") is not None:
-        values["body_com_xyz"] = " ".join(fmt_number(float(v) + 0.0) for v in com)
+        values["body_com_xyz"] = com_text(com)
     elif np.linalg.norm(com) > 1e-6:
         # The RotorS macro's <inertial> is fixed at the body origin: a COM elsewhere
         # cannot be written without moving the mesh, which is what the user must not get.
         raise ReedtoolError(
-            f"the body's centre of mass is at ({', '.join(f'{v * 1000:.4g}' for v in com)}) mm "
-            f"from the mesh origin, and {model_file.name} has no body_com_xyz property (its "
-            "body is RotorS' multirotor_base_macro, whose <inertial> is at the origin)",
+            f"the body COM is ({', '.join(f'{v * 1000:.4g}' for v in com)}) mm off the mesh "
+            f"origin and {model_file.name} has no body_com_xyz property: its body is the "
+            "RotorS multirotor_base_macro, whose <inertial> sits at the origin",
             file=model_file,
-            hint="regenerate the package with `reedtool new-package NAME --mesh MESH` (it "
-                 "writes the body with its COM), or pass --recenter com to move the mesh")
+            hint="regenerate the package with `reedtool new-package NAME --mesh MESH`, which "
+                 "writes the body with its COM, or pass --recenter com to move the mesh")
     mass_kg = float(props.mass_kg)
     if set_mass:
         values["mass"] = fmt_number(mass_kg)

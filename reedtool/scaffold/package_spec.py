@@ -519,6 +519,13 @@ def _centred(centre_m: float, expr: str) -> str:
     return f"{fmt_number(centre_m)} + {expr}"
 
 
+def com_text(com_m) -> str:
+    """A COM as an xyz attribute; below a nanometre is the mesh integral's round-off: 0."""
+    from reedtool.physics.inertia import fmt_number
+
+    return " ".join(fmt_number(0.0 if abs(v) < 1e-9 else float(v)) for v in com_m)
+
+
 def _body_depth_m(spec: PackageSpec) -> float:
     """How far the body reaches below base_link: the mesh's lowest point, else half the box."""
     if spec.cad is not None:
@@ -636,7 +643,7 @@ def _multirotor_context(spec: PackageSpec, body_props) -> dict:
         "frame_reference": frame.reference,
         "body_inertia": _inertia_attrs(body_props.inertia_kg_m2),
         "body_inertia_source": body_source,
-        "body_com_xyz": " ".join(fmt_number(float(v) + 0.0) for v in body_com),
+        "body_com_xyz": com_text(body_com),
         "rotor_inertia": _inertia_attrs(rotor_I),
         "total_mass_kg": fmt_number(total.mass_kg),
         "total_inertia": _inertia_attrs(I_total),
@@ -684,7 +691,7 @@ def _ground_context(spec: PackageSpec, body_props) -> dict:
         "drive": layout.drive,
         "body_inertia": _inertia_attrs(body_props.inertia_kg_m2),
         "body_inertia_source": body_source,
-        "body_com_xyz": " ".join(fmt_number(float(v) + 0.0) for v in body_props.com_m),
+        "body_com_xyz": com_text(body_props.com_m),
         "wheel_inertia": _inertia_attrs(cylinder_inertia(spec["wheel_mass"], r,
                                                          spec["wheel_width"], axis="y")),
         "base_height": fmt_number(base_height_m),
