@@ -221,13 +221,8 @@ def apply_fix_xacro(model: Path, comparisons) -> tuple[list[str], set[str]]:
     file, never in a file of reedtool's install.
     """
     from reedtool.io.fileio import atomic_write_text, read_xml_file
-    from reedtool.io.xacro_edit import (
-        inertia_element,
-        inertia_elements_matching,
-        replace_span,
-        users_file,
-    )
-    from reedtool.physics.inertia import inertial_xml
+    from reedtool.io.xacro_edit import inertia_elements_matching, replace_span, users_file
+    from reedtool.physics.inertia import inertia_element, inertial_xml
 
     edits: dict[tuple[str, int, int], tuple[object, np.ndarray, list[str]]] = {}
     printed: list[str] = []
@@ -251,12 +246,15 @@ def apply_fix_xacro(model: Path, comparisons) -> tuple[list[str], set[str]]:
                 entry = edits.setdefault(key, (spans[0], props.inertia_kg_m2, []))
                 entry[2].append(c.link)
             continue
-        inside = (f"the macro body at {c.loc.macro}, called at {c.loc}" if c.loc.macro
-                  else f"{c.loc}")
         if c.loc.macro and not users_file(c.loc.macro_file, model):
-            inside = (f"the <inertial> a macro writes from the call at {c.loc} (the macro "
-                      "is not in your package: pass the block there)")
-        printed.append(f"--fix: link '{c.link}': set the <inertial> of {inside} to")
+            where = (f"written by the macro called at {c.loc} (the macro is not in your "
+                     "package: pass the block there)")
+        elif c.loc.macro:
+            # The element is written once in the macro body; the call says which link.
+            where = f"in the macro body at {c.loc.macro} (the call at {c.loc})"
+        else:
+            where = f"at {c.loc}"
+        printed.append(f"--fix: link '{c.link}': replace the <inertial> {where} with")
         printed.append(inertial_xml(props, indent="  "))
         printed.append("")
 

@@ -77,14 +77,6 @@ def inertia_elements_matching(text: str, tensor_kg_m2, rtol: float = 1e-6) -> li
     return found
 
 
-def inertia_element(tensor_kg_m2) -> str:
-    from reedtool.physics.inertia import clean_tensor, fmt_number
-
-    I = clean_tensor(np.asarray(tensor_kg_m2, dtype=float))
-    return "<inertia " + " ".join(f'{key}="{fmt_number(I[_INDEX[key]])}"'
-                                  for key in INERTIA_KEYS) + " />"
-
-
 def replace_span(text: str, span: Span, new: str) -> str:
     return text[:span.start] + new + text[span.end:]
 
@@ -128,8 +120,8 @@ def set_properties(text: str, values: dict[str, str]) -> tuple[str, list[str]]:
     return text, missing
 
 
-def set_block_inertia(text: str, name: str, tensor_kg_m2) -> tuple[str, Span | None]:
-    """`text` with the <inertia/> inside block property NAME replaced by `tensor_kg_m2`."""
+def set_block_inertia(text: str, name: str, element: str) -> tuple[str, Span | None]:
+    """`text` with the <inertia/> inside block property NAME replaced by `element`."""
     block = property_block_span(text, name)
     if block is None:
         return text, None
@@ -137,4 +129,4 @@ def set_block_inertia(text: str, name: str, tensor_kg_m2) -> tuple[str, Span | N
     if match is None:
         return text, None
     span = Span(match.start(), match.end(), _line(text, match.start()))
-    return replace_span(text, span, inertia_element(tensor_kg_m2)), span
+    return replace_span(text, span, element), span

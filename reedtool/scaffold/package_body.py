@@ -69,13 +69,8 @@ def plan_body_edit(model_file: Path, package: str, mesh_name: str, props,
     """The edit that makes meshes/MESH_NAME.stl (with `props`: MassProperties in the
     mesh's frame) the body of `model_file`."""
     from reedtool.io.fileio import read_xml_file
-    from reedtool.io.xacro_edit import (
-        inertia_element,
-        property_value_span,
-        set_block_inertia,
-        set_properties,
-    )
-    from reedtool.physics.inertia import fmt_number
+    from reedtool.io.xacro_edit import property_value_span, set_block_inertia, set_properties
+    from reedtool.physics.inertia import fmt_number, inertia_element
     from reedtool.scaffold.package_spec import com_text
 
     text, encoding = read_xml_file(model_file, what="xacro file")
@@ -100,7 +95,8 @@ def plan_body_edit(model_file: Path, package: str, mesh_name: str, props,
         values["mass"] = fmt_number(mass_kg)
     new_text, missing = set_properties(text, values)
     missing = [name for name in missing if name != "use_mesh_file"]
-    new_text, inertia_span = set_block_inertia(new_text, "body_inertia", props.inertia_kg_m2)
+    new_text, inertia_span = set_block_inertia(new_text, "body_inertia",
+                                               inertia_element(props.inertia_kg_m2))
     if missing or inertia_span is None:
         raise ReedtoolError(f"{model_file.name} has no {' / '.join(missing or ['body_inertia'])}"
                             " property to set", file=model_file)
