@@ -145,6 +145,8 @@ def run_import(mesh: Path, package_dir: Path, *, name: str | None = None, units:
                            density_kg_m3=density_kg_m3, recenter=recenter,
                            collision=collision, progress=progress,
                            role="body" if body_model is not None else "part")
+    if body_mass is not None:
+        imported.mass_source = f"the body mass in {body_model.name}"
     if progress:
         progress("writing")
     header = f"reedtool import-stl {mesh.name}: metres, FLU"

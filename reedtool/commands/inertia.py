@@ -108,8 +108,8 @@ def format_text(model: Path, robot, comparisons, whole, own, findings=()) -> str
         lines.append(f"{len(failing)} of {len(comparisons)} links need attention (error, as in "
                      "validate): " + ", ".join(f"{c.link} ({c.verdict})" for c in failing))
     if failing or warned:
-        lines.append("pass --fix to write the geometry's inertia into a .urdf, or to print "
-                     "the blocks to paste into a .xacro")
+        lines.append("pass --fix to write the geometry's inertia into the model (a .urdf, or "
+                     "the <inertia/> in your xacro file it comes from)")
     if not failing and not warned:
         lines.append("no link inertia needs attention")
     return "\n".join(lines) + "\n"

@@ -243,6 +243,10 @@ def choose_axes(given: str, vertices_src: np.ndarray, *, flag: str = "--from-fra
     frame = axis_convention("flu" if auto else given)
     vertices = np.asarray(vertices_src, dtype=float).reshape(-1, 3) @ frame.R_flu_src.T
     reading = read_axes(vertices, frame, shown_unit)
+    if not auto and reading.suggested:
+        # The user's word is taken; what the extents say is kept beside it.
+        reading = AxisReading(reading.suggested,
+                              f"{reading.reason} (taken as given with {flag} {given})")
     if auto and reading.suggested:
         choices = " or ".join(f"{flag} {name}" for name in reading.suggested)
         raise ReedtoolError(
