@@ -318,3 +318,32 @@ def test_import_stl_refuses_a_z_down_mesh_instead_of_turning_it_upside_down(tmp_
     assert code == 0, out
     assert "frame: NED → FLU: 180° about x" in out
     assert "lies above its origin" in out
+
+
+def test_an_iris_shaped_body_puts_the_rotors_on_its_uneven_mounts(tmp_path):
+    """PX4's iris has its front motors 0.22 m out to the side and its back ones 0.20 m
+    (iris.sdf rotor poses (0.13, +-0.22), (-0.13, +-0.20)); reedtool's mount finder puts
+    them within 8 mm of those on iris.stl itself. Built here in that shape (our own
+    parts): the rotors land on the mounts, not on a symmetric pattern."""
+    from reedtool.io.stl import stl_bytes
+
+    mounts_mm = [(130.0, -220.0), (-130.0, 200.0), (130.0, 220.0), (-130.0, -200.0)]
+    parts = [EX.box_mesh((-60.0, -50.0, 0.0), (60.0, 50.0, 20.0))]
+    for x, y in mounts_mm:
+        parts.append(EX.cylinder_mesh(x, y, 16.0, 0.0, 25.0, 40))
+        length = np.hypot(x, y)
+        yaw = np.arctan2(y, x)
+        parts.append(EX.box_mesh((75.0, -6.0, 5.0), (length - 15.0, 6.0, 15.0), yaw))
+    mesh = tmp_path / "iris_like.stl"
+    mesh.write_bytes(stl_bytes(np.vstack([V[F] for V, F in parts])))
+    code, out = new_package(tmp_path, "irisish", mesh, "--mesh-units", "mm")
+    assert code == 0, out
+    assert "4 round mounts at the arm tips" in out and "every rotor is on its mount" in out
+    rotors = rotor_origins(expanded_urdf(tmp_path / "irisish"))
+    # PX4 order FR, BL, FL, BR = the mounts as listed; 40-gon vertices on the circle:
+    # the fitted centre to float32 (1e-7 m).
+    np.testing.assert_allclose(rotors[:, :2], np.array(mounts_mm) / 1000.0, atol=2e-7)
+    np.testing.assert_allclose(rotors[:, 2], 0.025 + 0.026, atol=2e-7)
+    code, report = run_cli("validate", tmp_path / "irisish" / "urdf" /
+                           "mav_generic_odometry_sensor.gazebo", "--package-path", tmp_path)
+    assert code == 0, report
