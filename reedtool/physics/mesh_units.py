@@ -35,7 +35,8 @@ UNITS_M = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254}
 # - body (the vehicle's body, new-package --mesh): from a 65 mm tiny-whoop frame's
 #   body (3 cm) to the largest multirotors that exist (DJI Agras T50: 2.8 m across the
 #   unfolded arms): 0.03 .. 3 m.
-SIZE_M = {"part": (0.01, 5.0), "body": (0.03, 3.0)}
+# - link (a mesh in a model validate reads): a part's sizes.
+SIZE_M = {"part": (0.01, 5.0), "body": (0.03, 3.0), "link": (0.01, 5.0)}
 
 # Mean density of a mesh filled uniformly with the declared mass [kg/m^3].
 # Lower: a closed shell filled uniformly counts the air inside as body. A DJI Phantom 4
@@ -49,7 +50,8 @@ SIZE_M = {"part": (0.01, 5.0), "body": (0.03, 3.0)}
 #   about 40 cm^3 under a 1.5 kg body: 37,500 kg/m^3; 1e5 leaves room for lighter frames
 #   under heavier bodies. The window is still 1e4 wide, less than the 16,387 between mm
 #   and inch: density alone always tells those two apart.
-DENSITY_KG_M3 = {"part": (10.0, 22_590.0), "body": (10.0, 1e5)}
+#   A link's mesh in a model is judged as a body: its <mass> may be more than the mesh's own.
+DENSITY_KG_M3 = {"part": (10.0, 22_590.0), "body": (10.0, 1e5), "link": (10.0, 1e5)}
 
 # Motor mounts found in the mesh (physics.motor_mounts) against the arm length given: the
 # unit that puts the mounts under the rotors. Units differ by 2.54x at least; a rotor
@@ -158,6 +160,24 @@ def choose_units(given: str, cues: UnitCues, *, declared_m: float | None = None,
         message = f"which unit? {said} fit no unit ({choices})"
     raise ReedtoolError(message, file=file,
                         hint="pass " + " or ".join(f"{flag} {u}" for u in listed))
+
+
+UNIT_WORDS = {"mm": "millimetres", "cm": "centimetres", "in": "inches", "m": "metres"}
+
+
+def units_read_as_metres(largest_extent_m: float, volume_m3: float | None,
+                         mass_kg: float | None) -> list[str]:
+    """The units (mm, in, cm) a mesh Gazebo reads as metres was most likely written in:
+    those that make it a plausible link (size, and density at its link's mass), in
+    UNIT_ORDER; [] when none does. validate's mesh-unit rules name them (I206, I210)."""
+    cues = UnitCues(largest_extent_m, volume_m3, mass_kg, None, "link")
+    return [unit for unit in UNIT_ORDER if unit != "m" and judge_unit(unit, cues)[0]]
+
+
+def signed_volume(triangles: np.ndarray) -> float:
+    """|Volume| enclosed by a closed triangle mesh (divergence theorem), in its units^3."""
+    t = np.asarray(triangles, dtype=float)
+    return abs(float(np.einsum("ij,ij->", t[:, 0], np.cross(t[:, 1], t[:, 2]))) / 6.0)
 
 
 def _unit_name(metres_per_unit: float) -> str:
