@@ -347,3 +347,17 @@ def test_an_iris_shaped_body_puts_the_rotors_on_its_uneven_mounts(tmp_path):
     code, report = run_cli("validate", tmp_path / "irisish" / "urdf" /
                            "mav_generic_odometry_sensor.gazebo", "--package-path", tmp_path)
     assert code == 0, report
+
+
+def test_a_named_centre_without_an_arm_length_takes_the_arm_from_the_mounts(tmp_path):
+    code, out = new_package(tmp_path, "c", SEED_BODY, "--mesh-frame", "ned", "--center", "com")
+    assert code == 0, out
+    assert "rotors at arm_length 0.1768 m (measured from the motor mounts) about the rotor " \
+           "centre" in out
+    rotors = rotor_origins(expanded_urdf(tmp_path / "c"))
+    com = analytic_body_com_flu_m()
+    # The mounts' pattern (a = 176.8 mm, float32: 1e-6 m) about the body COM.
+    np.testing.assert_allclose(np.abs(rotors[:, 0] - com[0]), MOUNT_M, atol=1e-6)
+    np.testing.assert_allclose(np.abs(rotors[:, 1] - com[1]), MOUNT_M, atol=1e-6)
+    # Centred on the COM, the rotors are off the mounts by the COM's x offset, and say so.
+    assert "NOT over the mesh's motor mounts" in out

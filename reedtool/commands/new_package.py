@@ -150,10 +150,10 @@ def _summary(result: NewPackageResult, spec) -> list[str]:
               help="Axes the mesh was exported in (flu, ned, frd, y-up, ...). Default: FLU, "
                    "unless the mesh's extents say it stands on another axis (then say which).")
 @click.option("--center", "center", default=None, metavar="origin|com|mounts|X,Y,Z",
-              help="With --mesh: the point the rotors are placed about with --arm-length, in "
-                   "the CAD frame (FLU): the CAD origin (default), the body's COM, the motor "
-                   "mounts' centre, or x,y,z with a unit ('15.2,0,0 mm'). Without "
-                   "--arm-length the rotors go on the motor mounts found in the mesh.")
+              help="With --mesh: the point the rotor pattern is centred on, in the CAD frame "
+                   "(FLU): the CAD origin (default with --arm-length), the body's COM, the "
+                   "motor mounts' centre, or x,y,z with a unit ('15.2,0,0 mm'). Without "
+                   "--center and --arm-length the rotors go on the mesh's motor mounts.")
 @click.option("-o", "--output-dir", type=click.Path(path_type=Path, file_okay=False),
               default=Path("."), show_default=True,
               help="Directory to create the package directory NAME in.")

@@ -106,23 +106,35 @@ def load_cad_body(spec, *, units: str = "auto", frame: str | None = None,
         mounts = MountReading((), mounts.reason + ", but they do not follow the "
                               f"{spec.frame.title} layout: not used")
 
-    centre_m, centre_how = _resolve_centre(choice, props, mounts)
     top = spec["rotor_offset_top"]
-    on_mounts = bool(mounts.mounts) and not arm_given
+    # Rotors go on the mounts unless the user placed them: an arm length or a centre.
+    on_mounts = bool(mounts.mounts) and not arm_given and centre is None
+    if mounts.mounts:
+        on_slots = [mounts.mounts[i] for i in slots]
+        mount_xyz = np.array([(m.xy_m[0], m.xy_m[1], m.top_z_m) for m in on_slots])
+        mounts_centre = mount_xyz.mean(axis=0)
     if on_mounts:
-        placed = [mounts.mounts[i] for i in slots]
+        centre_m, centre_how = mounts_centre, "the motor mounts' centre"
         # Rounded to 0.1 um: a float32 STL carries about 7 digits.
-        positions = tuple(tuple(round(float(v), 7) + 0.0
-                                for v in (m.xy_m[0], m.xy_m[1], m.top_z_m + top))
-                          for m in placed)
+        positions = tuple(tuple(round(float(v), 7) + 0.0 for v in (x, y, z + top))
+                          for x, y, z in mount_xyz)
         measured = _arm_length_from(spec.frame, np.array(positions), centre_m)
         spec.values["arm_length"], spec.origin["arm_length"] = measured, "the motor mounts"
         note = (f"rotors on the motor mounts, rotor_offset_top {top:g} m above their tops; "
-                f"arm_length {measured:.4g} m measured from the rotor centre")
-        spec.cad = CadPlacement(tuple(centre_m), tuple(props.com_m), bottom, positions)
+                f"arm_length {measured:.4g} m measured from their centre")
+        spec.cad = CadPlacement(tuple(float(v) for v in centre_m), tuple(props.com_m), bottom,
+                                positions)
     else:
+        centre_m, centre_how = _resolve_centre(choice, props, mounts)
+        if arm_given:
+            source = "given"
+        elif mounts.mounts:
+            measured = _arm_length_from(spec.frame, mount_xyz, mounts_centre)
+            spec.values["arm_length"], spec.origin["arm_length"] = measured, "the motor mounts"
+            source = "measured from the motor mounts"
+        else:
+            source = "the default (pass --arm-length)"
         spec.cad = CadPlacement(tuple(float(v) for v in centre_m), tuple(props.com_m), bottom)
-        source = "given" if arm_given else "the default (pass --arm-length)"
         note = f"rotors at arm_length {spec['arm_length']:.4g} m ({source}) about the rotor centre"
     offsets = []
     if mounts.mounts:
@@ -135,7 +147,8 @@ def load_cad_body(spec, *, units: str = "auto", frame: str | None = None,
     if not body.trim.feasible:
         # A model that cannot hover is not written: validate would refuse it (R307).
         raise ReedtoolError(
-            f"the rotors about {centre_how.split(' (')[0]} cannot hold this body level: "
+            f"the rotors about {centre_how.split(' (')[0].replace(chr(39), '')} cannot hold "
+            "this body level: "
             f"its centre of mass is at {_mm(props.com_m)} in the CAD frame; "
             f"{body.trim.message}", file=spec.mesh,
             hint="pass --center com (rotors about the COM), --center x,y,z, or move the CAD "
