@@ -53,6 +53,18 @@ def test_density_always_tells_mm_from_inch():
             assert fits == [unit], (density, unit, fits)
 
 
+def test_an_arm_length_no_unit_can_hold_is_named_as_the_cause():
+    """The issue's `--arm-length 18` (metres meant as cm or inches?) on a 0.38 m mm body:
+    25 m rotor radius over a 0.19 m half-span is 133, beyond 12; the mesh itself is a
+    body only in mm. The refusal names the arm length, not the unit."""
+    cues = UnitCues(383.6, 246994.0, 1.2, 18.0 * 2 ** 0.5, "body")
+    with pytest.raises(ReedtoolError, match="the arm length puts the rotors 25.4558 m out, "
+                                            "which fits this body in no unit: as mm") as info:
+        choose_units("auto", cues, flag="--mesh-units")
+    assert "133 half-spans out" in info.value.message
+    assert "check --arm-length" in info.value.hint
+
+
 def test_a_given_unit_is_taken_and_a_slip_is_said():
     choice = choose_units("in", UnitCues(383.6, 246994.0, 1.2, None, "body"),
                           flag="--mesh-units")

@@ -152,6 +152,20 @@ def choose_units(given: str, cues: UnitCues, *, declared_m: float | None = None,
     missing = [name for name, value in (("the mass", cues.mass_kg),
                                         ("the arm length", cues.arm_radial_m)) if value is None]
     more = f"; giving {' or '.join(missing)} may settle it" if missing and fits else ""
+    if not fits and cues.arm_radial_m is not None:
+        from dataclasses import replace
+
+        armless = replace(cues, arm_radial_m=None, mount_radial=None)
+        body_fits = [u for u in UNIT_ORDER if judge_unit(u, armless)[0]]
+        if body_fits:
+            # The mesh is a body in some unit; the rotors are what no unit can hold.
+            said_units = " or ".join(body_fits)
+            raise ReedtoolError(
+                f"the arm length puts the rotors {cues.arm_radial_m:g} m out, which fits "
+                f"this body in no unit: as {said_units} (what its size and mass allow) "
+                f"{'; '.join(verdicts[u][2] for u in body_fits)}", file=file,
+                hint="check --arm-length and its unit (e.g. '176.8 mm'), or name the "
+                     f"mesh's unit with {flag}")
     if fits:
         choices = "; ".join(f"as {u}: {verdicts[u][1]}" for u in fits)
         message = f"which unit? {said} fit {' and '.join(fits)} ({choices}){more}"
