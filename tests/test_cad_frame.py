@@ -361,3 +361,23 @@ def test_a_named_centre_without_an_arm_length_takes_the_arm_from_the_mounts(tmp_
     np.testing.assert_allclose(np.abs(rotors[:, 1] - com[1]), MOUNT_M, atol=1e-6)
     # Centred on the COM, the rotors are off the mounts by the COM's x offset, and say so.
     assert "NOT over the mesh's motor mounts" in out
+
+
+@pytest.mark.parametrize("sides, radius_mm, arm_width_mm", [
+    (8, 15.0, 12.0), (12, 20.0, 8.0), (16, 14.0, 30.0), (64, 10.0, 12.0)])
+def test_mounts_of_any_tessellation_and_arm_width(sides, radius_mm, arm_width_mm):
+    """Round mounts drawn as 8- to 64-gons, arms narrower or wider than them: the centres
+    as drawn. The polygons' vertices lie on the circle, in float64 here: 1e-9 m."""
+    from reedtool.physics.motor_mounts import find_mounts
+
+    parts = [EX.box_mesh((-70.0, -70.0, 0.0), (70.0, 70.0, 4.0))]
+    for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1)):
+        reach = 176.8 * np.sqrt(2.0) - radius_mm / 2
+        parts.append(EX.box_mesh((99.0, -arm_width_mm / 2, 0.0), (reach, arm_width_mm / 2, 4.0),
+                                 np.arctan2(sy, sx)))
+        parts.append(EX.cylinder_mesh(sx * 176.8, sy * 176.8, radius_mm, 0.0, 8.0, sides))
+    reading = find_mounts(np.vstack([V[F] for V, F in parts]) / 1000.0, 4)
+    assert len(reading.mounts) == 4, reading.reason
+    drawn = [np.array([sx, sy]) * MOUNT_M for sx in (1, -1) for sy in (1, -1)]
+    for mount in reading.mounts:
+        assert min(np.linalg.norm(mount.xy_m - d) for d in drawn) < 1e-9
