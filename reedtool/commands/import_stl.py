@@ -229,6 +229,11 @@ def report_lines(outcome: ImportOutcome) -> list[str]:
         lines.extend(f"  {line}" for line in edit.lines)
         lines.append("  the rotors stay where the model puts them; `reedtool new-package "
                      "--mesh` places them on the body's motor mounts")
+        if outcome.body_written:
+            package_dir = edit.file.parent.parent
+            lines.append(f"next: reedtool validate {package_dir}   (R342: what the body's COM "
+                         "does to the hover trim)")
+            lines.append(f"      reedtool hover-test {package_dir}")
     return lines
 
 
@@ -258,7 +263,9 @@ class _StageBar:
               help="Axes of the STL: ned, frd, flu, enu, nwu, y-up, z-up, or x/y/z letters "
                    "from f/b, l/r, u/d (e.g. luf). auto: FLU, unless the mesh's extents say "
                    "it stands on another axis (then it is refused, naming the choices).")
-@click.option("--mass", "mass_kg", type=float, default=None, help="Mass of the part [kg].")
+@click.option("--mass", "mass_kg", type=float, default=None,
+              help="Mass of the part [kg] (into a package new-package wrote: default the "
+                   "model's body mass).")
 @click.option("--density", "density_kg_m3", type=float, default=None,
               help="Density [kg/m^3] (default 1000 when neither --mass nor --density is given).")
 @click.option("--recenter", default="none", show_default=True,
@@ -280,7 +287,8 @@ def command(mesh, package_dir, name, units, from_frame, mass_kg, density_kg_m3, 
 
     Writes DIR/meshes/NAME.stl (binary, metres, FLU), optionally NAME_collision.stl, and
     prints the <link> snippet (visual, collision and <inertial>) to paste into a URDF or
-    xacro. Existing files are never overwritten without --force.
+    xacro; into a package new-package wrote, also the lines that make the mesh the model's
+    body (--set-body writes them). Existing files are never overwritten without --force.
     """
     # Progress is for a person watching a terminal; in a pipe it is one more stderr line.
     big = (sys.stderr.isatty() and mesh.is_file()
