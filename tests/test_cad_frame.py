@@ -190,6 +190,21 @@ def test_seed_path_keeps_the_cad_body_under_the_rotors(tmp_path):
     assert com_pin[0] == pytest.approx(c_x, abs=1e-6)
     assert abs(com_pin[1]) < 1e-6
 
+    # 4b. Drake's own URDF parser (another consumer, meshes loaded from package://)
+    #     reads the same body COM and whole-vehicle COM.
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import MultibodyPlant
+
+    plant = MultibodyPlant(0.0)
+    parser = Parser(plant)
+    parser.package_map().Add("seed_quad", str(pkg))
+    parser.AddModelsFromString(urdf, "urdf")
+    plant.Finalize()
+    body = plant.GetBodyByName("seed_quad/base_link_inertia")
+    np.testing.assert_allclose(body.default_com(), com_body, atol=1e-6)
+    drake_com = plant.CalcCenterOfMassPositionInWorld(plant.CreateDefaultContext())
+    np.testing.assert_allclose(drake_com, com_pin, atol=1e-9)
+
     # 5. The trim, by hand: rotors at x = +-a, COM at x = c; pitch balance
     #    T_front (a - c) = T_back (a + c) and 2 T_front + 2 T_back = m g give
     #    T_front = m g (a + c) / (4 a), T_back = m g (a - c) / (4 a).
@@ -381,3 +396,33 @@ def test_mounts_of_any_tessellation_and_arm_width(sides, radius_mm, arm_width_mm
     drawn = [np.array([sx, sy]) * MOUNT_M for sx in (1, -1) for sy in (1, -1)]
     for mount in reading.mounts:
         assert min(np.linalg.norm(mount.xy_m - d) for d in drawn) < 1e-9
+
+
+def test_the_gz_sim_package_keeps_the_cad_frame_too(tmp_path):
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import MultibodyPlant
+
+    code, out = new_package(tmp_path, "gz_seed", SEED_BODY, "--mesh-frame", "ned",
+                            "--ros", "2")
+    assert code == 0, out
+    pkg = tmp_path / "gz_seed"
+    code, urdf = run_cli("expand", pkg / "urdf" / "gz_seed.urdf.xacro", "--package-path",
+                         tmp_path)
+    assert code == 0, urdf
+    urdf = urdf[urdf.index("<?xml"):]
+    plant = MultibodyPlant(0.0)
+    parser = Parser(plant)
+    parser.package_map().Add("gz_seed", str(pkg))
+    parser.AddModelsFromString(urdf, "urdf")
+    plant.Finalize()
+    # The body COM from the parts' formulas (float32 mesh: 1e-6 m); the rotors on the
+    # mounts, 0.026 m above their 8 mm tops (written to 1e-7 m).
+    com = plant.GetBodyByName("base_link_inertia").default_com()
+    np.testing.assert_allclose(com, analytic_body_com_flu_m(), atol=1e-6)
+    context = plant.CreateDefaultContext()
+    for k, (sx, sy) in enumerate(((1, -1), (-1, 1), (1, 1), (-1, -1))):
+        X = plant.GetBodyByName(f"rotor_{k}").EvalPoseInWorld(context)
+        np.testing.assert_allclose(X.translation(), [sx * MOUNT_M, sy * MOUNT_M, 0.034],
+                                   atol=2e-7)
+    code, report = run_cli("validate", pkg / "urdf" / "gz_seed.urdf.xacro")
+    assert code == 0 and "R342" in report, report
