@@ -112,9 +112,38 @@ def test_fix_never_overwrites_an_older_backup(tmp_path, capsys):
     assert (tmp_path / "smartcar.urdf.bak.1").read_text() == original
 
 
-def test_fix_on_xacro_prints_blocks_with_their_lines(capsys):
-    source = FIXTURES / "wheel_macro.urdf.xacro"
-    before = source.read_text()
+def test_fix_on_xacro_rewrites_the_literal_inertia_in_the_macro_body(tmp_path, capsys):
+    """Both wheels take their tensor from the one literal <inertia/> in the macro body of
+    the user's file and need the same correction: it is rewritten there, once."""
+    source = tmp_path / "wheel_macro.urdf.xacro"
+    before = (FIXTURES / "wheel_macro.urdf.xacro").read_text()
+    source.write_text(before)
+    code, out, err = run([source, "--fix"], capsys)
+    assert code == 0, out + err
+    assert (tmp_path / "wheel_macro.urdf.xacro.bak").read_text() == before
+    lines = before.splitlines()
+    inertia_line = next(i for i, text in enumerate(lines, 1) if "<inertia " in text)
+    assert f"rewrote the <inertia/> at {source}:{inertia_line} (link left_wheel, right_wheel" \
+        in out
+    # A solid cylinder r = 25 mm, 20 mm long, 0.1 kg, axis y: m r^2 / 2 about y and
+    # m (3 r^2 + l^2) / 12 about x and z; 10 significant digits written.
+    new_line = source.read_text().splitlines()[inertia_line - 1]
+    values = dict(re.findall(r'(i\w\w)="([^"]+)"', new_line))
+    transverse = 0.1 * (3 * 0.025 ** 2 + 0.02 ** 2) / 12
+    assert float(values["iyy"]) == pytest.approx(0.1 * 0.025 ** 2 / 2, rel=1e-9)
+    assert float(values["ixx"]) == pytest.approx(transverse, rel=1e-9)
+    assert float(values["izz"]) == pytest.approx(transverse, rel=1e-9)
+    # Only that line changed.
+    assert [a == b for a, b in zip(lines, source.read_text().splitlines())].count(False) == 1
+
+
+def test_fix_on_xacro_prints_blocks_with_their_lines(tmp_path, capsys):
+    """A tensor written as an expression cannot be rewritten in place: printed, with the
+    line of the macro body and of each call."""
+    source = tmp_path / "wheel_macro.urdf.xacro"
+    before = (FIXTURES / "wheel_macro.urdf.xacro").read_text().replace(
+        'ixx="1.0"', 'ixx="${0.5 * 2}"')
+    source.write_text(before)
     code, out, err = run([source, "--fix"], capsys)
     assert code == 1
     assert source.read_text() == before

@@ -10,7 +10,7 @@ import trimesh
 from reedtool.errors import ReedtoolError
 from reedtool.io.meshes import check_triangles
 from reedtool.io.stl import parse_stl, read_stl, stl_bytes
-from reedtool.physics.mesh_import import CollisionSpec, choose_units, guess_units
+from reedtool.physics.mesh_import import CollisionSpec
 from reedtool.physics.mesh_topology import cluster_decimate, convex_hull_triangles, topology
 
 FIXTURES = Path(__file__).parent / "fixtures" / "meshes"
@@ -127,17 +127,7 @@ def test_topology_of_fixtures():
     assert not topology(read_stl(FIXTURES / "l_bracket_open.stl").triangles).watertight
 
 
-def test_unit_guess_and_its_reason():
-    assert guess_units(np.array([450.0, 450.0, 60.0])).unit == "mm"
-    assert guess_units(np.array([0.45, 0.45, 0.06])).unit == "m"
-    assert guess_units(np.array([8.0, 2.0, 1.0])).unit == "cm"       # 8 m too big, 8 mm too small
-    choice = guess_units(np.array([60.0, 40.0, 30.0]))
-    assert choice.guessed and "60" in choice.reason and "mm" in choice.reason
-    given = choose_units("in", np.ones(3))
-    # Exact: a table constant, not computed.
-    assert given.metres_per_unit == 0.0254 and not given.guessed
-    with pytest.raises(ReedtoolError, match="unknown unit"):
-        choose_units("furlong", np.ones(3))
+# The unit reading is tested in tests/test_mesh_units.py (physics/mesh_units.py).
 
 
 def test_stl_bytes_round_trip_through_trimesh(tmp_path):

@@ -140,8 +140,12 @@ def test_import_honours_the_dae_unit_and_guesses_only_without_one(tmp_path):
     # Unit scaling of whole numbers by 0.01: a few ulps; default rel 1e-6 is a ceiling.
     assert declared.size_m == pytest.approx([3.0, 2.0, 1.0])
     assert declared.mass.volume_m3 == pytest.approx(6.0)
-    unitless = import_mesh(write_obj(tmp_path / "mm.obj", box_triangles((300, 200, 100))),
-                           units="auto")
+    obj = write_obj(tmp_path / "mm.obj", box_triangles((300, 200, 100)))
+    # Without a unit and a mass, 300 units is a 0.3 m part in mm or a 3 m one in cm: asked.
+    with pytest.raises(ReedtoolError, match="which unit.*fit mm and cm"):
+        import_mesh(obj, units="auto")
+    # 6 kg: 1000 kg/m^3 as mm, 1 kg/m^3 as cm (below any body): mm, guessed.
+    unitless = import_mesh(obj, units="auto", mass_kg=6.0)
     assert (unitless.units.unit, unitless.units.guessed) == ("mm", True)
     # Whole mm times 0.001: one rounding; default rel 1e-6 is a ceiling.
     assert unitless.size_m == pytest.approx([0.3, 0.2, 0.1])

@@ -378,13 +378,18 @@ def test_body_mesh_gives_the_inertia(tmp_path):
     stl = tmp_path / "body.stl"
     stl.write_bytes(stl_bytes(triangles))
     code, output = run_cli("new-package", "meshy", "--frame", "quad-x", "--mesh", stl,
-                           "--mass", "1.2", "-o", tmp_path)
+                           "--mass", "1.2", "--center", "com", "-o", tmp_path)
     assert code == 0, output
     pkg = tmp_path / "meshy"
     written = read_stl(pkg / "meshes" / "body.stl").triangles.reshape(-1, 3)
-    assert np.allclose((written.min(0) + written.max(0)) / 2, 0, atol=1e-6)  # COM at origin
+    # The CAD frame is kept: the mesh is where the file put it (mm -> m only), and its COM,
+    # the box's centre by symmetry, is in <inertial><origin>. float32 STL: 1e-7 m.
+    centre_m = (lo + hi) / 2 / 1000
+    assert np.allclose(written.min(0), lo / 1000, atol=1e-7)
+    assert np.allclose(written.max(0), hi / 1000, atol=1e-7)
     robot = load_robot(model_file(pkg, "quad-x"))
     body = robot.link_map["meshy/base_link_inertia"]
+    assert np.allclose(body.inertial.com_m, centre_m, atol=1e-7)
     m, (a, b, c) = 1.2, (0.3, 0.2, 0.1)
     assert np.allclose(np.diag(body.inertial.inertia_kg_m2),
                        # The body from a float32 STL (coordinates to 6e-8 relative): the tensor, a

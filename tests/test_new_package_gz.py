@@ -506,6 +506,10 @@ def test_body_mesh_resolves_through_package_uri(tmp_path):
     stl.write_bytes(stl_bytes(corners[np.array(faces)]))
     code, output = run_cli("new-package", "meshy_gz", "--ros", "2", "--mesh", stl,
                            "--mesh-units", "m", "-o", tmp_path)
+    # Drawn from its corner: about the CAD origin the rotors cannot hold its COM level.
+    assert code == 2 and "cannot hold this body level" in output and "--center com" in output
+    code, output = run_cli("new-package", "meshy_gz", "--ros", "2", "--mesh", stl,
+                           "--mesh-units", "m", "--center", "com", "-o", tmp_path)
     assert code == 0, output
     pkg = tmp_path / "meshy_gz"
     assert "package://meshy_gz/meshes/body.stl" in model_file(pkg).read_text()

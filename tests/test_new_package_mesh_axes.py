@@ -27,17 +27,12 @@ def new_package(tmp_path, name, mesh, *extra):
                    "-o", tmp_path, *extra)
 
 
-def body_box(tmp_path, name):
-    """The body collision box the package was generated with, read back from the model."""
-    from reedtool.io.loader import load_robot
-    from reedtool.model import Box
+def written_vertices(tmp_path, name):
+    """The body mesh the package was generated with (metres), read by trimesh."""
+    import trimesh
 
-    pkg = tmp_path / name
-    robot = load_robot(pkg / "urdf" / "mav_generic_odometry_sensor.gazebo",
-                       {"mav_name": name, "namespace": name}, [tmp_path])
-    boxes = [c.geometry for link in robot.links for c in link.collisions
-             if isinstance(c.geometry, Box) and link.name == f"{name}/base_link_inertia"]
-    return boxes[0].size_m
+    mesh = trimesh.load(tmp_path / name / "meshes" / "body.stl", process=False)
+    return {tuple(v) for v in np.round(mesh.vertices, 6)}
 
 
 def test_a_y_up_body_is_refused_without_mesh_frame_and_names_the_choices(tmp_path):
@@ -52,20 +47,21 @@ def test_a_y_up_body_is_refused_without_mesh_frame_and_names_the_choices(tmp_pat
 
 def test_the_named_frame_is_taken_and_reported(tmp_path):
     mesh = box_stl(tmp_path / "body.stl", (0, 0, 0), (300, 60, 350))
-    code, out = new_package(tmp_path, "yup", mesh, "--mesh-frame", "y-up")
+    code, out = new_package(tmp_path, "yup", mesh, "--mesh-frame", "y-up", "--center", "com")
     assert code == 0, out
-    assert "  units: mm (largest extent 350 units; as mm that is 0.35 m" in out
+    assert "  units: mm (largest extent 350 units; as mm: 0.35 m across" in out
     assert "  frame: Y-UP → FLU" in out
     # Y-up (luf): source z is forward, x left, y up -> FLU 0.35 x 0.3 x 0.06 m.
     assert "  size: 0.35 x 0.3 x 0.06 m (x, y, z in FLU)" in out
-    # The collision box is square in plan at the wider side, max(0.35, 0.3), and as tall
-    # as the mesh's source y extent; STL stores float32, so 1e-7 m.
-    assert body_box(tmp_path, "yup") == pytest.approx([0.35, 0.35, 0.06], abs=1e-7)
+    # By hand: FLU (x, y, z) = source (z, x, y) / 1000, with no translation (the CAD
+    # origin is kept): the corners of [0, 0.35] x [0, 0.3] x [0, 0.06].
+    corners = {(x, y, z) for x in (0.0, 0.35) for y in (0.0, 0.3) for z in (0.0, 0.06)}
+    assert written_vertices(tmp_path, "yup") == corners
 
 
 def test_keeping_flu_on_purpose_is_allowed(tmp_path):
     mesh = box_stl(tmp_path / "body.stl", (0, 0, 0), (300, 60, 350))
-    code, out = new_package(tmp_path, "tall", mesh, "--mesh-frame", "flu")
+    code, out = new_package(tmp_path, "tall", mesh, "--mesh-frame", "flu", "--center", "com")
     assert code == 0, out
     assert "350 mm tall and 60 mm along y" in out   # said, not refused: the user chose
 
@@ -98,7 +94,7 @@ def test_the_reading_is_one_implementation_with_import_stl(tmp_path):
     (tmp_path / "pkg" / "package.xml").write_text(
         "<package format='2'><name>pkg</name></package>")
     code, out = run_cli("import-stl", mesh, "--package", tmp_path / "pkg", "--from-frame",
-                        "y-up")
+                        "y-up", "--mass", "1.2")
     assert code == 0, out
-    for line in assumption_lines(import_mesh(mesh, from_frame="y-up")):
+    for line in assumption_lines(import_mesh(mesh, from_frame="y-up", mass_kg=1.2)):
         assert line in out.splitlines()

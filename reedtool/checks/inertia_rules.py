@@ -20,6 +20,7 @@ from reedtool.physics.inertia import (
     robot_mass_problem,
     tensor_problem,
 )
+from reedtool.physics.mesh_units import UNIT_WORDS, UNITS_M
 
 # How far outside its geometry's bounding box a COM may lie, as a fraction of the box size.
 COM_MARGIN_FRACTION = 0.1
@@ -437,19 +438,40 @@ def _mesh_scale_findings(ctx: CheckContext, certain: bool) -> Iterator[Issue]:
             if _unit_certainly_wrong(ctx, extent) != certain:
                 continue
             scale = np.asarray(mesh.scale, dtype=float)
-            if extent > high:
-                factor, why = 0.001, "looks like millimetres read as metres"
-            else:
-                factor, why = 1000.0, "looks scaled down twice"
             read = ctx.mesh_file(mesh)
+            units = ["mm"]
+            if extent > high:
+                units = _units_of(link, read, scale) or units
+                factors = [UNITS_M[u] for u in units]
+                why = f"looks like {' or '.join(UNIT_WORDS[u] for u in units)} read as metres"
+            else:
+                factors, why = [1000.0], "looks scaled down twice"
             unit = getattr(read, "metres_per_unit", 1.0)
             declared = (f"; the file declares <unit meter=\"{unit:g}\">"
                         if getattr(read, "unit_declared", False) else "")
-            fixed = " ".join(_fmt(s * factor) for s in scale)
+            fixes = [" ".join(_fmt(s * factor) for s in scale) for factor in factors]
+            uses = " or ".join(f"scale=\"{fixed}\"" + (f" ({UNIT_WORDS[u]})" if len(fixes) > 1
+                                                        else "")
+                               for fixed, u in zip(fixes, units))
             yield Issue(f"link '{link.name}': mesh '{mesh.uri}' is {_fmt(extent)} m across "
                         f"({why}{declared})", shape.loc, link.name,
-                        hint=f"use <mesh filename=\"{mesh.uri}\" scale=\"{fixed}\"/>, or "
+                        hint=f"use <mesh filename=\"{mesh.uri}\" {uses}/>, or "
                              "convert the file (reedtool import-stl)")
+
+
+def _units_of(link: Link, read, scale) -> list[str]:
+    """The units the mesh was likely written in, by the one detector import-stl and
+    new-package use (physics.mesh_units): its size and the link's mass over its volume."""
+    from reedtool.physics.mesh_units import signed_volume, units_read_as_metres
+
+    triangles = getattr(read, "triangles_m", None)
+    if triangles is None or len(triangles) == 0:
+        return []
+    scaled = np.asarray(triangles) * scale
+    extent = float(np.max(np.ptp(scaled.reshape(-1, 3), axis=0)))
+    mass = link.inertial.mass_kg if link.inertial is not None else None
+    mass = mass if mass is not None and math.isfinite(mass) and mass > 0 else None
+    return units_read_as_metres(extent, signed_volume(scaled) or None, mass)
 
 
 @rule("I206", "mesh-scale-implausible", "warning",
@@ -461,7 +483,9 @@ def mesh_scale_implausible(ctx: CheckContext) -> Iterator[Issue]:
     times the `<mesh scale>`; STL and OBJ have no unit and are read as metres.
 
     A mesh larger than 20 m or smaller than 1 mm across is reported with the scale that
-    brings it into range: as this warning when the rest of the robot leaves room for it
+    brings it into range, for each unit (mm, inch, cm) that makes it a plausible link by
+    the detector import-stl and new-package use (physics.mesh_units: its size, and the
+    link's mass over its volume): as this warning when the rest of the robot leaves room for it
     being intended (a large ground plane, a tiny marker), as I210 (error) when the unit is
     certainly wrong.
 

@@ -51,6 +51,9 @@ class ImportOutcome:
     mesh_file: Path
     collision_file: Path | None
     snippet: str
+    body_edit: object | None = None   # scaffold.package_body.BodyEdit for the package's model
+    body_written: bool = False        # the edit was written (--set-body)
+    body_backup: Path | None = None
 
 
 def snippet_text(imported, package: str, name: str, collision_name: str | None) -> str:
@@ -87,17 +90,22 @@ def snippet_text(imported, package: str, name: str, collision_name: str | None) 
 
 
 def run_import(mesh: Path, package_dir: Path, *, name: str | None = None, units: str = "auto",
-               from_frame: str = "flu", mass_kg: float | None = None,
+               from_frame: str = "auto", mass_kg: float | None = None,
                density_kg_m3: float | None = None, recenter: str = "none",
                collision: str = "same", snippet_file: Path | None = None,
-               force: bool = False, progress=None) -> ImportOutcome:
-    """Import `mesh` into `package_dir`: the whole command without its printing."""
+               force: bool = False, progress=None, set_body: bool = False) -> ImportOutcome:
+    """Import `mesh` into `package_dir`: the whole command without its printing.
+
+    When the package's model is one new-package wrote (scaffold.package_body), the edit
+    that makes the mesh its body is planned: written with `set_body` (a numbered backup
+    of the model file first), else returned for its lines to be printed."""
     from reedtool.frames import axis_convention
     from reedtool.io.fileio import atomic_write_many, check_writable
     from reedtool.io.stl import stl_bytes
     from reedtool.physics.mesh_import import import_mesh
 
-    axis_convention(from_frame)  # an unknown frame is the error to report, not a refusal
+    if from_frame.strip().lower() != "auto":
+        axis_convention(from_frame)  # an unknown frame is the error to report, not a refusal
     from reedtool.errors import check_plausible
 
     if mass_kg is not None:
@@ -120,9 +128,25 @@ def run_import(mesh: Path, package_dir: Path, *, name: str | None = None, units:
         raise ReedtoolError("the output would overwrite the input mesh", file=mesh,
                             hint="pass a different --name")
 
-    imported = import_mesh(mesh, units=units, from_frame=from_frame, mass_kg=mass_kg,
+    from reedtool.scaffold.package_body import find_body_model, package_mass_kg
+
+    body_model = find_body_model(package_dir)
+    if set_body and body_model is None:
+        raise ReedtoolError("--set-body: no model in DIR/urdf/ declares the body properties "
+                            "(mesh_file and body_inertia) new-package writes", file=package_dir,
+                            hint="set the body by hand from the snippet, or create the package "
+                                 "with `reedtool new-package`")
+    # The body's mass is the package's unless given: it is what the model flies with.
+    body_mass = None
+    if body_model is not None and mass_kg is None and density_kg_m3 is None:
+        body_mass = package_mass_kg(body_model)
+    imported = import_mesh(mesh, units=units, from_frame=from_frame,
+                           mass_kg=mass_kg if body_mass is None else body_mass,
                            density_kg_m3=density_kg_m3, recenter=recenter,
-                           collision=collision, progress=progress)
+                           collision=collision, progress=progress,
+                           role="body" if body_model is not None else "part")
+    if body_mass is not None:
+        imported.mass_source = f"the body mass in {body_model.name}"
     if progress:
         progress("writing")
     header = f"reedtool import-stl {mesh.name}: metres, FLU"
@@ -134,9 +158,23 @@ def run_import(mesh: Path, package_dir: Path, *, name: str | None = None, units:
                            collision_file.stem if collision_file is not None else None)
     if snippet_file is not None:
         outputs.append((snippet_file, snippet.encode("utf-8")))
+    edit = None
+    if body_model is not None:
+        from reedtool.scaffold.package_body import check_edit, plan_body_edit
+
+        edit = plan_body_edit(body_model, package, name, imported.mass,
+                              set_mass=mass_kg is not None or density_kg_m3 is not None)
+        check_edit(edit, imported.mass)
     # All or nothing: a snippet that cannot be written must not leave the meshes behind.
     atomic_write_many(outputs, force=force)
-    return ImportOutcome(imported, package, mesh_file, collision_file, snippet)
+    backup = None
+    if set_body:
+        from reedtool.io.fileio import atomic_write_text
+
+        backup = atomic_write_text(edit.file, edit.new_text, force=True, backup=True,
+                                   encoding=edit.encoding, in_place=True)
+    return ImportOutcome(imported, package, mesh_file, collision_file, snippet, edit,
+                         set_body, backup)
 
 
 def _vector(v) -> str:
@@ -180,6 +218,22 @@ def report_lines(outcome: ImportOutcome) -> list[str]:
     if outcome.collision_file is not None and imp.collision_m is not None:
         lines.append(f"wrote {outcome.collision_file} ({imp.collision.kind}, "
                      f"{len(imp.collision_m)} triangles)")
+    edit = outcome.body_edit
+    if edit is not None:
+        if outcome.body_written:
+            lines.append(f"set the body of {edit.file} to this mesh (backup: "
+                         f"{outcome.body_backup}):")
+        else:
+            lines.append(f"to make it the body of {edit.file}, change these lines (or pass "
+                         "--set-body to write them, keeping a backup):")
+        lines.extend(f"  {line}" for line in edit.lines)
+        lines.append("  the rotors stay where the model puts them; `reedtool new-package "
+                     "--mesh` places them on the body's motor mounts")
+        if outcome.body_written:
+            package_dir = edit.file.parent.parent
+            lines.append(f"next: reedtool validate {package_dir}   (R342: what the body's COM "
+                         "does to the hover trim)")
+            lines.append(f"      reedtool hover-test {package_dir}")
     return lines
 
 
@@ -203,11 +257,15 @@ class _StageBar:
 @click.option("--name", default=None, help="Output name (default: the mesh file's stem).")
 @click.option("--units", default="auto", show_default=True,
               type=click.Choice(["auto", "mm", "cm", "m", "in"]),
-              help="Units of the STL; auto guesses from the size and says why.")
-@click.option("--from-frame", default="flu", show_default=True, metavar="FRAME",
+              help="Units of the STL; auto judges by the size and the mass (density), "
+                   "says why, and refuses naming the choices when more than one unit fits.")
+@click.option("--from-frame", default="auto", show_default=True, metavar="FRAME",
               help="Axes of the STL: ned, frd, flu, enu, nwu, y-up, z-up, or x/y/z letters "
-                   "from f/b, l/r, u/d (e.g. luf).")
-@click.option("--mass", "mass_kg", type=float, default=None, help="Mass of the part [kg].")
+                   "from f/b, l/r, u/d (e.g. luf). auto: FLU, unless the mesh's extents say "
+                   "it stands on another axis (then it is refused, naming the choices).")
+@click.option("--mass", "mass_kg", type=float, default=None,
+              help="Mass of the part [kg] (into a package new-package wrote: default the "
+                   "model's body mass).")
 @click.option("--density", "density_kg_m3", type=float, default=None,
               help="Density [kg/m^3] (default 1000 when neither --mass nor --density is given).")
 @click.option("--recenter", default="none", show_default=True,
@@ -218,20 +276,26 @@ class _StageBar:
 @click.option("--snippet", "snippet_file", type=click.Path(path_type=Path, dir_okay=False),
               default=None, help="Write the URDF/xacro snippet here instead of printing it.")
 @click.option("--force", is_flag=True, help="Overwrite existing output files.")
+@click.option("--set-body", is_flag=True,
+              help="Make the mesh the body of the package's model (a package new-package "
+                   "wrote): set mesh_file, body_com_xyz, body_inertia (and mass, with "
+                   "--mass or --density) in its xacro file, keeping a numbered backup. "
+                   "Without it those lines are printed.")
 def command(mesh, package_dir, name, units, from_frame, mass_kg, density_kg_m3, recenter,
-            collision, snippet_file, force) -> int:
+            collision, snippet_file, force, set_body=False) -> int:
     """Import a CAD STL into a package: metres, FLU axes, inertia about the COM.
 
     Writes DIR/meshes/NAME.stl (binary, metres, FLU), optionally NAME_collision.stl, and
     prints the <link> snippet (visual, collision and <inertial>) to paste into a URDF or
-    xacro. Existing files are never overwritten without --force.
+    xacro; into a package new-package wrote, also the lines that make the mesh the model's
+    body (--set-body writes them). Existing files are never overwritten without --force.
     """
     # Progress is for a person watching a terminal; in a pipe it is one more stderr line.
     big = (sys.stderr.isatty() and mesh.is_file()
            and mesh.stat().st_size >= PROGRESS_MIN_BYTES)
     kwargs = dict(name=name, units=units, from_frame=from_frame, mass_kg=mass_kg,
                   density_kg_m3=density_kg_m3, recenter=recenter, collision=collision,
-                  snippet_file=snippet_file, force=force)
+                  snippet_file=snippet_file, force=force, set_body=set_body)
     if big:
         with click.progressbar(length=len(STAGES) - 1, label="import-stl", file=sys.stderr) as bar:
             outcome = run_import(mesh, package_dir, progress=_StageBar(bar), **kwargs)

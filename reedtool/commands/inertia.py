@@ -108,8 +108,8 @@ def format_text(model: Path, robot, comparisons, whole, own, findings=()) -> str
         lines.append(f"{len(failing)} of {len(comparisons)} links need attention (error, as in "
                      "validate): " + ", ".join(f"{c.link} ({c.verdict})" for c in failing))
     if failing or warned:
-        lines.append("pass --fix to write the geometry's inertia into a .urdf, or to print "
-                     "the blocks to paste into a .xacro")
+        lines.append("pass --fix to write the geometry's inertia into the model (a .urdf, or "
+                     "the <inertia/> in your xacro file it comes from)")
     if not failing and not warned:
         lines.append("no link inertia needs attention")
     return "\n".join(lines) + "\n"
@@ -208,23 +208,82 @@ def apply_fix_urdf(model: Path, comparisons, force: bool) -> list[str]:
             f"(backup: {backup})"]
 
 
-def print_fix_xacro(comparisons) -> list[str]:
-    from reedtool.physics.inertia import inertial_xml
+def apply_fix_xacro(model: Path, comparisons) -> tuple[list[str], set[str]]:
+    """--fix on a xacro model: each tensor to change is edited where the user wrote it.
 
-    lines = []
+    The <inertial> of a link may be written in a macro body (RotorS' multirotor_base_macro,
+    in a file of reedtool's or of another package) with its tensor passed in as a block
+    from the user's file (`<xacro:insert_block name="body_inertia"/>`). The literal
+    <inertia/> to change is the one in the user's file (the call's file, inside the
+    model's own package) whose six moments are the link's declared ones: it is edited
+    there, with a numbered backup, when exactly one matches and every link it feeds gets
+    the same correction. Anything else is printed, with the line to change in the user's
+    file, never in a file of reedtool's install.
+    """
+    from reedtool.io.fileio import atomic_write_text, read_xml_file
+    from reedtool.io.xacro_edit import inertia_elements_matching, replace_span, users_file
+    from reedtool.physics.inertia import inertia_element, inertial_xml
+
+    edits: dict[tuple[str, int, int], tuple[object, np.ndarray, list[str]]] = {}
+    printed: list[str] = []
+    texts: dict[str, tuple[str, str]] = {}
     for c in comparisons:
         props = c.corrected()
         if props is None:
             continue
-        if c.loc.macro:
+        file = c.loc.file
+        com_moves = not np.allclose(props.com_m, c.declared.com_m, atol=1e-12)
+        spans = []
+        if file and users_file(file, model) and not com_moves:
+            if file not in texts:
+                texts[file] = read_xml_file(Path(file), what="xacro file")
+            spans = inertia_elements_matching(texts[file][0], c.declared.inertia_kg_m2)
+        if len(spans) == 1:
+            key = (file, spans[0].start, spans[0].end)
+            if key in edits and not np.allclose(edits[key][1], props.inertia_kg_m2):
+                edits[key][2].append(f"!{c.link}")       # two links, two corrections
+            else:
+                entry = edits.setdefault(key, (spans[0], props.inertia_kg_m2, []))
+                entry[2].append(c.link)
+            continue
+        if c.loc.macro and not users_file(c.loc.macro_file, model):
+            where = (f"written by the macro called at {c.loc} (the macro is not in your "
+                     "package: pass the block there)")
+        elif c.loc.macro:
             # The element is written once in the macro body; the call says which link.
             where = f"in the macro body at {c.loc.macro} (the call at {c.loc})"
         else:
             where = f"at {c.loc}"
-        lines.append(f"--fix: link '{c.link}': replace the <inertial> {where} with")
-        lines.append(inertial_xml(props, indent="  "))
-        lines.append("")
-    return lines or ["--fix: nothing to change"]
+        printed.append(f"--fix: link '{c.link}': replace the <inertial> {where} with")
+        printed.append(inertial_xml(props, indent="  "))
+        printed.append("")
+
+    notes, fixed = [], set()
+    by_file: dict[str, list] = {}
+    for (file, _s, _e), (span, tensor, links) in edits.items():
+        if any(link.startswith("!") for link in links):
+            names = ", ".join(link.lstrip("!") for link in links)
+            notes.append(f"--fix: links {names} share the <inertia/> at {file}:{span.line} "
+                         "but need different tensors: give each its own; not changed")
+            continue
+        by_file.setdefault(file, []).append((span, tensor, links))
+    for file, changes in by_file.items():
+        text, encoding = texts[file]
+        for span, tensor, _links in sorted(changes, key=lambda change: -change[0].start):
+            text = replace_span(text, span, inertia_element(tensor))
+        # The edit reads back as meant before it replaces the user's file.
+        for span, tensor, links in changes:
+            if len(inertia_elements_matching(text, tensor)) < 1:
+                raise ReedtoolError(f"internal check failed rewriting the inertia of "
+                                    f"{', '.join(links)}; the file was left unchanged",
+                                    file=file)
+        backup = atomic_write_text(Path(file), text, force=True, backup=True,
+                                   encoding=encoding, in_place=True)
+        for span, _tensor, links in changes:
+            fixed.update(links)
+            notes.append(f"--fix: rewrote the <inertia/> at {file}:{span.line} "
+                         f"(link {', '.join(links)}; backup: {backup})")
+    return (notes + printed or ["--fix: nothing to change"]), fixed
 
 
 @click.command("inertia")
@@ -232,8 +291,10 @@ def print_fix_xacro(comparisons) -> list[str]:
 @click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
               show_default=True, help="Output format.")
 @click.option("--fix", is_flag=True,
-              help="Write the geometry's inertia into a .urdf (with a .bak backup); for a "
-                   ".xacro, print the blocks to paste and where.")
+              help="Write the geometry's inertia into the model (with a numbered .bak "
+                   "backup): a .urdf's <inertial>, or the <inertia/> in your xacro file the "
+                   "link's tensor comes from (a macro's block property, e.g. body_inertia "
+                   "in NAME.xacro); what cannot be placed is printed with its line.")
 @click.option("--force", is_flag=True,
               help="Kept for compatibility: --fix never overwrites a backup (it picks the first "
                    "free NAME.bak, NAME.bak.1, ...).")
@@ -299,12 +360,14 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
     failing = [c for c in comparisons if c.failing]
     if fix:
         is_urdf = model.suffix.lower() == ".urdf"
-        notes = (apply_fix_urdf(model, comparisons, force) if is_urdf
-                 else print_fix_xacro(comparisons))
+        if is_urdf:
+            notes, fixed = apply_fix_urdf(model, comparisons, force), set()
+        else:
+            notes, fixed = apply_fix_xacro(model, comparisons)
         # Keep JSON on stdout parseable: fix notes go to stderr there.
         click.echo("\n".join(notes), err=(fmt == "json"))
-        if is_urdf:
-            # What --fix rewrote no longer fails; what it could not fix still does.
-            failing = [c for c in failing if c.corrected() is None]
+        # What --fix rewrote no longer fails; what it could only print still does.
+        failing = [c for c in failing if c.corrected() is None
+                   or (not is_urdf and c.link not in fixed)]
     errors = [f for f in findings if f.severity == "error" and f.code in SHARED_CODES]
     return 1 if failing or errors else 0

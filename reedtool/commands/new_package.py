@@ -16,7 +16,7 @@ class NewPackageResult:
     files: list[PurePosixPath]
     backup: Path | None
     context: dict
-    mesh: object | None = None     # the imported body mesh (physics.mesh_import.ImportedMesh)
+    mesh: object | None = None     # the CAD body (scaffold.cad_body.CadBody)
 
 
 def template_sets(kind: str, ros: int, sim: str = "classic") -> list[str]:
@@ -38,55 +38,24 @@ def model_path(spec) -> PurePosixPath:
     return PurePosixPath("urdf", f"{spec.name}.urdf.xacro")
 
 
-def _import_body_mesh(spec, units: str, from_frame: str | None):
-    """Body mesh in metres and FLU, moved so its COM is the body origin, and its inertia.
+def mesh_lines(body, spec) -> list[str]:
+    """What new-package assumed about the body mesh, as import-stl says it, and where the
+    CAD body put the COM and the rotors."""
+    from reedtool.physics.mesh_import import assumption_lines
+    from reedtool.scaffold.cad_body import cad_lines
 
-    Without --mesh-frame the mesh is read as FLU, unless its extents say another
-    convention fits better (a Y-up or Z-down export): then it is refused, naming them.
-    """
-    import numpy as np
-
-    from reedtool.errors import ReedtoolError
-    from reedtool.io.stl import stl_bytes
-    from reedtool.physics.inertia import MassProperties
-    from reedtool.physics.mesh_import import import_mesh, read_axes
-
-    imported = import_mesh(spec.mesh, units=units, from_frame=from_frame or "flu",
-                           mass_kg=spec["mass"], recenter="com")
-    reading = read_axes(imported)
-    if from_frame is None and reading.suggested:
-        choices = " or ".join(f"--mesh-frame {name}" for name in reading.suggested)
-        raise ReedtoolError(
-            f"which way is up? {reading.reason}", file=spec.mesh,
-            hint=f"pass {choices} if it was exported so, or --mesh-frame flu to keep its "
-                 "axes (`reedtool import-stl --help` lists every convention)")
-    props = MassProperties(imported.mass.mass_kg, np.zeros(3), imported.mass.inertia_kg_m2)
-    # The collision box follows the mesh unless the user sized it.
-    size_m = imported.size_m
-    if spec.origin.get("body_width") == "default":
-        wide = max(size_m[0], size_m[1]) if spec.kind == "multirotor" else size_m[1]
-        spec.values["body_width"], spec.origin["body_width"] = float(wide), "the mesh"
-    if spec.origin.get("body_height") == "default":
-        spec.values["body_height"], spec.origin["body_height"] = float(size_m[2]), "the mesh"
-    if spec.kind == "ground" and spec.origin.get("body_length") == "default":
-        spec.values["body_length"], spec.origin["body_length"] = float(size_m[0]), "the mesh"
-    return props, stl_bytes(imported.triangles_m, header=f"reedtool body of {spec.name}"), imported
-
-
-def mesh_lines(imported) -> list[str]:
-    """What new-package assumed about the body mesh, as import-stl says it."""
-    from reedtool.physics.mesh_import import assumption_lines, read_axes
-
+    imported = body.imported
     size = imported.size_m
     return ([f"body mesh {imported.source}: {imported.file_format}"]
             + [f"  {line}" for line in assumption_lines(imported)]
-            + [f"  axes: {read_axes(imported).reason}",
-               f"  size: {size[0]:.4g} x {size[1]:.4g} x {size[2]:.4g} m (x, y, z in FLU)"])
+            + [f"  note: {note}" for note in imported.notes]
+            + [f"  size: {size[0]:.4g} x {size[1]:.4g} x {size[2]:.4g} m (x, y, z in FLU)"]
+            + cad_lines(body, spec))
 
 
 def new_package(spec, output_dir: Path, *, force: bool = False, mesh_units: str = "auto",
-                mesh_frame: str | None = None, autopilot: str | None = None
-                ) -> NewPackageResult:
+                mesh_frame: str | None = None, autopilot: str | None = None,
+                center: str | None = None) -> NewPackageResult:
     """Render the package for `spec` into output_dir/spec.name, all or nothing.
 
     `autopilot` ('px4' | 'ardupilot') adds the autopilot's rotor table, written from the
@@ -99,9 +68,20 @@ def new_package(spec, output_dir: Path, *, force: bool = False, mesh_units: str 
 
     target = Path(output_dir) / spec.name
     check_target(target.absolute(), force)   # fail before any expensive work
-    body_props = mesh_data = imported = None
+    body_props = mesh_data = body = None
     if spec.mesh is not None:
-        body_props, mesh_data, imported = _import_body_mesh(spec, mesh_units, mesh_frame)
+        from reedtool.io.stl import stl_bytes
+        from reedtool.scaffold.cad_body import load_cad_body
+
+        body = load_cad_body(spec, units=mesh_units, frame=mesh_frame, centre=center)
+        body_props = body.props
+        mesh_data = stl_bytes(body.imported.triangles_m,
+                              header=f"reedtool body of {spec.name}: metres, FLU, CAD origin")
+    elif center is not None:
+        from reedtool.errors import ReedtoolError
+
+        raise ReedtoolError("--center places rotors on a CAD body: it needs --mesh",
+                            hint="drop --center, or pass the body with --mesh")
     from reedtool.scaffold.package_spec import template_context
 
     context = template_context(spec, body_props)
@@ -111,7 +91,7 @@ def new_package(spec, output_dir: Path, *, force: bool = False, mesh_units: str 
         files.append(RenderedFile(PurePosixPath("meshes", context["mesh_file"]), mesh_data, 0o644))
     files += autopilot_files(spec, autopilot)
     backup = write_tree(target, files, force=force)
-    return NewPackageResult(target, sorted(f.path for f in files), backup, context, imported)
+    return NewPackageResult(target, sorted(f.path for f in files), backup, context, body)
 
 
 def _summary(result: NewPackageResult, spec) -> list[str]:
@@ -122,7 +102,7 @@ def _summary(result: NewPackageResult, spec) -> list[str]:
     if result.backup is not None:
         lines.append(f"previous contents kept in {result.backup}")
     if result.mesh is not None:
-        lines.extend(mesh_lines(result.mesh))
+        lines.extend(mesh_lines(result.mesh, spec))
     if spec.kind == "multirotor":
         lines.append(f"mass {ctx['p']['mass']} kg body, {ctx['total_mass_kg']} kg total; "
                      f"max thrust / weight {ctx['thrust_to_weight']}")
@@ -163,10 +143,17 @@ def _summary(result: NewPackageResult, spec) -> list[str]:
 @click.option("--mesh", type=click.Path(path_type=Path, dir_okay=False), metavar="BODY.stl",
               help="Body mesh; its shape gives the body inertia.")
 @click.option("--mesh-units", default="auto", show_default=True,
-              help="Units of the mesh: auto, m, cm, mm, in.")
+              type=click.Choice(["auto", "mm", "cm", "m", "in"]),
+              help="Units of the mesh. auto judges by its size, --mass (density) and "
+                   "--arm-length, and refuses naming the choices when more than one fits.")
 @click.option("--mesh-frame", default=None,
               help="Axes the mesh was exported in (flu, ned, frd, y-up, ...). Default: FLU, "
                    "unless the mesh's extents say it stands on another axis (then say which).")
+@click.option("--center", "center", default=None, metavar="origin|com|mounts|X,Y,Z",
+              help="With --mesh: the point the rotor pattern is centred on, in the CAD frame "
+                   "(FLU): the CAD origin (default with --arm-length), the body's COM, the "
+                   "motor mounts' centre, or x,y,z with a unit ('15.2,0,0 mm'). Without "
+                   "--center and --arm-length the rotors go on the mesh's motor mounts.")
 @click.option("-o", "--output-dir", type=click.Path(path_type=Path, file_okay=False),
               default=Path("."), show_default=True,
               help="Directory to create the package directory NAME in.")
@@ -176,7 +163,7 @@ def _summary(result: NewPackageResult, spec) -> list[str]:
               help="Also write the autopilot's rotor table for this model: a PX4 gz airframe "
                    "(px4/) or an ArduPilot .parm (ardupilot/).")
 def command(name, frame, ros, sim, spec_file, mass, arm_length, mesh, mesh_units, mesh_frame,
-            output_dir, force, autopilot=None) -> int:
+            output_dir, force, autopilot=None, center=None) -> int:
     """Create the ROS package NAME for a multirotor or ground robot.
 
     Masses and inertias are computed from the geometry; a multirotor (gz-sim
@@ -188,7 +175,7 @@ def command(name, frame, ros, sim, spec_file, mass, arm_length, mesh, mesh_units
     spec = build_spec(name, frame=frame, ros=int(ros) if ros else None, spec_file=spec_file,
                       flags={"mass": mass, "arm_length": arm_length}, mesh=mesh, sim=sim)
     result = new_package(spec, output_dir, force=force, mesh_units=mesh_units,
-                         mesh_frame=mesh_frame, autopilot=autopilot)
+                         mesh_frame=mesh_frame, autopilot=autopilot, center=center)
     for line in _summary(result, spec):
         click.echo(line)
     return 0

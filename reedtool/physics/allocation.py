@@ -16,14 +16,22 @@ def allocation_matrix(rotors: Sequence[Rotor], com_m: np.ndarray) -> np.ndarray:
     base axes: the lever arm of each rotor's force plus its drag reaction torque, which
     RotorS applies as -turning_sign * moment_constant * thrust along the rotor axis.
     """
+    return allocation_from_geometry([r.position_m for r in rotors], [r.axis for r in rotors],
+                                    [r.turning_sign for r in rotors],
+                                    [r.moment_constant for r in rotors], com_m)
+
+
+def allocation_from_geometry(positions_m, axes, turning_signs, moment_constants,
+                             com_m) -> np.ndarray:
+    """allocation_matrix from the rotors' numbers alone (a model not yet written)."""
     com_m = np.asarray(com_m, dtype=float)
-    B = np.zeros((4, len(rotors)))
-    for i, rotor in enumerate(rotors):
-        axis = rotor.axis / np.linalg.norm(rotor.axis)
-        lever = rotor.position_m - com_m
-        torque = np.cross(lever, axis) - rotor.turning_sign * rotor.moment_constant * axis
+    B = np.zeros((4, len(positions_m)))
+    for i, (position, axis, sign, k_m) in enumerate(zip(positions_m, axes, turning_signs,
+                                                        moment_constants)):
+        axis = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+        lever = np.asarray(position, dtype=float) - com_m
         B[0, i] = axis[2]
-        B[1:, i] = torque
+        B[1:, i] = np.cross(lever, axis) - sign * k_m * axis
     return B
 
 

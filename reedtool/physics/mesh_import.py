@@ -1,6 +1,8 @@
-"""The pipeline behind `reedtool import-stl`.
+"""The pipeline behind `reedtool import-stl` and `new-package --mesh`.
 
-read -> check -> units -> axes to FLU -> recentre -> mass properties -> collision mesh.
+read -> check -> units and axes (physics.mesh_units) -> to metres and FLU -> mass properties
+-> recentre (only when asked) -> collision mesh. The CAD origin is kept unless the user
+asks to recentre; the COM is reported, never moved to.
 """
 
 from __future__ import annotations
@@ -11,8 +13,10 @@ from pathlib import Path
 import numpy as np
 
 from reedtool.errors import ReedtoolError
-from reedtool.frames import AxisConvention, axis_convention
+from reedtool.frames import AxisConvention
 from reedtool.io.meshes import MeshCheck, check_triangles, read_mesh
+from reedtool.physics import mesh_units
+from reedtool.physics.mesh_units import AxisReading, UnitChoice, UnitCues
 from reedtool.physics.inertia import MassProperties, mesh_mass_properties
 from reedtool.physics.mesh_topology import (
     Topology,
@@ -21,57 +25,8 @@ from reedtool.physics.mesh_topology import (
     topology,
 )
 
-UNITS_M = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254}
-
-
-# A part of a multirotor is between a screw and a large airframe.
-PLAUSIBLE_SIZE_M = (0.01, 5.0)
-
-
-@dataclass(frozen=True)
-class UnitChoice:
-    unit: str
-    metres_per_unit: float
-    reason: str
-    guessed: bool
-
-
-def guess_units(extent: np.ndarray) -> UnitChoice:
-    """Pick the unit that makes the part's largest extent a plausible multirotor part size."""
-    largest = float(np.max(extent))
-    low, high = PLAUSIBLE_SIZE_M
-    for unit in ("m", "mm", "cm", "in"):
-        size_m = largest * UNITS_M[unit]
-        if low <= size_m <= high:
-            return UnitChoice(unit, UNITS_M[unit],
-                              f"largest extent {largest:g} units; as {unit} that is "
-                              f"{size_m:g} m, within the plausible {low:g}-{high:g} m", True)
-    unit = "mm" if largest > high else "m"
-    return UnitChoice(unit, UNITS_M[unit],
-                      f"largest extent {largest:g} units fits no unit's plausible "
-                      f"{low:g}-{high:g} m; assuming {unit} — pass --units to be sure", True)
-
-
-def _unit_name(metres_per_unit: float) -> str:
-    for unit, metres in UNITS_M.items():
-        if np.isclose(metres, metres_per_unit, rtol=1e-9):
-            return unit
-    return f"{metres_per_unit:g} m"
-
-
-def choose_units(name: str, extent: np.ndarray, declared_m: float | None = None) -> UnitChoice:
-    """--units NAME; "auto" takes the unit the file declares (COLLADA <unit>), as Gazebo
-    does, and guesses from the size only for formats without one (STL, OBJ)."""
-    if name == "auto" and declared_m is not None:
-        return UnitChoice(_unit_name(declared_m), declared_m,
-                          f"declared by the file (<unit meter=\"{declared_m:g}\">), as "
-                          "Gazebo reads it", False)
-    if name == "auto":
-        return guess_units(extent)
-    if name not in UNITS_M:
-        raise ReedtoolError(f"unknown unit '{name}'", hint="use one of: auto, "
-                            + ", ".join(UNITS_M))
-    return UnitChoice(name, UNITS_M[name], "given with --units", False)
+# Units and axes are read by physics.mesh_units, the one detector every command uses.
+UNITS_M = mesh_units.UNITS_M
 
 
 @dataclass(frozen=True)
@@ -108,6 +63,7 @@ class ImportedMesh:
     triangles_m: np.ndarray          # (n, 3, 3), metres, FLU, recentred
     units: UnitChoice
     frame: AxisConvention
+    axes: AxisReading                # what the extents say about the axes
     offset_m: np.ndarray             # translation applied after rotation (recentring)
     recenter: str
     check: MeshCheck
@@ -127,17 +83,29 @@ class ImportedMesh:
 DEFAULT_DENSITY_KG_M3 = 1000.0
 
 
-def import_mesh(path: str | Path, *, units: str = "auto", from_frame: str = "flu",
+def import_mesh(path: str | Path, *, units: str = "auto", from_frame: str = "auto",
                 mass_kg: float | None = None, density_kg_m3: float | None = None,
-                recenter: str = "none", collision: str = "same", progress=None) -> ImportedMesh:
+                recenter: str = "none", collision: str = "same", progress=None,
+                arm_radial_m: float | None = None, role: str = "part",
+                mount_count: int | None = None,
+                flags: tuple[str, str] = ("--units", "--from-frame")) -> ImportedMesh:
     """Read a CAD mesh (STL, COLLADA .dae, OBJ) and return it in metres and FLU with its
     mass properties. A .dae's <unit> is honoured (COLLADA node transforms applied).
 
+    `units` and `from_frame` may be "auto": physics.mesh_units decides from the size, the
+    mass (density) and `arm_radial_m` (centre to rotor axis), or refuses naming the
+    choices and `flags` (the command's own option names). `role` is "body" for a
+    vehicle's body (tighter size bounds), else "part". `mount_count` motor mounts, when
+    the mesh has them where the arm length puts rotors, settle a unit size and density
+    leave open.
     `progress(stage_name)` is called before each stage, for a progress bar.
     """
     step = progress or (lambda _stage: None)
     path = Path(path)
-    frame = axis_convention(from_frame)
+    if from_frame.strip().lower() != "auto":
+        from reedtool.frames import axis_convention
+
+        axis_convention(from_frame)      # an unknown name is the error, before any reading
     spec = CollisionSpec.parse(collision)
     if recenter not in ("none", "com", "bbox"):
         raise ReedtoolError(f"bad --recenter value '{recenter}'", hint="use none, com or bbox")
@@ -152,8 +120,36 @@ def import_mesh(path: str | Path, *, units: str = "auto", from_frame: str = "flu
     step("checking")
     check = check_triangles(read.triangles, path)
     topo = topology(read.triangles)
-    choice = choose_units(units, check.extent,
-                          read.metres_per_unit if read.unit_declared else None)
+    # Volume in file units: a rotation does not change it, a unit scales it by s^3.
+    try:
+        raw = mesh_mass_properties(read.triangles, 1.0, closed=topo.closed)
+    except ReedtoolError as exc:
+        raise ReedtoolError(exc.message, file=path, hint=exc.hint) from exc
+    cues = UnitCues(float(np.max(check.extent)), float(raw.volume_m3), mass_kg,
+                    arm_radial_m, role)
+    declared = read.metres_per_unit if read.unit_declared else None
+    try:
+        choice = mesh_units.choose_units(units, cues, declared_m=declared, flag=flags[0],
+                                         file=path)
+    except ReedtoolError:
+        if not (mount_count and arm_radial_m and units == "auto"):
+            raise
+        # Sizes and density leave more than one unit: the motor mounts settle it, if the
+        # mesh has them, as the unit that puts them under the rotors of the arm length.
+        frame, _ = mesh_units.choose_axes(from_frame, read.triangles, flag=flags[1],
+                                          file=path, shown_unit=(1.0, "file units"))
+        from reedtool.physics.motor_mounts import find_mounts
+
+        found = find_mounts(read.triangles @ frame.R_flu_src.T, mount_count).mounts
+        if not found:
+            raise
+        centre = np.mean([m.xy_m for m in found], axis=0)
+        radial = float(np.mean([np.linalg.norm(m.xy_m - centre) for m in found]))
+        cues = UnitCues(cues.largest_extent, cues.volume, mass_kg, arm_radial_m, role, radial)
+        choice = mesh_units.choose_units(units, cues, declared_m=declared, flag=flags[0],
+                                         file=path)
+    frame, axes = mesh_units.choose_axes(from_frame, read.triangles * choice.metres_per_unit,
+                                         flag=flags[1], file=path)
 
     step("transforming")
     # Uniform scale and a rotation commute; one matrix does both.
@@ -197,72 +193,16 @@ def import_mesh(path: str | Path, *, units: str = "auto", from_frame: str = "flu
         notes.append(f"mesh is {why}: mass properties are those of its convex hull")
     file_format = {"stl-binary": "binary STL", "stl-ascii": "ASCII STL", "dae": "COLLADA",
                    "obj": "OBJ"}.get(read.format, read.format)
-    return ImportedMesh(path, file_format, triangles, choice, frame, offset, recenter, check,
-                        topo, props, mass_source, collision_m, spec, notes)
+    if choice.note:
+        notes.insert(0, choice.note)
+    return ImportedMesh(path, file_format, triangles, choice, frame, axes, offset, recenter,
+                        check, topo, props, mass_source, collision_m, spec, notes)
 
 
 # ------------------------------------------------------------------ what was assumed
 
 def assumption_lines(imported: ImportedMesh) -> list[str]:
-    """The unit and axis reasoning `import-stl` and `new-package --mesh` both print."""
+    """The unit and axis reasoning every command that reads a mesh prints."""
     return [f"units: {imported.units.unit} ({imported.units.reason})",
-            f"frame: {imported.frame.description}"]
-
-
-# A vehicle body is flatter than it is wide: its height is its thinnest extent. Another
-# axis this much thinner than the assumed height says the mesh stands on another axis
-# (a 300 x 60 x 350 mm Y-up body read as Z-up is 35 cm tall and 6 cm wide: ratio 5.8).
-TALLER_THAN_THINNEST = 1.5
-# A part drawn upward from its CAD origin on a Z-down (NED/FRD) export lies wholly on the
-# negative side of the assumed up axis; allow this fraction of its height as round-off.
-ORIGIN_SLACK = 0.01
-
-
-@dataclass(frozen=True)
-class AxisReading:
-    """What a mesh's extents say about its axes, against the convention assumed."""
-
-    suggested: tuple[str, ...]     # conventions the extents fit better; () = the assumed fits
-    reason: str
-
-
-def _conventions_with(source_axis: int, letter: str, assumed: str) -> tuple[str, ...]:
-    """Named conventions, then the letter codes closest to the `assumed` code, whose
-    source axis `source_axis` points `letter` (u or d)."""
-    from reedtool.frames import ALIASES, RIGHT_HANDED_CODES
-
-    named = [name for name, (code, _) in ALIASES.items() if code[source_axis] == letter]
-    # Closest first; on a tie, x forward (FLU, FRD, NED all keep it) before the rest.
-    codes = sorted((code for code in RIGHT_HANDED_CODES if code[source_axis] == letter),
-                   key=lambda code: (-sum(a == b for a, b in zip(code, assumed)),
-                                     code[0] != "f"))
-    return tuple(dict.fromkeys(named + codes[:1]))
-
-
-def read_axes(imported: ImportedMesh) -> AxisReading:
-    """Does the mesh sit as a body does in the assumed convention (thinnest extent up, not
-    hanging wholly below its origin)? Otherwise, the conventions that fit its extents."""
-    vertices = imported.triangles_m.reshape(-1, 3) - imported.offset_m   # before recentring
-    low, high = vertices.min(axis=0), vertices.max(axis=0)
-    size = high - low
-    R = imported.frame.R_flu_src
-    names = "xyz"
-    thinnest = int(np.argmin(size))
-    shown = " x ".join(f"{s * 1000:.4g}" for s in size)
-    if thinnest != 2 and size[2] > TALLER_THAN_THINNEST * size[thinnest]:
-        source_axis = int(np.argmax(np.abs(R[thinnest])))   # the source axis on FLU `thinnest`
-        return AxisReading(
-            _conventions_with(source_axis, "u", imported.frame.code),
-            f"read as {imported.frame.name.upper()} the body is {shown} mm (x, y, z in FLU): "
-            f"{size[2] * 1000:.4g} mm tall and {size[thinnest] * 1000:.4g} mm along "
-            f"{names[thinnest]}; a body is thinnest in height, so its source "
-            f"{names[source_axis]} axis is most likely up")
-    if low[2] < 0 and high[2] <= ORIGIN_SLACK * size[2]:
-        source_axis = int(np.argmax(np.abs(R[2])))
-        return AxisReading(
-            _conventions_with(source_axis, "d", imported.frame.code),
-            f"read as {imported.frame.name.upper()} the body lies wholly below its origin "
-            f"(z from {low[2] * 1000:.4g} to {high[2] * 1000:.4g} mm): a part drawn upward "
-            f"from its CAD origin in a {names[source_axis]}-down export")
-    return AxisReading((), f"read as {imported.frame.name.upper()} the body is {shown} mm "
-                           "(x, y, z in FLU), thinnest in height, as a body is")
+            f"frame: {imported.frame.description}",
+            f"axes: {imported.axes.reason}"]

@@ -61,10 +61,12 @@ def prepare_spec(spec, autopilot: str | None):
 
 
 def _com_m(spec, positions: np.ndarray) -> np.ndarray:
-    """Whole-model COM: body and sensors at the origin, each rotor's mass at its hub."""
-    from reedtool.scaffold.package_spec import total_mass_estimate_kg
+    """Whole-model COM: the body's at its COM (a CAD body's, else the origin), sensors at
+    the origin, each rotor's mass at its hub."""
+    from reedtool.scaffold.package_spec import body_com_m, total_mass_estimate_kg
 
-    return spec["mass_rotor"] * positions.sum(axis=0) / total_mass_estimate_kg(spec)
+    moment = spec["mass"] * np.array(body_com_m(spec)) + spec["mass_rotor"] * positions.sum(axis=0)
+    return moment / total_mass_estimate_kg(spec)
 
 
 def autopilot_files(spec, autopilot: str | None):
@@ -77,7 +79,9 @@ def autopilot_files(spec, autopilot: str | None):
         raise ReedtoolError("--autopilot applies to multirotor frames only",
                             hint="drop --autopilot for a ground robot")
     frame: Airframe = spec.frame
-    positions = frame.rotor_positions_m(spec["arm_length"], spec["rotor_offset_top"])
+    from reedtool.scaffold.package_spec import rotor_positions_m
+
+    positions = rotor_positions_m(spec)
     if autopilot == "px4":
         from reedtool.flightstack.px4 import RotorSpec, px4_airframe_text
         from reedtool.scaffold.package_spec import STANDARD_GRAVITY_M_S2, total_mass_estimate_kg
@@ -108,7 +112,9 @@ def autopilot_context(spec, autopilot: str | None) -> dict:
     if autopilot == "ardupilot" and spec.kind == "multirotor" and spec.sim == "gz":
         from reedtool.scaffold.ardupilot_gz import package_block
 
-        positions = spec.frame.rotor_positions_m(spec["arm_length"], spec["rotor_offset_top"])
+        from reedtool.scaffold.package_spec import rotor_positions_m
+
+        positions = rotor_positions_m(spec)
         return {"ardupilot_block": package_block(spec, positions, _com_m(spec, positions))}
     return {"ardupilot_block": ""}
 

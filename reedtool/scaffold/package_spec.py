@@ -123,6 +123,17 @@ TEXT_KEYS = ("name", "frame", "ros", "sim", "mesh", "description", "maintainer",
 
 
 @dataclass
+class CadPlacement:
+    """Where a CAD body mesh puts things, in its own frame (base_link = the CAD origin,
+    FLU, metres): set by scaffold.cad_body when --mesh is given."""
+
+    centre_m: tuple[float, float, float]            # rotors are placed about it
+    body_com_m: tuple[float, float, float]          # the body's COM (its <inertial><origin>)
+    body_bottom_z_m: float                          # lowest point of the mesh
+    rotor_positions_m: tuple | None = None          # (n, 3) on the motor mounts, else None
+
+
+@dataclass
 class PackageSpec:
     name: str
     frame: Airframe | GroundLayout
@@ -136,6 +147,7 @@ class PackageSpec:
     version: str = "0.1.0"
     origin: dict[str, str] = field(default_factory=dict)  # key -> "default"|"spec"|"--flag"
     sim: str = "classic"                       # a SIMULATORS entry
+    cad: CadPlacement | None = None            # a CAD body's frame, COM and mounts
 
     @property
     def kind(self) -> str:
@@ -368,8 +380,22 @@ def _choose_simulator(flag: str | None, from_spec, frame_obj, ros: int,
 # ------------------------------------------------------------------ checks
 
 def rotor_positions_m(spec: PackageSpec):
-    """(n, 3) rotor hub positions in the body frame, ordered by motor number."""
-    return spec.frame.rotor_positions_m(spec["arm_length"], spec["rotor_offset_top"])
+    """(n, 3) rotor hub positions in the body frame, ordered by motor number: on a CAD
+    body's motor mounts, else the frame's pattern for arm_length about the rotor centre."""
+    import numpy as np
+
+    if spec.cad is not None and spec.cad.rotor_positions_m is not None:
+        return np.array(spec.cad.rotor_positions_m, dtype=float)
+    pattern = spec.frame.rotor_positions_m(spec["arm_length"], spec["rotor_offset_top"])
+    return pattern + np.array(rotor_centre_m(spec))
+
+
+def rotor_centre_m(spec: PackageSpec) -> tuple[float, float, float]:
+    return spec.cad.centre_m if spec.cad is not None else (0.0, 0.0, 0.0)
+
+
+def body_com_m(spec: PackageSpec) -> tuple[float, float, float]:
+    return spec.cad.body_com_m if spec.cad is not None else (0.0, 0.0, 0.0)
 
 
 def total_mass_estimate_kg(spec: PackageSpec) -> float:
@@ -470,8 +496,41 @@ def _py_coeff(coefficient: float, prop: str) -> str:
 
 
 def _xacro_coeff(coefficient: float, prop: str) -> str:
-    expr = _py_coeff(coefficient, prop)
-    return expr if expr == "0" else f"${{{expr}}}"
+    return _as_xacro(_py_coeff(coefficient, prop))
+
+
+def _as_xacro(expr: str) -> str:
+    """A Python expression as a xacro attribute value: plain numbers stay plain."""
+    try:
+        float(expr)
+        return expr
+    except ValueError:
+        return f"${{{expr}}}"
+
+
+def _centred(centre_m: float, expr: str) -> str:
+    """`expr` moved by a rotor-centre coordinate, e.g. `0.0152 + arm_length`."""
+    from reedtool.physics.inertia import fmt_number
+
+    if centre_m == 0.0:
+        return expr
+    if expr == "0":
+        return fmt_number(centre_m)
+    return f"{fmt_number(centre_m)} + {expr}"
+
+
+def com_text(com_m) -> str:
+    """A COM as an xyz attribute; below a nanometre is the mesh integral's round-off: 0."""
+    from reedtool.physics.inertia import fmt_number
+
+    return " ".join(fmt_number(0.0 if abs(v) < 1e-9 else float(v)) for v in com_m)
+
+
+def _body_depth_m(spec: PackageSpec) -> float:
+    """How far the body reaches below base_link: the mesh's lowest point, else half the box."""
+    if spec.cad is not None:
+        return max(-spec.cad.body_bottom_z_m, 0.0)
+    return spec["body_height"] / 2.0
 
 
 def _inertia_attrs(I) -> dict[str, str]:
@@ -485,8 +544,9 @@ def _inertia_attrs(I) -> dict[str, str]:
 def template_context(spec: PackageSpec, body_props=None) -> dict:
     """Everything the templates may use, with numbers already formatted.
 
-    `body_props` (reedtool.physics.inertia.MassProperties about the body origin) replaces the body
-    box when a mesh was imported; its COM must already be at the origin.
+    `body_props` (reedtool.physics.inertia.MassProperties in the body frame: COM and the
+    tensor about it) replaces the body box when a mesh was imported; its COM is written
+    into the body's <inertial><origin>.
     """
     from reedtool.physics.inertia import fmt_number
 
@@ -544,7 +604,9 @@ def _multirotor_context(spec: PackageSpec, body_props) -> dict:
     blade = (spec["radius_rotor"], ROTOR_BLADE_WIDTH_M, ROTOR_BLADE_THICKNESS_M)
     rotor_I = box_inertia(spec["mass_rotor"] * spec["rotor_velocity_slowdown_sim"], blade)
 
-    positions = frame.rotor_positions_m(spec["arm_length"], spec["rotor_offset_top"])
+    positions = rotor_positions_m(spec)
+    centre = rotor_centre_m(spec)
+    on_mounts = spec.cad is not None and spec.cad.rotor_positions_m is not None
     rotors = []
     parts = [body_props]
     if sensor_mass_kg(spec) > 0.0:
@@ -552,14 +614,19 @@ def _multirotor_context(spec: PackageSpec, body_props) -> dict:
                                     sphere_inertia(sensor_mass_kg(spec), 0.01)))
     for slot, position in zip(frame.rotors, positions):
         ux, uy = frame.unit_xy(slot)
-        z_expr = "${rotor_offset_top}" if slot.level > 0 else "${-rotor_offset_top}"
+        if on_mounts:
+            # On the CAD body's motor mounts: where the mesh has them, not a pattern.
+            xyz_expr = [fmt_number(float(v)) for v in position]
+        else:
+            xyz_expr = [_centred(c, expr) for c, expr in zip(centre, (
+                _py_coeff(ux, "arm_length"), _py_coeff(uy, "arm_length"),
+                "rotor_offset_top" if slot.level > 0 else "-rotor_offset_top"))]
         rotors.append({
             "suffix": slot.suffix, "motor_number": slot.motor_number,
             "direction": slot.direction, "direction_sign": 1 if slot.direction == "ccw" else -1,
             "color": "Red" if position[0] < -1e-9 else "Blue",
-            "xyz": f"{_xacro_coeff(ux, 'arm_length')} {_xacro_coeff(uy, 'arm_length')} {z_expr}",
-            "xyz_expr": [_py_coeff(ux, "arm_length"), _py_coeff(uy, "arm_length"),
-                         "rotor_offset_top" if slot.level > 0 else "-rotor_offset_top"],
+            "xyz": " ".join(_as_xacro(expr) for expr in xyz_expr),
+            "xyz_expr": xyz_expr,
             "angle_rad": fmt_number(float(np.arctan2(position[1], position[0]))),
             "radial_m": fmt_number(float(np.hypot(position[0], position[1]))),
             "position_m": [fmt_number(v) for v in position],
@@ -568,6 +635,7 @@ def _multirotor_context(spec: PackageSpec, body_props) -> dict:
                                     box_inertia(spec["mass_rotor"], blade)))
     total = combine(parts)
     I_total = total.inertia_kg_m2
+    body_com = body_props.com_m
     gains = scaled_lee_gains(total.mass_kg, I_total)
     return {
         "rotor_count": frame.rotor_count,
@@ -575,14 +643,15 @@ def _multirotor_context(spec: PackageSpec, body_props) -> dict:
         "frame_reference": frame.reference,
         "body_inertia": _inertia_attrs(body_props.inertia_kg_m2),
         "body_inertia_source": body_source,
+        "body_com_xyz": com_text(body_com),
         "rotor_inertia": _inertia_attrs(rotor_I),
         "total_mass_kg": fmt_number(total.mass_kg),
         "total_inertia": _inertia_attrs(I_total),
         "lee_gains": gains,
         "thrust_to_weight": f"{thrust_to_weight(spec):.2f}",
         "rotor_disc_thickness_m": fmt_number(ROTOR_DISC_THICKNESS_M),
-        # Spawn 5 cm above the ground: below the body box or the lower rotor discs.
-        "spawn_z_m": fmt_number(round(0.05 + max(spec["body_height"] / 2.0, max(
+        # Spawn 5 cm above the ground: below the body (box or mesh) or the lower rotor discs.
+        "spawn_z_m": fmt_number(round(0.05 + max(_body_depth_m(spec), max(
             -p[2] for p in positions) + ROTOR_DISC_THICKNESS_M / 2.0), 3)),
     }
 
@@ -622,6 +691,7 @@ def _ground_context(spec: PackageSpec, body_props) -> dict:
         "drive": layout.drive,
         "body_inertia": _inertia_attrs(body_props.inertia_kg_m2),
         "body_inertia_source": body_source,
+        "body_com_xyz": com_text(body_props.com_m),
         "wheel_inertia": _inertia_attrs(cylinder_inertia(spec["wheel_mass"], r,
                                                          spec["wheel_width"], axis="y")),
         "base_height": fmt_number(base_height_m),
