@@ -123,7 +123,8 @@ def test_bad_view_options_are_one_line(tmp_path, bad, says):
 
 
 def test_layout_draws_the_cad_body_silhouette_not_its_box(tmp_path):
-    code, text = run_cli("new-package", "cadq", "--mesh", CAD_BODY, "-o", tmp_path)
+    code, text = run_cli("new-package", "cadq", "--mesh", CAD_BODY, "--mesh-units", "mm",
+                         "-o", tmp_path)
     assert code == 0, text
     model = tmp_path / "cadq" / "urdf" / "mav_generic_odometry_sensor.gazebo"
     robot = load_robot(model)
