@@ -145,3 +145,19 @@ def test_layout_draws_the_cad_body_silhouette_not_its_box(tmp_path):
 
     assert covered(centre) and not covered(corner)
     assert run_cli("layout", model, "-o", tmp_path / "l.svg")[0] == 0
+
+
+def test_outline_discs_make_the_rotor_links_see_through(example):
+    """--discs outline: the rotors' own geometry turns into a veil (alpha 50 of 255), so
+    the mounts under it show; filled discs leave it opaque."""
+    from reedtool.report.scene import ROTOR_FADE_ALPHA
+
+    rotor_links = {r.link for r in discover_rotors(example) if r.link}
+    for style, expected in (("outline", ROTOR_FADE_ALPHA), ("filled", 255)):
+        view = view_robot(example, disc_style=style)
+        scene = view.scene
+        alphas = {int(np.max(np.asarray(scene.geometry[scene.graph[node][1]].visual
+                                         .face_colors)[:, 3]))
+                  for node in scene.graph.nodes_geometry
+                  if scene.graph.transforms.parents.get(node) in rotor_links}
+        assert alphas == {expected}, (style, alphas)

@@ -479,6 +479,8 @@ def _decorate(view: ViewScene, robot, rotors, disc_style: str = "filled") -> Non
               and np.linalg.norm(r.axis) > 0]
     # the disc radius `layout` draws: the rotor link's cylinder, else from the rotor gaps
     marks = rotor_marks(robot, rotors)
+    if disc_style == "outline":
+        _fade_rotor_links(view, [rotor.link for rotor in rotors if rotor.link])
     for rotor, mark in zip(rotors, marks):
         radius = mark.radius_m
         T_base_disc = _frame_along(np.asarray(rotor.position_m, dtype=float),
@@ -520,6 +522,27 @@ def _decorate(view: ViewScene, robot, rotors, disc_style: str = "filled") -> Non
     _add(scene, bar, "scale_bar", base,
          _translation([low[0] + 0.5 * view.framing.scale_bar_m, low[1] - 0.05 * size_m, low[2]]),
          (0, 0, 0, 255))
+
+
+ROTOR_FADE_ALPHA = 50       # of 255: a propeller stand-in as a veil over what it covers
+
+
+def _fade_rotor_links(view: ViewScene, links: list[str]) -> None:
+    """With outlined discs, the rotor links' own geometry (RotorS' propeller cylinders, a
+    prop mesh) is drawn see-through too: otherwise it hides the motor mounts the outline
+    is there to show."""
+    scene = view.scene
+    for node in list(scene.graph.nodes_geometry):
+        if node.startswith(DECORATION_PREFIXES):
+            continue
+        if scene.graph.transforms.parents.get(node) not in links:
+            continue
+        _, geometry_name = scene.graph[node]
+        mesh = scene.geometry[geometry_name].copy()
+        colours = np.asarray(mesh.visual.face_colors).copy()
+        colours[:, 3] = np.minimum(colours[:, 3], ROTOR_FADE_ALPHA)
+        mesh.visual.face_colors = colours
+        scene.geometry[geometry_name] = mesh
 
 
 def _front(view: ViewScene, rotors) -> None:
