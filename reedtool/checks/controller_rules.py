@@ -256,6 +256,11 @@ def controller_direction_mismatch(ctx: CheckContext) -> Iterator[Issue]:
 
 def _angle_hint(ctx: CheckContext, entry: "ControllerRotor", model_rad: float,
                 controller_rad: float) -> str:
+    # Degrees where radians are read: the number, taken as degrees, is the model's angle.
+    if abs(controller_rad) > ANGLE_TOL_RAD \
+            and abs(_wrap(math.radians(controller_rad) - model_rad)) < ANGLE_TOL_RAD:
+        return (f"{controller_rad:g} is the rotor's angle in degrees; RotorS reads radians: "
+                f"set angle: {model_rad:.6g}")
     # An entry that matches another motor in angle and direction is an ordering mistake.
     for number, other in _motor_index(ctx).items():
         planar = _planar(other)

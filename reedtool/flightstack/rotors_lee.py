@@ -113,6 +113,7 @@ def load_lee_parameters(paths) -> LeeParameters:
                      f"{ROTORS_DEFAULT_INERTIA_KG_M2} kg*m^2 (the Firefly's)")
     if gains.defaulted:
         notes.append(f"not set, RotorS' default (the Firefly's) used: {', '.join(gains.defaulted)}")
+    vehicle.lee_gains = gains
     return LeeParameters(gains, vehicle, [str(p) for p in paths], notes)
 
 
@@ -195,3 +196,83 @@ def parse_gains(texts: list[tuple[Path, str]]) -> LeeGainsTable:
                  if f"{key}/{axis}" not in set_keys]
     return LeeGainsTable(*(np.array(values[key], dtype=float) for key in GAIN_KEYS),
                          locs=locs, defaulted=defaulted, problems=problems)
+
+
+# ------------------------------------------------------------ the loops the gains make
+
+# The Firefly's gains (rotors_gazebo lee_controller_firefly.yaml) and the vehicle they were
+# tuned on (firefly.yaml): what "N times the usual gain" is measured against.
+FIREFLY_GAINS = {"position_gain": (6.0, 6.0, 6.0), "velocity_gain": (4.7, 4.7, 4.7),
+                 "attitude_gain": (3.0, 3.0, 0.15), "angular_rate_gain": (0.52, 0.52, 0.18)}
+FIREFLY_MASS_KG = ROTORS_DEFAULT_MASS_KG
+FIREFLY_INERTIA_KG_M2 = ROTORS_DEFAULT_INERTIA_KG_M2
+
+
+def _expm(M: np.ndarray) -> np.ndarray:
+    """exp(M) of a small matrix: scaling and squaring with an 18-term Taylor series (the
+    norm is scaled below 0.5 first, so the truncation error is below 0.5^19 / 19!)."""
+    norm = float(np.max(np.sum(np.abs(M), axis=1)))
+    s = max(0, int(math.ceil(math.log2(norm / 0.5)))) if norm > 0.5 else 0
+    A = M / (2.0 ** s)
+    out, term = np.eye(len(M)), np.eye(len(M))
+    for k in range(1, 19):
+        term = term @ A / k
+        out = out + term
+    for _ in range(s):
+        out = out @ out
+    return out
+
+
+def loop_spectral_radius(stiffness: float, damping: float, inertia: float, lag_s: float,
+                         period_s: float) -> float:
+    """The spectral radius of one axis' sampled closed loop: inertia * x'' = f, the force
+    (or torque) f following the command u through a first-order lag `lag_s` (the motors;
+    0: none), u = -stiffness x_k - damping x'_k computed every `period_s` and held (zero-
+    order hold, as RotorS' node holds its command between odometry messages). < 1: stable.
+
+    The exact discretisation: x_{k+1} = Phi x_k + Gamma u_k from the matrix exponential of
+    [[A, B], [0, 0]] * period, closed with u_k = -K x_k.
+    """
+    if lag_s > 0:
+        A = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0 / inertia], [0.0, 0.0, -1.0 / lag_s]])
+        B = np.array([0.0, 0.0, 1.0 / lag_s])
+        K = np.array([stiffness, damping, 0.0])
+    else:
+        A = np.array([[0.0, 1.0], [0.0, 0.0]])
+        B = np.array([0.0, 1.0 / inertia])
+        K = np.array([stiffness, damping])
+    n = len(A)
+    M = np.zeros((n + 1, n + 1))
+    M[:n, :n], M[:n, n] = A, B
+    E = _expm(M * period_s)
+    closed = E[:n, :n] - np.outer(E[:n, n], K)
+    return float(np.max(np.abs(np.linalg.eigvals(closed))))
+
+
+def largest_stable_scale(stiffness: float, damping: float, inertia: float, lag_s: float,
+                         period_s: float) -> float:
+    """The largest s for which s * (stiffness, damping) keeps the sampled loop stable
+    (bisection on log s over 1e-6 .. 1e6, to 1 %); inf if stable throughout."""
+    def stable(s: float) -> bool:
+        return loop_spectral_radius(s * stiffness, s * damping, inertia, lag_s, period_s) < 1.0
+
+    lo, hi = 1e-6, 1e6
+    if stable(hi):
+        return math.inf
+    if not stable(lo):
+        return 0.0
+    while hi / lo > 1.01:
+        mid = math.sqrt(lo * hi)
+        lo, hi = (mid, hi) if stable(mid) else (lo, mid)
+    return lo
+
+
+def firefly_scaled(key: str, axis: int, mass_kg: float, inertia_kg_m2) -> float:
+    """The Firefly's gain for `key`/axis scaled to a vehicle: by mass for the position and
+    velocity gains (forces per metre), by the principal moment for the attitude and rate
+    gains (torques per radian): the same closed-loop frequencies and damping as the
+    Firefly's (sim.lee_rotors.loops)."""
+    base = FIREFLY_GAINS[key][axis]
+    if key in ("position_gain", "velocity_gain"):
+        return base * mass_kg / FIREFLY_MASS_KG
+    return base * float(np.asarray(inertia_kg_m2)[axis, axis]) / FIREFLY_INERTIA_KG_M2[axis]

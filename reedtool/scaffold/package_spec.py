@@ -446,9 +446,17 @@ def _check_propeller_clearance(spec: PackageSpec) -> None:
 # RotorS' firefly, which the Lee controller gains in rotors_gazebo were tuned for.
 _FIREFLY_MASS_KG = 1.56779
 _FIREFLY_INERTIA_KG_M2 = (0.0347563, 0.0458929, 0.0977)
+# rotors_gazebo/resource/lee_controller_firefly.yaml, the file RotorS' firefly launch
+# files load. Yaw: 0.15 and 0.18, not lee_position_controller.h's compiled-in 0.035 and
+# 0.025. RotorS' normalisation makes the yaw loop J_z psi'' = -k_R psi - k_w psi' (see
+# sim/lee_rotors.py), so on the Firefly (J_z 0.0977) the compiled-in pair gives
+# w_n = sqrt(0.035 / 0.0977) = 0.60 rad/s at damping 0.025 / (2 sqrt(0.035 * 0.0977))
+# = 0.21 (a 0.3 rad yaw error takes ~8 s to settle within 2 deg), the YAML's 1.24 rad/s
+# at 0.74. Scaling by J_z keeps both numbers on any vehicle (hover-test --controller
+# flies them: tests/test_lee_controller.py).
 _FIREFLY_LEE_GAINS = {
     "position_gain": (6.0, 6.0, 6.0), "velocity_gain": (4.7, 4.7, 4.7),
-    "attitude_gain": (3.0, 3.0, 0.035), "angular_rate_gain": (0.52, 0.52, 0.025)}
+    "attitude_gain": (3.0, 3.0, 0.15), "angular_rate_gain": (0.52, 0.52, 0.18)}
 
 # The seed's rotor inertia convention (RotorS' own): a 3 mm x 15 mm blade box as long as
 # the rotor radius, with the rotor mass multiplied by rotor_velocity_slowdown_sim because

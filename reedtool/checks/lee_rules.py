@@ -1,0 +1,223 @@
+"""RotorS Lee controller rules (C450-C453): the gains and vehicle parameters RotorS'
+`lee_position_controller_node` reads, against the model they will fly.
+
+The controller files come from `hover-test --controller` and `validate --controller`
+(reedtool.flightstack.rotors_lee, reedtool.flightstack.controller_tables). The rotor
+table itself (count, angles, directions, constants, mass, inertia within tolerance) is
+C401-C411's; these rules catch what makes the Lee controller itself fail: a gain of the
+wrong sign, a loop the 100 Hz controller and the motors cannot hold (a unit slip in a
+gain), and a vehicle mass or inertia in another unit.
+
+Physics (sim/lee_rotors.py has the equations): RotorS divides the attitude and rate gains
+by the YAML inertia and multiplies the angular acceleration by it again, so about one axis
+the torque is -k_R theta - k_w theta' and the loop is J theta'' = -k_R theta - k_w theta'
+with the true J; the thrust is m_yaml g - k_x z - k_v z', so m x'' = -k_x x - k_v x'.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Iterator
+
+import numpy as np
+
+from reedtool.checks.context import CheckContext
+from reedtool.checks.finding import Issue
+from reedtool.checks.registry import rule
+
+# RotorS' basic.world steps at 100 Hz and the node commands once per odometry message.
+CONTROL_PERIOD_S = 0.01
+# A gain this many times the Firefly's scaled to the vehicle (or this fraction of it) is
+# named as a likely unit slip: tuned gains stay within a factor of a few of it (the
+# rotors_gazebo vehicles' gains, scaled to their own inertia, span 0.3x-3x the Firefly's).
+UNIT_SLIP_FACTOR = 30.0
+# A vehicle mass or inertia moment 10x off the model's is no estimate error; these are
+# the unit factors an inertia is then named after (ratio within 30 % of one).
+INERTIA_UNITS = {1e3: "g*m^2", 1e4: "kg*cm^2", 1e6: "kg*mm^2", 1e7: "g*cm^2", 1e9: "g*mm^2"}
+AXES = "xyz"
+
+
+def _lee_tables(ctx: CheckContext) -> list:
+    if not ctx.tree_ok:
+        return []
+    return [t for t in ctx.controller_tables if getattr(t, "lee_gains", None) is not None]
+
+
+def _motor_lag_s(ctx: CheckContext) -> float:
+    """The slowest rotor's mean of its spin-up and spin-down time constants (the torque
+    lags the speed command about hover with that time constant, linearised)."""
+    lags = [0.5 * (r.time_constant_up_s + r.time_constant_down_s) for r in ctx.lift_rotors
+            if math.isfinite(r.time_constant_up_s) and math.isfinite(r.time_constant_down_s)]
+    return max(lags) if lags else 0.0
+
+
+@rule("C450", "lee-gain-not-positive", "error",
+      "A RotorS Lee controller gain is zero or negative.", clause="cannot-fly")
+def lee_gain_not_positive(ctx: CheckContext) -> Iterator[Issue]:
+    """RotorS' Lee controller applies -k o error for every gain (position, velocity,
+    attitude, angular rate): a negative gain pushes the vehicle further from where it
+    should be, so it flips (attitude, rate) or runs away (position, velocity) on take-off;
+    a zero gain leaves that axis without a spring or damper.
+
+    Severity (error, cannot-fly): the loop is unstable or undamped.
+    """
+    for table in _lee_tables(ctx):
+        gains = table.lee_gains
+        for key in ("position_gain", "velocity_gain", "attitude_gain", "angular_rate_gain"):
+            for i, axis in enumerate(AXES):
+                value = float(gains.gain(key)[i])
+                if value > 0.0:
+                    continue
+                what = ("pushes the vehicle further from the setpoint" if value < 0
+                        else "leaves that axis without feedback")
+                yield Issue(f"{key}/{axis} is {value:g}: RotorS' Lee controller applies "
+                            f"-{key.replace('_gain', '')} gain x error, so this {what}; "
+                            "the vehicle flips or drifts away on take-off",
+                            gains.loc_of(key, axis), f"{key}/{axis}",
+                            hint=f"a positive gain (RotorS' Firefly uses "
+                                 f"{_firefly(key, i)}); a sign flipped for another axis "
+                                 "convention is not needed: RotorS uses the body frame FLU")
+
+
+def _firefly(key: str, i: int) -> str:
+    from reedtool.flightstack.rotors_lee import FIREFLY_GAINS
+
+    return f"{FIREFLY_GAINS[key][i]:g}"
+
+
+@rule("C451", "lee-loop-unstable", "error",
+      "A RotorS Lee controller loop is unstable at 100 Hz with the model's motors.",
+      clause="cannot-fly")
+def lee_loop_unstable(ctx: CheckContext) -> Iterator[Issue]:
+    """About each body axis the attitude and angular-rate gains make the loop
+    J theta'' = -k_R theta - k_w theta' (RotorS normalises by the YAML inertia and
+    multiplies by it again), with J the model's principal moment; the position and
+    velocity gains make m x'' = -k_x x - k_v x'. The node computes its command once per
+    odometry message, 100 Hz in RotorS' worlds, and holds it; the motors follow with
+    their time constants. The rule discretises each loop exactly (zero-order hold, the
+    motor lag as a first-order lag of the torque) and reports a loop whose sampled
+    closed loop has a pole outside the unit circle: a gain too large for 100 Hz, most
+    often a unit slip (it names the factor against the Firefly's gains scaled to this
+    vehicle).
+
+    Severity (error, cannot-fly): the controller oscillates with growing amplitude.
+    """
+    from reedtool.flightstack.rotors_lee import (
+        firefly_scaled,
+        largest_stable_scale,
+        loop_spectral_radius,
+    )
+
+    whole = ctx.whole_robot
+    J = np.asarray(whole.inertia_kg_m2, dtype=float)
+    if whole.mass_kg <= 0 or not np.all(np.isfinite(J)) or np.any(np.diag(J) <= 0):
+        return
+    lag_s = _motor_lag_s(ctx)
+    for table in _lee_tables(ctx):
+        gains = table.lee_gains
+        loops = [("attitude_gain", "angular_rate_gain", J[i, i], lag_s, i,
+                  f"J{AXES[i] * 2} = {J[i, i]:.4g} kg*m^2") for i in range(3)]
+        loops += [("position_gain", "velocity_gain", whole.mass_kg, 0.0, i,
+                   f"mass {whole.mass_kg:.4g} kg") for i in range(3)]
+        for k_key, d_key, inertia, lag, i, plant in loops:
+            k, d = float(gains.gain(k_key)[i]), float(gains.gain(d_key)[i])
+            if not (k > 0 and d > 0):
+                continue          # C450's
+            radius = loop_spectral_radius(k, d, inertia, lag, CONTROL_PERIOD_S)
+            if radius < 1.0:
+                continue
+            scale = largest_stable_scale(k, d, inertia, lag, CONTROL_PERIOD_S)
+            slips = []
+            for key, value in ((k_key, k), (d_key, d)):
+                usual = firefly_scaled(key, i, whole.mass_kg, J)
+                ratio = value / usual
+                if ratio >= UNIT_SLIP_FACTOR:
+                    slips.append(f"{key}/{AXES[i]} {value:g} is {ratio:.3g}x the Firefly's "
+                                 f"scaled to this vehicle ({usual:.3g})")
+            cause = ("; " + ", ".join(slips) + ": a unit slip?") if slips else ""
+            lagged = f" and its motors' {lag:.3g} s lag" if lag > 0 else ""
+            yield Issue(
+                f"{k_key}/{AXES[i]} {k:g} with {d_key}/{AXES[i]} {d:g} on this model "
+                f"({plant}) is unstable at RotorS' {1 / CONTROL_PERIOD_S:g} Hz"
+                f"{lagged}: the sampled loop's largest pole has magnitude {radius:.3g} "
+                f"(> 1); stable only up to {scale:.3g}x these gains{cause}",
+                # located at the gain named as the slip (the damping one if both are)
+                gains.loc_of(d_key if slips and slips[-1].startswith(d_key) else k_key,
+                             AXES[i]), f"{k_key}/{AXES[i]}",
+                hint=f"set {k_key}/{AXES[i]}: "
+                     f"{firefly_scaled(k_key, i, whole.mass_kg, J):.3g} and {d_key}/{AXES[i]}: "
+                     f"{firefly_scaled(d_key, i, whole.mass_kg, J):.3g} (the Firefly's "
+                     "scaled to this vehicle) and tune from there")
+
+
+def _unit_named(ratio: float, units: dict[float, str]) -> str | None:
+    for factor, name in units.items():
+        if 0.7 <= ratio / factor <= 1.0 / 0.7:
+            return name
+    return None
+
+
+@rule("C452", "lee-mass-unit-slip", "error",
+      "A RotorS vehicle file's mass is 10x or more off the model's.", clause="cannot-fly")
+def lee_mass_unit_slip(ctx: CheckContext) -> Iterator[Issue]:
+    """RotorS' Lee controller feeds forward the hover thrust m g with the vehicle file's
+    `mass` and has no integral term: with the mass 10x off, the thrust it commands at the
+    setpoint is 10x off the weight, and the vehicle climbs away at full throttle or never
+    leaves the ground. C409 reports smaller differences (an altitude offset of
+    (m_model - m_file) g / k_z).
+
+    Severity (error, cannot-fly): the controller cannot hold the vehicle's weight.
+    """
+    if not ctx.tree_ok:
+        return
+    whole = ctx.whole_robot.mass_kg
+    for table in ctx.controller_tables:
+        if table.source != "yaml" or table.mass_kg is None or not math.isfinite(table.mass_kg):
+            continue
+        if whole <= 0 or table.mass_kg <= 0:
+            continue
+        ratio = table.mass_kg / whole
+        if 0.1 < ratio < 10.0:
+            continue
+        unit = _unit_named(ratio, {1e3: "grams written as kg", 1e-3: "the file in kg, the "
+                                   "model in grams"})
+        yield Issue(f"{table.label}: mass {table.mass_kg:.6g} kg is {ratio:.3g}x the model's "
+                    f"{whole:.6g} kg ('{ctx.robot.name}'); the Lee controller's hover thrust "
+                    f"{table.mass_kg * 9.81:.4g} N is that far off the weight"
+                    + (f" ({unit}?)" if unit else ""), table.loc_of("mass"), ctx.robot.name,
+                    hint=f"set mass: {whole:.6g} (kg, the whole vehicle)")
+
+
+@rule("C453", "lee-inertia-unit-slip", "warning",
+      "A RotorS vehicle file's inertia is 10x or more off the model's.", clause="suspicious")
+def lee_inertia_unit_slip(ctx: CheckContext) -> Iterator[Issue]:
+    """RotorS' controllers read `inertia` in kg*m^2. A moment 10x or more off the model's
+    is another unit (g*cm^2 is 10^7 kg*m^2, kg*mm^2 10^6) or another vehicle's file.
+    RotorS' Lee and roll-pitch-yawrate controllers divide the attitude gains by this
+    inertia and multiply the angular acceleration by it again, so a uniform factor
+    cancels and their flight is unchanged (hover-test --controller flies the same); the
+    numbers are still wrong for anything else that reads the file.
+
+    Severity (warning, suspicious): the file is wrong, but RotorS' controllers fly the
+    same with it.
+    """
+    if not ctx.tree_ok:
+        return
+    I_m = np.asarray(ctx.whole_robot.inertia_kg_m2, dtype=float)
+    for table in ctx.controller_tables:
+        I_c = table.inertia_kg_m2
+        if table.source != "yaml" or I_c is None or not np.all(np.isfinite(I_c)):
+            continue
+        ratios = [I_c[i, i] / I_m[i, i] for i in range(3) if I_m[i, i] > 0 and I_c[i, i] > 0]
+        off = [r for r in ratios if not 0.1 < r < 10.0]
+        if not off:
+            continue
+        ratio = float(np.exp(np.mean(np.log(off))))
+        unit = _unit_named(ratio, INERTIA_UNITS)
+        yield Issue(f"{table.label}: inertia is {ratio:.3g}x the model's whole-robot inertia "
+                    f"about its COM ('{ctx.robot.name}')"
+                    + (f": {unit} written where kg*m^2 is read?" if unit else "")
+                    + "; RotorS' Lee controller flies the same (the factor cancels), anything "
+                      "else reading the file does not", table.loc_of("inertia"),
+                    ctx.robot.name,
+                    hint="write the inertia in kg*m^2 (`reedtool inertia` prints the model's)")
