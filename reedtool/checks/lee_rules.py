@@ -70,11 +70,11 @@ def lee_gain_not_positive(ctx: CheckContext) -> Iterator[Issue]:
                     continue
                 what = ("pushes the vehicle further from the setpoint" if value < 0
                         else "leaves that axis without feedback")
-                yield Issue(f"{key}/{axis} is {value:g}: RotorS' Lee controller applies "
+                yield Issue(f"{key}/{axis} is {value:g}: the RotorS Lee controller applies "
                             f"-{key.replace('_gain', '')} gain x error, so this {what}; "
                             "the vehicle flips or drifts away on take-off",
                             gains.loc_of(key, axis), f"{key}/{axis}",
-                            hint=f"a positive gain (RotorS' Firefly uses "
+                            hint=f"a positive gain (the RotorS Firefly uses "
                                  f"{_firefly(key, i)}); a sign flipped for another axis "
                                  "convention is not needed: RotorS uses the body frame FLU")
 
@@ -127,26 +127,26 @@ def lee_loop_unstable(ctx: CheckContext) -> Iterator[Issue]:
             if radius < 1.0:
                 continue
             scale = largest_stable_scale(k, d, inertia, lag, CONTROL_PERIOD_S)
-            slips = []
-            for key, value in ((k_key, k), (d_key, d)):
-                usual = firefly_scaled(key, i, whole.mass_kg, J)
-                ratio = value / usual
-                if ratio >= UNIT_SLIP_FACTOR:
-                    slips.append(f"{key}/{AXES[i]} {value:g} is {ratio:.3g}x the Firefly's "
-                                 f"scaled to this vehicle ({usual:.3g})")
-            cause = ("; " + ", ".join(slips) + ": a unit slip?") if slips else ""
-            lagged = f" and its motors' {lag:.3g} s lag" if lag > 0 else ""
+            # The gain furthest from the Firefly gain scaled to this vehicle is the cause
+            # named (messages avoid apostrophes: quoted names are shortened).
+            ratios = [(value / firefly_scaled(key, i, whole.mass_kg, J), key, value)
+                      for key, value in ((k_key, k), (d_key, d))]
+            ratio, key, value = max(ratios, key=lambda r: abs(math.log(r[0])))
+            usual = value / ratio
+            slip = (f"{key}/{AXES[i]} {value:g} is {ratio:.0f}x the Firefly gain scaled to "
+                    f"this vehicle ({usual:.3g}): a unit slip? "
+                    if ratio >= UNIT_SLIP_FACTOR else "")
+            lagged = f" with motor lag {lag:.3g} s" if lag > 0 else ""
+            loop_name = "attitude" if k_key == "attitude_gain" else "position"
             yield Issue(
-                f"{k_key}/{AXES[i]} {k:g} with {d_key}/{AXES[i]} {d:g} on this model "
-                f"({plant}) is unstable at RotorS' {1 / CONTROL_PERIOD_S:g} Hz"
-                f"{lagged}: the sampled loop's largest pole has magnitude {radius:.3g} "
-                f"(> 1); stable only up to {scale:.3g}x these gains{cause}",
-                # located at the gain named as the slip (the damping one if both are)
-                gains.loc_of(d_key if slips and slips[-1].startswith(d_key) else k_key,
-                             AXES[i]), f"{k_key}/{AXES[i]}",
+                f"{loop_name} loop about {AXES[i]} unstable at the {1 / CONTROL_PERIOD_S:g} Hz "
+                f"of RotorS worlds{lagged}: {slip}{k_key}/{AXES[i]} {k:g} and "
+                f"{d_key}/{AXES[i]} {d:g} on {plant} give a sampled pole of magnitude "
+                f"{radius:.3g} (> 1); stable only up to {scale:.3g}x these gains",
+                gains.loc_of(key if slip else k_key, AXES[i]), f"{k_key}/{AXES[i]}",
                 hint=f"set {k_key}/{AXES[i]}: "
                      f"{firefly_scaled(k_key, i, whole.mass_kg, J):.3g} and {d_key}/{AXES[i]}: "
-                     f"{firefly_scaled(d_key, i, whole.mass_kg, J):.3g} (the Firefly's "
+                     f"{firefly_scaled(d_key, i, whole.mass_kg, J):.3g} (the Firefly gains "
                      "scaled to this vehicle) and tune from there")
 
 
@@ -181,9 +181,10 @@ def lee_mass_unit_slip(ctx: CheckContext) -> Iterator[Issue]:
             continue
         unit = _unit_named(ratio, {1e3: "grams written as kg", 1e-3: "the file in kg, the "
                                    "model in grams"})
-        yield Issue(f"{table.label}: mass {table.mass_kg:.6g} kg is {ratio:.3g}x the model's "
-                    f"{whole:.6g} kg ('{ctx.robot.name}'); the Lee controller's hover thrust "
-                    f"{table.mass_kg * 9.81:.4g} N is that far off the weight"
+        yield Issue(f"{table.label}: mass {table.mass_kg:.6g} kg is {ratio:.3g}x the "
+                    f"{whole:.6g} kg of the model '{ctx.robot.name}'; the hover thrust the Lee "
+                    f"controller feeds forward, {table.mass_kg * 9.81:.4g} N, is that far off "
+                    "the weight"
                     + (f" ({unit}?)" if unit else ""), table.loc_of("mass"), ctx.robot.name,
                     hint=f"set mass: {whole:.6g} (kg, the whole vehicle)")
 
@@ -214,10 +215,10 @@ def lee_inertia_unit_slip(ctx: CheckContext) -> Iterator[Issue]:
             continue
         ratio = float(np.exp(np.mean(np.log(off))))
         unit = _unit_named(ratio, INERTIA_UNITS)
-        yield Issue(f"{table.label}: inertia is {ratio:.3g}x the model's whole-robot inertia "
-                    f"about its COM ('{ctx.robot.name}')"
+        yield Issue(f"{table.label}: inertia is {ratio:.3g}x the whole-robot inertia about "
+                    f"the COM of the model '{ctx.robot.name}'"
                     + (f": {unit} written where kg*m^2 is read?" if unit else "")
-                    + "; RotorS' Lee controller flies the same (the factor cancels), anything "
+                    + "; the RotorS Lee controller flies the same (the factor cancels), anything "
                       "else reading the file does not", table.loc_of("inertia"),
                     ctx.robot.name,
                     hint="write the inertia in kg*m^2 (`reedtool inertia` prints the model's)")
