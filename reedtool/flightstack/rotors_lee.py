@@ -276,3 +276,34 @@ def firefly_scaled(key: str, axis: int, mass_kg: float, inertia_kg_m2) -> float:
     if key in ("position_gain", "velocity_gain"):
         return base * mass_kg / FIREFLY_MASS_KG
     return base * float(np.asarray(inertia_kg_m2)[axis, axis]) / FIREFLY_INERTIA_KG_M2[axis]
+
+
+def load_controller_files(paths) -> list[ControllerTable]:
+    """validate --controller's files: each vehicle YAML (rotor_configuration) is a table;
+    Lee gain files (lee_controller_<mav>.yaml) are read with the vehicle file given
+    beside them on the command line (the last one) or found beside them, and their gains
+    ride on that table (checked by C450-C451)."""
+    from reedtool.flightstack.controller_tables import load_controller_yaml
+    from reedtool.io.fileio import read_text_file
+
+    paths = [Path(p) for p in paths]
+    vehicle_files, gain_files = [], []
+    for path in paths:
+        if not path.exists() and not path.is_symlink():
+            raise ReedtoolError("controller file not found", file=path,
+                                hint="check the --controller path")
+        text = read_text_file(path, what="controller file")
+        has_gains = any(_has_key(text, path, key) for key in GAIN_KEYS)
+        if has_gains and not _has_key(text, path, "rotor_configuration"):
+            gain_files.append(path)
+        else:
+            vehicle_files.append(path)
+    tables = [load_controller_yaml(path) for path in vehicle_files]
+    if gain_files:
+        lee = load_lee_parameters(gain_files + vehicle_files[-1:])
+        same = [t for t in tables if t.file == lee.vehicle.file]
+        if same:
+            same[-1].lee_gains = lee.gains
+        else:
+            tables.append(lee.vehicle)
+    return tables
