@@ -386,3 +386,81 @@ def test_validate_names_degrees(tmp_path):
     code, findings = validate_codes(tmp_path, vehicle=vehicle)
     assert code == 1 and [f["code"] for f in findings] == ["C405"] * 4
     assert all("in degrees; RotorS reads radians" in f["hint"] for f in findings)
+
+
+# ------------------------------------------------------------------ COM off the base origin
+
+BATTERY_KG, BATTERY_X_M = 0.3, 0.08      # a battery strapped 8 cm forward, as users do
+BATTERY_I = 1e-5                        # its own inertia, each axis [kg m^2]
+
+
+def _with_battery(pkg, tmp_path):
+    """A copy of the package with a battery link fixed to the base link, 8 cm forward."""
+    import shutil
+
+    copy = tmp_path / pkg.name
+    shutil.copytree(pkg, copy)
+    xacro = copy / "urdf" / f"{pkg.name}.xacro"
+    battery = f"""
+  <link name="${{namespace}}/battery">
+    <inertial><origin xyz="0 0 0"/><mass value="{BATTERY_KG}"/>
+      <inertia ixx="{BATTERY_I}" ixy="0" ixz="0" iyy="{BATTERY_I}" iyz="0" izz="{BATTERY_I}"/>
+    </inertial>
+  </link>
+  <joint name="${{namespace}}/battery_joint" type="fixed">
+    <parent link="${{namespace}}/base_link"/><child link="${{namespace}}/battery"/>
+    <origin xyz="{BATTERY_X_M} 0 0" rpy="0 0 0"/>
+  </joint>
+</robot>"""
+    text = xacro.read_text()
+    xacro.write_text(text[:text.rindex("</robot>")] + battery.lstrip("\n") + "\n")
+    return copy
+
+
+def test_com_off_the_base_origin(packages, tmp_path):
+    """With the COM 13 mm forward of the base origin, RotorS' allocation must measure the
+    rotors from the COM: its torques are about that point, and the body turns about the
+    COM. The vehicle file is rewritten by hand here for the new mass and inertia (parallel
+    axis theorem) and with the rotors (a) from the base origin, (b) from the COM. (a) is
+    named (C405, C406) and does not fly: no integral term, so the attitude loop holds the
+    tilt error m g d / k_R that balances the COM's lever, and the position loop sits
+    m g theta / k_x off (about 0.3 m here); (b) is clean and flies."""
+    pkg = _with_battery(packages["quad-x"], tmp_path)
+    v = yaml.safe_load((pkg / "config" / f"{pkg.name}.yaml").read_text())
+    m0 = v["mass"]
+    m = m0 + BATTERY_KG
+    com_x = BATTERY_KG * BATTERY_X_M / m                       # 13.1 mm for the quad-x
+    I = v["inertia"]
+    # parallel axis: each part about the new COM (the old COM sits at -com_x, the battery
+    # at BATTERY_X_M - com_x, both on the x axis)
+    shift = m0 * com_x ** 2 + BATTERY_KG * (BATTERY_X_M - com_x) ** 2
+    v["mass"] = m
+    v["inertia"] = {**I, "xx": I["xx"] + BATTERY_I, "yy": I["yy"] + BATTERY_I + shift,
+                    "zz": I["zz"] + BATTERY_I + shift}
+    from_base = {k: dict(e) for k, e in v["rotor_configuration"].items()}
+    from_com = {}
+    for k, e in from_base.items():
+        x = e["arm_length"] * math.cos(e["angle"]) - com_x
+        y = e["arm_length"] * math.sin(e["angle"])
+        from_com[k] = {**e, "angle": math.atan2(y, x), "arm_length": math.hypot(x, y)}
+    g = (pkg / "config" / f"lee_controller_{pkg.name}.yaml").read_text()
+    results = {}
+    for label, rotors in (("base", from_base), ("com", from_com)):
+        d = tmp_path / label
+        d.mkdir()
+        (d / f"lee_controller_{pkg.name}.yaml").write_text(g)
+        (d / f"{pkg.name}.yaml").write_text(yaml.safe_dump({**v, "rotor_configuration": rotors}))
+        results[label] = fly(pkg, d / f"lee_controller_{pkg.name}.yaml")
+    code, report = results["base"]
+    assert code == 1 and report["verdict"]["status"] != "flies"
+    assert sorted(codes(report) | codes(report, "warning")) == ["C405", "C406"]
+    # C405 proposes, for each entry, the angle this test derived by hand about the COM
+    import re
+    for f in report["controller"]["preflight"]:
+        if f["code"] == "C405":
+            entry = re.search(r"rotor_configuration/(\d+)", f["message"]).group(1)
+            proposed = float(re.search(r"set angle: (-?[\d.]+)", f["hint"]).group(1))
+            assert proposed == pytest.approx(from_com[entry]["angle"], abs=1e-5)
+    code, report = results["com"]
+    assert [f["code"] for f in report["controller"]["preflight"]] == []
+    assert code == 0 and report["verdict"]["status"] == "flies", report["message"]

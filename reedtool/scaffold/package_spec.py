@@ -568,14 +568,19 @@ def _multirotor_context(spec: PackageSpec, body_props) -> dict:
             "xyz": f"{_xacro_coeff(ux, 'arm_length')} {_xacro_coeff(uy, 'arm_length')} {z_expr}",
             "xyz_expr": [_py_coeff(ux, "arm_length"), _py_coeff(uy, "arm_length"),
                          "rotor_offset_top" if slot.level > 0 else "-rotor_offset_top"],
-            "angle_rad": fmt_number(float(np.arctan2(position[1], position[0]))),
-            "radial_m": fmt_number(float(np.hypot(position[0], position[1]))),
             "position_m": [fmt_number(v) for v in position],
         })
         parts.append(MassProperties(spec["mass_rotor"], np.asarray(position),
                                     box_inertia(spec["mass_rotor"], blade)))
     total = combine(parts)
     I_total = total.inertia_kg_m2
+    # The controller's rotor angles and arms are measured from the centre of mass: RotorS'
+    # allocation gives torques about the point they are measured from, and the body turns
+    # about its COM (checks/controller_rules.py, C405/C406).
+    for rotor, position in zip(rotors, positions):
+        dx, dy = position[0] - total.com_m[0], position[1] - total.com_m[1]
+        rotor["angle_rad"] = fmt_number(float(np.arctan2(dy, dx)))
+        rotor["radial_m"] = fmt_number(float(np.hypot(dx, dy)))
     gains = scaled_lee_gains(total.mass_kg, I_total)
     return {
         "rotor_count": frame.rotor_count,
