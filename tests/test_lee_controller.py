@@ -464,3 +464,25 @@ def test_com_off_the_base_origin(packages, tmp_path):
     code, report = results["com"]
     assert [f["code"] for f in report["controller"]["preflight"]] == []
     assert code == 0 and report["verdict"]["status"] == "flies", report["message"]
+
+
+def test_mass_5_percent_low_hovers_low_and_says_so(packages, tmp_path):
+    """RotorS' pelican.yaml shape: the file's mass 5 % below the model's. No integral term,
+    so it hovers (m_file 9.81 - m 9.80665) / k_z off the height it is sent (by hand below);
+    hover-test names C409, reports that offset, and judges the flight about it."""
+    pkg = packages["quad-x"]
+
+    def light(v):
+        v["mass"] = round(v["mass"] * 0.95, 6)
+
+    gpath, vpath = broken_copy(pkg, tmp_path, vehicle=light)
+    code, report = fly(pkg, gpath)
+    c = report["controller"]
+    m, m_file = c["model_mass_kg"], yaml.safe_load(vpath.read_text())["mass"]
+    k_z = yaml.safe_load(gpath.read_text())["position_gain"]["z"]
+    by_hand = (m_file * 9.81 - m * 9.80665) / k_z          # about -12 cm
+    assert c["predicted_altitude_offset_m"] == pytest.approx(by_hand, rel=1e-3)
+    assert c["judged_about_offset"] and "C409" in codes(report, "warning")
+    assert code == 0 and report["verdict"]["status"] == "flies"
+    # it settled where the formula says: judged about that height, within the 5 cm band
+    assert report["sim"]["final_position_error_m"] < 0.05

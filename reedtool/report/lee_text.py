@@ -19,8 +19,10 @@ def controller_lines(c: dict) -> list[str]:
     offset = c["predicted_altitude_offset_m"]
     lines.append(f"  mass: file {c['yaml_mass_kg']:.6g} kg, model {c['model_mass_kg']:.6g} kg "
                  f"({100 * (ratio - 1):+.1f}%)"
-                 + (f"; no integral term: hovers {100 * offset:+.1f} cm off the setpoint "
-                    f"height" if offset is not None and abs(offset) >= 0.001 else ""))
+                 + (f"; no integral term: hovers {100 * offset:+.1f} cm off the height it "
+                    f"is sent" + (" (judged about that height)" if c.get("judged_about_offset")
+                                  else "")
+                    if offset is not None and abs(offset) >= 0.001 else ""))
     J_f, J_m = c["yaml_inertia_kg_m2"], c["model_inertia_kg_m2"]
     lines.append("  inertia diagonal: file " + ", ".join(f"{J_f[i][i]:.4g}" for i in range(3))
                  + "; model " + ", ".join(f"{J_m[i][i]:.4g}" for i in range(3)) + " kg*m^2")

@@ -183,6 +183,24 @@ class LeeGainsReport:
                 **self.loop.to_dict()}
 
 
+def equilibrium_altitude_offset_m(params: VehicleParams, lee: RotorsLee,
+                                  entry_of_rotor: np.ndarray | None = None) -> float:
+    """Where the vehicle hovers, level, relative to the height it is sent: no integral
+    term, so the collective T the controller asks, m_yaml g_c - k_z e_z, must give the
+    weight through the true motors. A command T gives rotor speeds squared M[:, 3] T
+    (entry order) and a true thrust c T with c = sum_i k_true,i M[entry_i, 3]; so
+    e_z = (m_yaml g_c - m g / c) / k_z. NaN when k_z or c is not positive."""
+    n = params.n_rotors
+    entry = motor_commands(lee, np.arange(n) if entry_of_rotor is None else entry_of_rotor)
+    column = lee.speed_map()[:, 3]
+    c = float(sum(params.motor_constant[j] * column[entry[j]] for j in range(n)
+                  if entry[j] >= 0))
+    k_z = float(lee.position_gain[2])
+    if not (c > 0 and k_z > 0):
+        return math.nan
+    return (lee.mass_kg * lee.gravity_m_s2 - params.weight_N / c) / k_z
+
+
 def motor_commands(lee: RotorsLee, entry_of_rotor: np.ndarray):
     """(n_rotors,) index of the controller entry each of the plant's rotors obeys (-1: none)."""
     entry_of_rotor = np.asarray(entry_of_rotor, dtype=int)
@@ -192,14 +210,17 @@ def motor_commands(lee: RotorsLee, entry_of_rotor: np.ndarray):
 def simulate_lee(params: VehicleParams, lee: RotorsLee, config: HoverConfig = HoverConfig(),
                  *, entry_of_rotor: np.ndarray | None = None,
                  odometry_from_com_m: np.ndarray | None = None,
-                 control_rate_hz: float = ROTORS_CONTROL_RATE_HZ, record: bool = False):
+                 control_rate_hz: float = ROTORS_CONTROL_RATE_HZ, record: bool = False,
+                 reference_offset_m: float = 0.0):
     """Fly `params` (the true vehicle) under RotorS' Lee controller from config's start;
     a sim.run.HoverRun judged as every hover flight is.
 
     `entry_of_rotor[j]`: the controller entry (motor speed index) rotor j of `params`
     obeys (its motor number; default j). `odometry_from_com_m`: where the odometry frame's
     origin (the base link) sits relative to the COM, body axes (default: at the COM).
-    The numpy engine only (sim.batch with a speed command).
+    `reference_offset_m`: the controller is sent the setpoint height minus this, so a
+    vehicle that hovers that far off what it is sent (equilibrium_altitude_offset_m) is
+    judged about where it settles. The numpy engine only (sim.batch with a speed command).
     """
     from reedtool.sim.batch import REASONS, simulate_batch
     from reedtool.sim.run import HoverRun, sample_series
@@ -216,7 +237,7 @@ def simulate_lee(params: VehicleParams, lee: RotorsLee, config: HoverConfig = Ho
     setpoint_com = np.array([0.0, 0.0, config.hover_altitude_m])
     # The controller is sent the setpoint for its odometry frame: the base link where it
     # hovers level with the COM at the hover setpoint.
-    p_ref = setpoint_com + r_odo
+    p_ref = setpoint_com + r_odo - np.array([0.0, 0.0, reference_offset_m])
     has_entry = entry >= 0
 
     def command_of(p, v, R, w) -> tuple[np.ndarray, bool, int]:
