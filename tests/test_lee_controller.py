@@ -486,3 +486,20 @@ def test_mass_5_percent_low_hovers_low_and_says_so(packages, tmp_path):
     assert code == 0 and report["verdict"]["status"] == "flies"
     # it settled where the formula says: judged about that height, within the 5 cm band
     assert report["sim"]["final_position_error_m"] < 0.05
+
+
+def test_bad_controller_input_is_one_line_exit_2(packages, tmp_path):
+    pkg = packages["quad-x"]
+    gains = pkg / "config" / f"lee_controller_{pkg.name}.yaml"
+    lonely = tmp_path / "lee_controller_other.yaml"          # no other.yaml beside it
+    lonely.write_text(gains.read_text())
+    for args, fragment in (
+            (("--controller", tmp_path / "missing.yaml"), "controller file not found"),
+            (("--controller", lonely), "no rotor_configuration"),
+            (("--controller", gains, "--samples", "3"), "--samples with --controller"),
+            (("--controller", gains, "--engine", "numba"), "--engine numba with --controller"),
+            (("--controller", gains, "--controller-rate", "5000"), "faster than"),
+    ):
+        code, output = run_cli("hover-test", model_of(pkg), *args)
+        assert code == 2 and fragment in output, output
+        assert "Traceback" not in output

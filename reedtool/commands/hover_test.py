@@ -164,8 +164,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
             if given:
                 raise ReedtoolError(f"bad option: {option} with --controller: the Lee "
                                     "controller flies one vehicle on the numpy engine",
-                                    hint=f"drop {option}, or --controller for reedtool's "
-                                         "own controller")
+                                    hint=f"drop {option}, or drop --controller to fly "
+                                         "reedtool's own controller")
     if engine == "numba":
         from reedtool.sim.compiled import available, unavailable_reason
 
