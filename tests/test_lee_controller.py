@@ -503,3 +503,26 @@ def test_bad_controller_input_is_one_line_exit_2(packages, tmp_path):
         code, output = run_cli("hover-test", model_of(pkg), *args)
         assert code == 2 and fragment in output, output
         assert "Traceback" not in output
+
+
+def test_rotors_own_firefly_files_fly_the_firefly():
+    """RotorS' authors tuned lee_controller_firefly.yaml on their Firefly in Gazebo; the
+    same files (fixtures in their shape) fly the Firefly-shaped model (tests/fixtures/
+    migrate/firefly_hex.xacro; its base inertia breaks the triangle inequality as
+    RotorS' does, hence --ignore I203). RotorS' file says 1.56779 kg, the model weighs
+    1.53 kg (body 1.5 + six 5 g rotors): by hand it hovers (1.56779 * 9.81 - 1.53 *
+    9.80665) / 6 = 6.3 cm high, which the report says and C409 names."""
+    fixtures = __import__("pathlib").Path(__file__).parent / "fixtures"
+    model = fixtures / "migrate" / "firefly_hex.xacro"
+    code, output = run_cli("hover-test", model, "--ignore", "I203", "--format", "json",
+                           "--controller", fixtures / "rotors_lee" / "lee_controller_firefly.yaml",
+                           "--yaw", "0.3")
+    report = json.loads(output)
+    c = report["controller"]
+    assert c["files"][-1].endswith("rotors_lee/firefly.yaml")   # found beside the gains
+    m = c["model_mass_kg"]
+    assert m == pytest.approx(1.5 + 6 * 0.005)
+    assert c["predicted_altitude_offset_m"] == pytest.approx(
+        (1.56779 * 9.81 - m * 9.80665) / 6, rel=1e-6)
+    assert [f["code"] for f in c["preflight"]] == ["C409"]
+    assert code == 0 and report["verdict"]["status"] == "flies", report["message"]
