@@ -173,7 +173,7 @@ def test_wrong_rotor_direction_fails_named(packages, tmp_path):
             entry["direction"] = -entry["direction"]
 
     code, report = fly(packages["quad-x"], *broken_copy(packages["quad-x"], tmp_path,
-                                                         vehicle=flip))
+                                                         vehicle=flip), extra=("--duration", "10"))
     assert code == 1 and report["verdict"]["status"] != "flies"
     assert "C404" in codes(report)
     # Yaw feedback of the wrong sign: it spins up about the vertical (0.3 rad start).
@@ -450,7 +450,8 @@ def test_com_off_the_base_origin(packages, tmp_path):
         d.mkdir()
         (d / f"lee_controller_{pkg.name}.yaml").write_text(g)
         (d / f"{pkg.name}.yaml").write_text(yaml.safe_dump({**v, "rotor_configuration": rotors}))
-        results[label] = fly(pkg, d / f"lee_controller_{pkg.name}.yaml")
+        results[label] = fly(pkg, d / f"lee_controller_{pkg.name}.yaml",
+                             extra=("--duration", "10"))
     code, report = results["base"]
     assert code == 1 and report["verdict"]["status"] != "flies"
     assert sorted(codes(report) | codes(report, "warning")) == ["C405", "C406"]
