@@ -527,3 +527,27 @@ def test_rotors_own_firefly_files_fly_the_firefly():
         (1.56779 * 9.81 - m * 9.80665) / 6, rel=1e-6)
     assert [f["code"] for f in c["preflight"]] == ["C409"]
     assert code == 0 and report["verdict"]["status"] == "flies", report["message"]
+
+
+@pytest.mark.parametrize("frame", FRAMES)
+def test_shipped_allocation_is_the_models(packages, frame):
+    """common.h's allocation from the shipped NAME.yaml (per rotor speed squared, divided
+    by k_F: torque per newton of thrust) against reedtool.physics.allocation's from the
+    model's motor plugins (lever about the COM, drag reaction -turning_sign k_M T): a
+    second derivation of the same matrix from the other file, so a sign convention
+    (angle, direction) read wrong in either shows. Equal to 1e-9 m (the YAML's 10
+    significant digits)."""
+    from reedtool.assembly.lee_flight import entry_of_rotor, rotors_lee_of
+    from reedtool.assembly.vehicle import Vehicle
+    from reedtool.flightstack.rotors_lee import load_lee_parameters
+    from reedtool.io.loader import load_robot
+    from reedtool.physics.allocation import allocation_matrix
+
+    pkg = packages[frame]
+    vehicle = Vehicle.of(load_robot(model_of(pkg)))
+    lee = rotors_lee_of(load_lee_parameters([pkg / "config" / f"lee_controller_{pkg.name}.yaml"]))
+    B = allocation_matrix(vehicle.rotors, vehicle.props.com_m)       # rotor order
+    A = lee.allocation() / lee.force_constant                        # entry order
+    entries = entry_of_rotor(vehicle.rotors)
+    # rows: RotorS [roll, pitch, yaw, thrust], physics [thrust, roll, pitch, yaw]
+    np.testing.assert_allclose(A[[3, 0, 1, 2]][:, entries], B, atol=1e-9)
