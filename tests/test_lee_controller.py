@@ -361,6 +361,7 @@ def test_validate_x3_gains_clean(tmp_path):
                                            "{x: 451.1, y: 334.5, z: 104.3}"), v),
      ["C451", "C451", "C451"]),
     ("grams", lambda g, v: (g, v.replace("mass: 1.52", "mass: 1520")), ["C409", "C452"]),
+    ("yaw-underdamped", lambda g, v: (g.replace("z: 0.1043", "z: 0.025"), v), ["C454"]),
     ("g-cm2", lambda g, v: (g, v.replace("xx: 0.0301535", "xx: 301535").replace(
         "yy: 0.0295235", "yy: 295235").replace("zz: 0.056631", "zz: 566310")), ["C410", "C453"]),
 ])
@@ -372,6 +373,7 @@ def test_validate_x3_broken(tmp_path, case, edit, expected):
     # every finding is located in the file it is about, on the line of the value (found
     # by text here, like grep -n)
     key = {"C450": "attitude_gain", "C451": "angular_rate_gain", "C452": "mass:",
+           "C454": "angular_rate_gain",
            "C409": "mass:", "C453": "inertia:", "C410": "inertia:"}
     for f in findings:
         lines = (tmp_path / __import__("pathlib").Path(f["file"]).name).read_text().splitlines()

@@ -222,3 +222,45 @@ def lee_inertia_unit_slip(ctx: CheckContext) -> Iterator[Issue]:
                       "else reading the file does not", table.loc_of("inertia"),
                     ctx.robot.name,
                     hint="write the inertia in kg*m^2 (`reedtool inertia` prints the model's)")
+
+
+# A loop damped below this rings: its step response overshoots by more than 37 %
+# (exp(-pi 0.3 / sqrt(1 - 0.09))) and each swing is at least 0.15 of the one before.
+MIN_DAMPING = 0.3
+
+
+@rule("C454", "lee-loop-underdamped", "warning",
+      "A RotorS Lee controller loop is damped below 0.3 on the model.", clause="suspicious")
+def lee_loop_underdamped(ctx: CheckContext) -> Iterator[Issue]:
+    """With the gains as forces and torques per unit error (RotorS' normalisation), each
+    loop on the model is second order: damping k_w / (2 sqrt(k_R J)) about each body axis
+    and k_v / (2 sqrt(k_x m)) per position axis, with the model's principal moment J and
+    mass m. Below 0.3 a disturbance rings: more than 37 % overshoot, settling in
+    4 / (zeta w_n). RotorS' compiled-in yaw gains (0.035, 0.025) give the Firefly 0.21.
+
+    Severity (warning, suspicious): it flies, but it rings; hover-test --controller shows
+    how long it takes to settle.
+    """
+    whole = ctx.whole_robot
+    J = np.asarray(whole.inertia_kg_m2, dtype=float)
+    if whole.mass_kg <= 0 or not np.all(np.isfinite(J)) or np.any(np.diag(J) <= 0):
+        return
+    for table in _lee_tables(ctx):
+        gains = table.lee_gains
+        for k_key, d_key, inertia, plant in (
+                *(("attitude_gain", "angular_rate_gain", J[i, i], i) for i in range(3)),
+                *(("position_gain", "velocity_gain", whole.mass_kg, i) for i in range(3))):
+            i = plant
+            k, d = float(gains.gain(k_key)[i]), float(gains.gain(d_key)[i])
+            if not (k > 0 and d > 0):
+                continue
+            zeta = d / (2.0 * math.sqrt(k * inertia))
+            wn = math.sqrt(k / inertia)
+            if zeta >= MIN_DAMPING:
+                continue
+            want = 2.0 * 0.7 * math.sqrt(k * inertia)
+            yield Issue(f"{d_key}/{AXES[i]} {d:g} with {k_key}/{AXES[i]} {k:g} damps the loop "
+                        f"about {AXES[i]} at {zeta:.2g} on this model (natural frequency "
+                        f"{wn:.3g} rad/s): it rings, settling in about {4 / (zeta * wn):.3g} s",
+                        gains.loc_of(d_key, AXES[i]), f"{d_key}/{AXES[i]}",
+                        hint=f"{d_key}/{AXES[i]}: {want:.3g} gives damping 0.7")
