@@ -3,7 +3,7 @@ the model and flown on it.
 
 The files are read as RotorS' node reads them (flightstack.rotors_lee), checked against
 the model by validate's controller rules (C401-C411: rotor count, order, angles,
-directions, constants, mass, inertia; C450-C453: the gains and units), then flown
+directions, constants, mass, inertia; C450-C454: the gains and units), then flown
 (sim.lee_rotors) on the model's true mass, inertia and rotors. The verdict is the
 flight's (sim.verdict); the test passes only when the controller flies the vehicle and no
 rule finds an error in the files.

@@ -1,4 +1,4 @@
-"""RotorS Lee controller rules (C450-C453): the gains and vehicle parameters RotorS'
+"""RotorS Lee controller rules (C450-C454): the gains and vehicle parameters RotorS'
 `lee_position_controller_node` reads, against the model they will fly.
 
 The controller files come from `hover-test --controller` and `validate --controller`
@@ -6,7 +6,7 @@ The controller files come from `hover-test --controller` and `validate --control
 table itself (count, angles, directions, constants, mass, inertia within tolerance) is
 C401-C411's; these rules catch what makes the Lee controller itself fail: a gain of the
 wrong sign, a loop the 100 Hz controller and the motors cannot hold (a unit slip in a
-gain), and a vehicle mass or inertia in another unit.
+gain), a loop that rings, and a vehicle mass or inertia in another unit.
 
 Physics (sim/lee_rotors.py has the equations): RotorS divides the attitude and rate gains
 by the YAML inertia and multiplies the angular acceleration by it again, so about one axis
