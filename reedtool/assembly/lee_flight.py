@@ -11,6 +11,7 @@ rule finds an error in the files.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 
@@ -118,7 +119,8 @@ def fly_controller(robot, vehicle, flying, config, files, *, control_rate_hz: fl
                             reference_offset_m=judged_offset_m)
 
     flying_label = f"flying the Lee controller {config.duration_s:g} s"
-    context = progress.flying(flying_label) if progress is not None else _null()
+    context = (progress.flying(flying_label) if progress is not None
+               else contextlib.nullcontext())
     with context:
         run = fly(config, record)
         found = judge.judge_flight(params, config, run, fly, requirement)
@@ -151,10 +153,3 @@ def fly_controller(robot, vehicle, flying, config, files, *, control_rate_hz: fl
     return {"controller": controller, "sim": sim, "_run": run, "found": found,
             "passed": passed, "message": message, "config": config}
 
-
-class _null:
-    def __enter__(self):
-        return None
-
-    def __exit__(self, *exc):
-        return False

@@ -191,7 +191,7 @@ def equilibrium_altitude_offset_m(params: VehicleParams, lee: RotorsLee,
     (entry order) and a true thrust c T with c = sum_i k_true,i M[entry_i, 3]; so
     e_z = (m_yaml g_c - m g / c) / k_z. NaN when k_z or c is not positive."""
     n = params.n_rotors
-    entry = motor_commands(lee, np.arange(n) if entry_of_rotor is None else entry_of_rotor)
+    entry = controller_entries(lee, np.arange(n) if entry_of_rotor is None else entry_of_rotor)
     column = lee.speed_map()[:, 3]
     c = float(sum(params.motor_constant[j] * column[entry[j]] for j in range(n)
                   if entry[j] >= 0))
@@ -201,7 +201,7 @@ def equilibrium_altitude_offset_m(params: VehicleParams, lee: RotorsLee,
     return (lee.mass_kg * lee.gravity_m_s2 - params.weight_N / c) / k_z
 
 
-def motor_commands(lee: RotorsLee, entry_of_rotor: np.ndarray):
+def controller_entries(lee: RotorsLee, entry_of_rotor: np.ndarray):
     """(n_rotors,) index of the controller entry each of the plant's rotors obeys (-1: none)."""
     entry_of_rotor = np.asarray(entry_of_rotor, dtype=int)
     return np.where(entry_of_rotor < lee.n_entries, entry_of_rotor, -1)
@@ -227,7 +227,7 @@ def simulate_lee(params: VehicleParams, lee: RotorsLee, config: HoverConfig = Ho
 
     config.validate()
     n = params.n_rotors
-    entry = motor_commands(lee, np.arange(n) if entry_of_rotor is None else entry_of_rotor)
+    entry = controller_entries(lee, np.arange(n) if entry_of_rotor is None else entry_of_rotor)
     r_odo = np.zeros(3) if odometry_from_com_m is None else np.asarray(odometry_from_com_m,
                                                                       dtype=float)
     hold = max(1, int(round(config.rate_hz / control_rate_hz)))
