@@ -553,3 +553,28 @@ def test_shipped_allocation_is_the_models(packages, frame):
     entries = entry_of_rotor(vehicle.rotors)
     # rows: RotorS [roll, pitch, yaw, thrust], physics [thrust, roll, pitch, yaw]
     np.testing.assert_allclose(A[[3, 0, 1, 2]][:, entries], B, atol=1e-9)
+
+
+def test_unset_gains_take_rotors_defaults_and_say_so(packages, tmp_path):
+    """The node keeps its compiled-in default (lee_position_controller.h: attitude 3, 3,
+    0.035) for a gain the files do not set; the report lists it."""
+    def drop(g):
+        del g["attitude_gain"]
+
+    code, report = fly(packages["quad-x"], *broken_copy(packages["quad-x"], tmp_path, gains=drop),
+                       extra=("--duration", "10"))
+    notes = " ".join(report["controller"]["notes"])
+    assert "attitude_gain/x, attitude_gain/y, attitude_gain/z" in notes
+    assert report["sim"]["gains"]["attitude_gain"] == [3.0, 3.0, 0.035]
+
+
+def test_a_missing_entry_leaves_its_motor_stopped(packages, tmp_path):
+    """Three entries for four motors: RotorS publishes three speeds and motor 3's plugin
+    refuses the index, so that motor gets nothing; C401 names it and it cannot hover."""
+    def drop(v):
+        del v["rotor_configuration"]["3"]
+
+    code, report = fly(packages["quad-x"], *broken_copy(packages["quad-x"], tmp_path, vehicle=drop),
+                       extra=("--duration", "10"))
+    assert code == 1 and "C401" in codes(report)
+    assert report["sim"]["status"] == "crashed"
