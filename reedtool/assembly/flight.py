@@ -36,14 +36,17 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
                engine: str = "numpy", envelope: bool = False,
                max_memory_bytes: int = DEFAULT_MAX_MEMORY_MB * 1024 * 1024,
                vehicle: Vehicle | None = None, requirement=None,
-               auto_duration: bool = False) -> dict:
+               auto_duration: bool = False, controller_files=(),
+               control_rate_hz: float | None = None) -> dict:
     """Trim, simulate and (optionally) batch one robot; the JSON-ready report.
 
     Keys: "model", "trim", "sim" (None when not flown), "batch" (None without samples),
     "verdict" (sim.verdict: what the vehicle can do, with its cause), "status" (the
     verdict's), "message", "passed" (the verdict against `requirement`, default
     --require stable); plus "_run" (the HoverRun, for CSV/plot), "_omega_max" and
-    "_envelope" (the batch's, with `envelope`).
+    "_envelope" (the batch's, with `envelope`). With `controller_files` (RotorS Lee
+    gains and vehicle YAML) the flight is that controller's (assembly.lee_flight) and
+    "controller" reports its checks; it passes only when it flies.
     """
     import numpy as np
 
@@ -106,6 +109,22 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
     controllable, acai = judge.stabilisable(params)
     if not controllable:
         return conclude(judge.uncontrollable(acai))
+
+    if controller_files:
+        from reedtool.assembly.lee_flight import fly_controller
+        from reedtool.sim.lee_rotors import ROTORS_CONTROL_RATE_HZ
+
+        lee = fly_controller(robot, vehicle, flying, config, controller_files,
+                             control_rate_hz=control_rate_hz or ROTORS_CONTROL_RATE_HZ,
+                             requirement=requirement, record=record,
+                             auto_duration=auto_duration, progress=progress)
+        sim = lee["sim"]
+        sim["trim_omega_rad_s"] = dict(zip(params.rotor_names,
+                                           (float(w) for w in trim.omega_rad_s)))
+        report["sim"], report["_run"], report["controller"] = sim, lee["_run"], lee["controller"]
+        conclude(lee["found"])
+        report["passed"], report["message"] = lee["passed"], lee["message"]
+        return report
 
     from reedtool.sim.controller import ControllerGains
     from reedtool.sim.run import simulate_hover

@@ -11,8 +11,13 @@ Matching: a velocity-control entry names its joint, so it is matched by `jointNa
 RotorS YAML entry i is what the controller sends as motor speed i, which the motor plugin
 with `<motorNumber>i` receives, so it is matched by motor number (by discovery order when
 the motor numbers are not 0..n-1, which R302 reports). Geometry for a YAML entry is taken
-in the base (root link) frame: RotorS controllers work in the body frame of the odometry,
-the base link. Every finding names both places: the controller entry (its file and line
+in the base (root link) axes, about the whole robot's centre of mass: RotorS controllers
+work in the body axes of the odometry (the base link), and their allocation's torques are
+torques about the point the angles and arms are measured from, which must be the point
+the body turns about. (With the COM at the base origin, as in RotorS' own models, the two
+are the same; with the COM 15 mm off it, angles from the base origin leave RotorS' Lee
+controller, which has no integral term, hovering tens of centimetres off its setpoint:
+tests/test_lee_controller.py flies both.) Every finding names both places: the controller entry (its file and line
 is the finding's location) and the model element (in the message).
 """
 
@@ -87,12 +92,27 @@ def _geometry_loc(ctx: CheckContext, rotor: "Rotor"):
     return rotor.loc
 
 
-def _planar(rotor: "Rotor") -> tuple[float, float] | None:
-    """(angle from +x towards +y [rad], arm length in the xy-plane [m]) in the base frame."""
+def _com_xy(ctx: CheckContext) -> np.ndarray:
+    """The whole robot's COM in the base xy-plane (0 when it cannot be computed)."""
+    com = np.asarray(ctx.whole_robot.com_m, dtype=float)[:2]
+    return com if ctx.whole_robot.mass_kg > 0 and np.all(np.isfinite(com)) else np.zeros(2)
+
+
+def _planar(rotor: "Rotor", com_xy: np.ndarray) -> tuple[float, float] | None:
+    """(angle from +x towards +y [rad], arm length in the xy-plane [m]) about the COM,
+    base axes."""
     p = rotor.position_m
     if not np.all(np.isfinite(p)):
         return None
-    return math.atan2(p[1], p[0]), math.hypot(p[0], p[1])
+    x, y = p[0] - com_xy[0], p[1] - com_xy[1]
+    return math.atan2(y, x), math.hypot(x, y)
+
+
+def _about(com_xy: np.ndarray) -> str:
+    if not np.any(np.abs(com_xy) >= 5e-4):
+        return ""
+    return (f", measured from the centre of mass at ({1000 * com_xy[0]:.1f}, "
+            f"{1000 * com_xy[1]:.1f}) mm of the base origin")
 
 
 def _entry(table: "ControllerTable", entry: "ControllerRotor") -> str:
@@ -256,9 +276,14 @@ def controller_direction_mismatch(ctx: CheckContext) -> Iterator[Issue]:
 
 def _angle_hint(ctx: CheckContext, entry: "ControllerRotor", model_rad: float,
                 controller_rad: float) -> str:
+    # Degrees where radians are read: the number, taken as degrees, is the model's angle.
+    if abs(controller_rad) > ANGLE_TOL_RAD \
+            and abs(_wrap(math.radians(controller_rad) - model_rad)) < ANGLE_TOL_RAD:
+        return (f"{controller_rad:g} is the rotor's angle in degrees; RotorS reads radians: "
+                f"set angle: {model_rad:.6g}")
     # An entry that matches another motor in angle and direction is an ordering mistake.
     for number, other in _motor_index(ctx).items():
-        planar = _planar(other)
+        planar = _planar(other, _com_xy(ctx))
         if number != entry.index and planar \
                 and abs(_wrap(planar[0] - controller_rad)) < ANGLE_TOL_RAD \
                 and entry.direction == other.turning_sign:
@@ -280,14 +305,16 @@ def controller_angle_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     xy-plane, measured from +x (forward) towards +y (left), i.e. counter-clockwise seen
     from above. The controller's roll and pitch columns are sin(angle) and -cos(angle)
     times the arm: a wrong angle commands roll when pitch is wanted, and the vehicle
-    drifts or flips. Compared in the base frame with a tolerance of 0.5°.
+    drifts or flips. Compared in the base axes about the whole robot's COM (the module
+    docstring says why) with a tolerance of 0.5°.
 
     Severity (error, flight-stack): the controller gives the rotor roll and pitch torque
     of the wrong sign.
     """
+    com_xy = _com_xy(ctx) if _tables(ctx) else np.zeros(2)
     for table in _tables(ctx):
         for entry, rotor in _pairs(ctx, table):
-            planar = _planar(rotor)
+            planar = _planar(rotor, com_xy)
             if entry.angle_rad is None or not math.isfinite(entry.angle_rad) or planar is None:
                 continue
             model_rad = planar[0]
@@ -295,8 +322,8 @@ def controller_angle_mismatch(ctx: CheckContext) -> Iterator[Issue]:
                 yield Issue(
                     f"{_entry(table, entry)}: angle {entry.angle_rad:.4f} rad "
                     f"({_deg(entry.angle_rad)}), but {_rotor_name(rotor)} sits at "
-                    f"{model_rad:.4f} rad ({_deg(model_rad)}) from body +x towards +y "
-                    f"(pose at {_geometry_loc(ctx, rotor)})",
+                    f"{model_rad:.4f} rad ({_deg(model_rad)}) from body +x towards +y"
+                    f"{_about(com_xy)} (pose at {_geometry_loc(ctx, rotor)})",
                     entry.loc_of("angle_rad"), rotor.joint or rotor.name,
                     hint=_angle_hint(ctx, entry, model_rad, entry.angle_rad))
 
@@ -304,17 +331,19 @@ def controller_angle_mismatch(ctx: CheckContext) -> Iterator[Issue]:
 @rule("C406", "controller-arm-length-mismatch", "warning",
       "A controller entry's arm length disagrees with where the rotor is.", clause="suspicious")
 def controller_arm_length_mismatch(ctx: CheckContext) -> Iterator[Issue]:
-    """`arm_length` [m] is the rotor's distance from the body frame origin in the body
-    xy-plane (the height of the rotor above the frame does not count). The controller
+    """`arm_length` [m] is the rotor's distance from the vehicle's centre of mass in the
+    body xy-plane (the height of the rotor above the frame does not count; RotorS' own
+    models have the COM at the base origin). The controller
     scales roll and pitch torque with it: a wrong arm gives a wrong attitude gain on that
     axis. Tolerance: 1 mm or 1 %, whichever is larger.
 
     Severity (warning): the torque keeps its sign, only its gain changes, so the vehicle
     flies (C405 is the error: a rotor at another angle gets torque of the wrong sign).
     """
+    com_xy = _com_xy(ctx) if _tables(ctx) else np.zeros(2)
     for table in _tables(ctx):
         for entry, rotor in _pairs(ctx, table):
-            planar = _planar(rotor)
+            planar = _planar(rotor, com_xy)
             if entry.arm_length_m is None or not math.isfinite(entry.arm_length_m) \
                     or planar is None:
                 continue
@@ -323,8 +352,8 @@ def controller_arm_length_mismatch(ctx: CheckContext) -> Iterator[Issue]:
                                                        ARM_LENGTH_REL_TOL * model_m):
                 yield Issue(
                     f"{_entry(table, entry)}: arm_length {entry.arm_length_m:.4g} m, but "
-                    f"{_rotor_name(rotor)} is {model_m:.4g} m from the base frame origin in the "
-                    f"xy-plane (pose at {_geometry_loc(ctx, rotor)})",
+                    f"{_rotor_name(rotor)} is {model_m:.4g} m from the centre of mass in the "
+                    f"xy-plane{_about(com_xy)} (pose at {_geometry_loc(ctx, rotor)})",
                     entry.loc_of("arm_length_m"), rotor.joint or rotor.name,
                     hint=f"set arm_length: {model_m:.6g}")
 

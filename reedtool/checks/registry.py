@@ -32,6 +32,7 @@ EXTRA_RULE_MODULES: tuple[str, ...] = (
     "reedtool.checks.argument_rules",
     "reedtool.checks.fault_rules",
     "reedtool.checks.flightstack_rules",
+    "reedtool.checks.lee_rules",
     "reedtool.checks.plausibility_rules",
 )
 

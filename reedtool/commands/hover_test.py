@@ -93,6 +93,16 @@ PROGRESS_AFTER_S = 2.0
               help="What exit 0 needs: a hover trim (hover); and a vehicle some controller "
                    "can stabilise (stable); and recovery from a start tilted DEG degrees "
                    "(margin:DEG).")
+@click.option("--controller", "controller_files", multiple=True,
+              type=click.Path(path_type=Path, dir_okay=False), metavar="FILE.yaml",
+              help="Fly RotorS' Lee position controller with these files instead of "
+                   "reedtool's controller: the gains (lee_controller_NAME.yaml) and the "
+                   "vehicle parameters (NAME.yaml; found beside the gains when not given). "
+                   "Repeatable. numpy engine only.")
+@click.option("--controller-rate", "controller_rate_hz", type=float, default=100.0,
+              show_default=True, help="Rate of the --controller node [Hz] (RotorS' worlds "
+                                      "step at 100 Hz; the node runs once per odometry "
+                                      "message).")
 @validation_options
 def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
             model_name: str | None, launch_file: Path | None,
@@ -103,7 +113,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
             max_memory_mb: int, seed: int,
             mass_spread: float, com_spread_m: float, inertia_spread: float,
             motor_spread: float, engine: str, min_pass_rate: float,
-            require: str = "stable",
+            require: str = "stable", controller_files: tuple[Path, ...] = (),
+            controller_rate_hz: float = 100.0,
             ignore: tuple[str, ...] = (), ignore_validation: bool = False) -> int:
     """Trim MODEL for hover and fly it.
 
@@ -146,6 +157,19 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
                             f"is {steps:.3g} steps, more than {MAX_STEPS:.0e}",
                             hint="a hover test settles in seconds; the defaults are 10 s at "
                                  "1000 Hz")
+    if controller_files:
+        check_plausible("rate", controller_rate_hz, "--controller-rate")
+        if controller_rate_hz > rate_hz:
+            raise ReedtoolError(f"bad option: --controller-rate {controller_rate_hz:g} Hz is "
+                                f"faster than the simulation's --rate {rate_hz:g} Hz",
+                                hint="keep --controller-rate at or below --rate")
+        for option, given in (("--samples", samples is not None),
+                              ("--engine numba", engine == "numba")):
+            if given:
+                raise ReedtoolError(f"bad option: {option} with --controller: the Lee "
+                                    "controller flies one vehicle on the numpy engine",
+                                    hint=f"drop {option}, or drop --controller to fly "
+                                         "reedtool's own controller")
     if engine == "numba":
         from reedtool.sim.compiled import available, unavailable_reason
 
@@ -155,6 +179,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
     from reedtool.io.fileio import check_writable, note_input
 
     note_model_files(inputs)          # the model is never an output of its own run
+    for path in controller_files:
+        note_input(path)
     if plot_path is not None:   # fail before flying, not after
         check_writable(plot_path, force)
     if replay_path is not None:
@@ -213,7 +239,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
                         engine=engine, envelope=plot_path is not None,
                         max_memory_bytes=max_memory_mb * 1024 * 1024,
                         vehicle=assembled.vehicle, requirement=requirement,
-                        auto_duration=auto_duration)
+                        auto_duration=auto_duration, controller_files=controller_files,
+                        control_rate_hz=controller_rate_hz)
     batch = report.get("batch")
     if batch is not None:
         batch["min_pass_rate"] = min_pass_rate
@@ -347,11 +374,16 @@ def render_text(report: dict) -> str:
                      f"; torque authority at hover: roll {a['roll']:.3g}, "
                      f"pitch {a['pitch']:.3g}, yaw {a['yaw']:.3g} N*m")
         lines.append(f"  thrust-to-weight {trim['thrust_to_weight']:.3f}{authority}")
+    if report.get("controller") is not None:
+        from reedtool.report.lee_text import controller_lines
+
+        lines += controller_lines(report["controller"])
     if sim is not None:
         from reedtool.sim.verdict import tuning_line
 
         c = sim["config"]
-        lines.append(f"tuning: {tuning_line(sim['gains'])}")
+        if sim["gains"].get("controller") != "rotors-lee":
+            lines.append(f"tuning: {tuning_line(sim['gains'])}")
         lines.append(f"sim: {sim['status'].upper()}: {sim['message']}")
         lines.append(f"  start {c['offset_m']} m off, roll {c['roll_rad']:g} pitch "
                      f"{c['pitch_rad']:g} yaw {c['yaw_rad']:g} rad; {c['duration_s']:g} s at "

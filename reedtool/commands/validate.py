@@ -202,7 +202,8 @@ def print_settings(targets, options: RunOptions) -> int:
 @click.option("--no-color", is_flag=True, help="Never colour the text output.")
 @click.option("--controller", "controller_files", multiple=True, metavar="FILE.yaml",
               type=click.Path(path_type=Path, dir_okay=False),
-              help="RotorS-style vehicle parameter YAML to cross-check against the model "
+              help="RotorS-style vehicle parameter YAML to cross-check against the model, "
+                   "and RotorS Lee gain files (lee_controller_NAME.yaml) with it "
                    "(repeatable).")
 @click.option("--airframe", "airframe_files", multiple=True, metavar="FILE",
               type=click.Path(path_type=Path, dir_okay=False),
@@ -265,9 +266,9 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
     if show_settings:
         return print_settings(targets, options)
     if controller_files:
-        from reedtool.flightstack.controller_tables import load_controller_yaml
+        from reedtool.flightstack.rotors_lee import load_controller_files
 
-        options.controllers = [load_controller_yaml(path) for path in controller_files]
+        options.controllers = load_controller_files(controller_files)
     if airframe_files or autopilot_files:
         from reedtool.flightstack.params_files import load_flight_params
 

@@ -69,6 +69,8 @@ class ControllerTable:
     com_link: str | None = None          # velocity-control: the frame arms are measured in
     plugin: Plugin | None = None
     problems: list[tuple[str, SourceLoc]] = field(default_factory=list)  # unreadable entries
+    # RotorS Lee gains loaded with this table (flightstack.rotors_lee.LeeGainsTable), if any
+    lee_gains: object | None = None
 
     @property
     def label(self) -> str:

@@ -472,9 +472,17 @@ def _check_propeller_clearance(spec: PackageSpec) -> None:
 # RotorS' firefly, which the Lee controller gains in rotors_gazebo were tuned for.
 _FIREFLY_MASS_KG = 1.56779
 _FIREFLY_INERTIA_KG_M2 = (0.0347563, 0.0458929, 0.0977)
+# rotors_gazebo/resource/lee_controller_firefly.yaml, the file RotorS' firefly launch
+# files load. Yaw: 0.15 and 0.18, not lee_position_controller.h's compiled-in 0.035 and
+# 0.025. RotorS' normalisation makes the yaw loop J_z psi'' = -k_R psi - k_w psi' (see
+# sim/lee_rotors.py), so on the Firefly (J_z 0.0977) the compiled-in pair gives
+# w_n = sqrt(0.035 / 0.0977) = 0.60 rad/s at damping 0.025 / (2 sqrt(0.035 * 0.0977))
+# = 0.21 (a 0.3 rad yaw error takes ~8 s to settle within 2 deg), the YAML's 1.24 rad/s
+# at 0.74. Scaling by J_z keeps both numbers on any vehicle (hover-test --controller
+# flies them: tests/test_lee_controller.py).
 _FIREFLY_LEE_GAINS = {
     "position_gain": (6.0, 6.0, 6.0), "velocity_gain": (4.7, 4.7, 4.7),
-    "attitude_gain": (3.0, 3.0, 0.035), "angular_rate_gain": (0.52, 0.52, 0.025)}
+    "attitude_gain": (3.0, 3.0, 0.15), "angular_rate_gain": (0.52, 0.52, 0.18)}
 
 # The seed's rotor inertia convention (RotorS' own): a 3 mm x 15 mm blade box as long as
 # the rotor radius, with the rotor mass multiplied by rotor_velocity_slowdown_sim because
@@ -627,8 +635,6 @@ def _multirotor_context(spec: PackageSpec, body_props) -> dict:
             "color": "Red" if position[0] < -1e-9 else "Blue",
             "xyz": " ".join(_as_xacro(expr) for expr in xyz_expr),
             "xyz_expr": xyz_expr,
-            "angle_rad": fmt_number(float(np.arctan2(position[1], position[0]))),
-            "radial_m": fmt_number(float(np.hypot(position[0], position[1]))),
             "position_m": [fmt_number(v) for v in position],
         })
         parts.append(MassProperties(spec["mass_rotor"], np.asarray(position),
@@ -636,6 +642,13 @@ def _multirotor_context(spec: PackageSpec, body_props) -> dict:
     total = combine(parts)
     I_total = total.inertia_kg_m2
     body_com = body_props.com_m
+    # The controller's rotor angles and arms are measured from the centre of mass: RotorS'
+    # allocation gives torques about the point they are measured from, and the body turns
+    # about its COM (checks/controller_rules.py, C405/C406).
+    for rotor, position in zip(rotors, positions):
+        dx, dy = position[0] - total.com_m[0], position[1] - total.com_m[1]
+        rotor["angle_rad"] = fmt_number(float(np.arctan2(dy, dx)))
+        rotor["radial_m"] = fmt_number(float(np.hypot(dx, dy)))
     gains = scaled_lee_gains(total.mass_kg, I_total)
     return {
         "rotor_count": frame.rotor_count,

@@ -138,14 +138,17 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
                    progress: Callable[[int], None] | None = None,
                    engine: str = "numpy", record: bool = False,
                    gains: ControllerGains | None = None,
-                   initial_omega_rad_s: np.ndarray | None = None) -> Outcome:
+                   initial_omega_rad_s: np.ndarray | None = None,
+                   command: SpeedCommand | None = None) -> Outcome:
     """Fly every vehicle of `plant` (default: one nominal vehicle) on the nominal controller.
 
     `progress(steps)` is called now and then with the number of steps done since the last call.
     `engine`: "numpy" (this loop, the reference) or "numba" (`compiled`, across the cores).
     `gains` and `initial_omega_rad_s` override the designed controller and the starting
     rotor speeds, as in run.simulate_hover (sim.failure: the flight after a rotor fails);
-    the numpy engine flies those.
+    the numpy engine flies those. `command` replaces the controller and its allocation by
+    another that commands rotor speeds itself (sim.lee_rotors: RotorS' Lee controller);
+    the numpy engine only, from `initial_omega_rad_s`.
     """
     config.validate()
     plant = plant or Plant.from_params(params, 1)
@@ -156,7 +159,9 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
         if progress is not None:
             progress(config.n_steps)
         return outcome
-    if gains is None:
+    if command is not None and initial_omega_rad_s is None:
+        raise ValueError("a speed command flies from the speeds it starts with")
+    if gains is None and command is None:
         gains = ControllerGains.from_params(params, design)
     kernel = PlantKernel(plant)
     N, n = plant.n_vehicles, params.n_rotors
@@ -179,13 +184,16 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
 
     up, down = (per_rotor(f) for f in speed_filter_factors(
         dt, params.time_constant_up_s, params.time_constant_down_s))
-    inv_k_hat = per_rotor(1.0 / gains.motor_constant)
-    lead = gains.motor_lead_factors(dt)
-    if lead is not None:
-        lead_up, lead_down = (per_rotor(f) for f in lead)
-    omega_max = per_rotor(gains.omega_max_rad_s)
-    thrust_max = per_rotor(gains.motor_constant * gains.omega_max_rad_s ** 2)
-    i_max = gains.max_integral_m_s
+    omega_max = per_rotor(params.omega_max_rad_s if command is not None
+                          else gains.omega_max_rad_s)
+    lead = None
+    if command is None:
+        inv_k_hat = per_rotor(1.0 / gains.motor_constant)
+        lead = gains.motor_lead_factors(dt)
+        if lead is not None:
+            lead_up, lead_down = (per_rotor(f) for f in lead)
+        thrust_max = per_rotor(gains.motor_constant * gains.omega_max_rad_s ** 2)
+        i_max = gains.max_integral_m_s
     p_col = np.repeat(setpoint[:, None], N, axis=1)    # full: no broadcasting per step
 
     # The step's stages, each bound once to the arrays it works on (see the kernels).
@@ -193,12 +201,15 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
     R = R9.reshape(3, 3, N)
     wrench, thrust_cmd, body = np.empty((4, N)), np.empty((n, N)), np.empty((8, N))
     rotate = rotation_kernel(state.q, np.empty((11, N)), R9)
-    compute_wrench = control_kernel(gains, evi, R9, state.w, wrench)
-    allocate = allocation_kernel(gains.allocation_pinv, wrench, thrust_max, thrust_cmd)
+    omega_cmd = np.empty((n, N))
+    if command is None:
+        compute_wrench = control_kernel(gains, evi, R9, state.w, wrench)
+        allocate = allocation_kernel(gains.allocation_pinv, wrench, thrust_max, thrust_cmd)
+    else:
+        speed_command_step = command(state, R9, setpoint, omega_cmd)
     evaluate_body_wrench = body_wrench_kernel(plant, kernel, state.omega, state.v, w5, R9, body)
     advance_body = rigid_body_kernel(plant, kernel, state.p, state.v, state.q, w5, R9, body, dt)
     omega = state.omega
-    omega_cmd = np.empty((n, N))
     spinning_up = np.empty((n, N), dtype=bool)
     mul, add, sub, sqrt = np.multiply, np.add, np.subtract, np.sqrt
 
@@ -230,8 +241,11 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
         sub(state.p, p_col, p_err)
         last = step == n_steps
         sample = step % every == 0 or last
-        compute_wrench()
-        saturated, worst_rotor = allocate(sample)
+        if command is None:
+            compute_wrench()
+            saturated, worst_rotor = allocate(sample)
+        else:
+            saturated, worst_rotor = speed_command_step(step, sample)
         if sample:
             # ---- judge every running vehicle on the state at time t
             running = status == 0
@@ -311,9 +325,11 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
                 if (status != 0).all():
                     break
         # ---- advance all vehicles one step
-        # The allocation keeps thrusts within [0, k w_max^2], so no clamp.
-        mul(thrust_cmd, inv_k_hat, omega_cmd)
-        sqrt(omega_cmd, omega_cmd)
+        # The allocation keeps thrusts within [0, k w_max^2], so no clamp (a `command`
+        # has written omega_cmd within [0, w_max] itself).
+        if command is None:
+            mul(thrust_cmd, inv_k_hat, omega_cmd)
+            sqrt(omega_cmd, omega_cmd)
         if lead is not None:
             # The controller's lead on slow motors (ControllerGains.motor_lead_factors).
             np.greater(omega_cmd, omega, spinning_up)
@@ -328,10 +344,11 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
         sub(omega, omega_cmd, omega)
         mul(omega, np.where(spinning_up, up, down), omega)
         add(omega, omega_cmd, omega)
-        mul(p_err, dt, p_err)
-        add(integral, p_err, integral)
-        np.minimum(integral, i_max, out=integral)
-        np.maximum(integral, -i_max, out=integral)
+        if command is None:
+            mul(p_err, dt, p_err)
+            add(integral, p_err, integral)
+            np.minimum(integral, i_max, out=integral)
+            np.maximum(integral, -i_max, out=integral)
         if progress is not None and step - reported >= report_every:
             progress(step - reported)
             reported = step
@@ -355,6 +372,14 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
         final_omega_rad_s=state.omega.copy(),
         final_state=state, config=config,
         position_error_m=_samples(recorded, config, N) if record else None)
+
+
+# `command(state, R9, setpoint, omega_cmd)` -> `step(step_index, sample)`: writes the rotor
+# speed command (n, N), within [0, omega_max], into omega_cmd for the state at that step;
+# returns (saturated (N,) bool or None, most-out-of-range rotor (N,) int or None) as the
+# allocation does.
+SpeedCommand = Callable[[State, np.ndarray, np.ndarray, np.ndarray],
+                        Callable[[int, bool], tuple]]
 
 
 def _samples(recorded: list[np.ndarray], config: HoverConfig, N: int) -> np.ndarray:

@@ -142,7 +142,7 @@ def simulate_hover(params: VehicleParams, config: HoverConfig = HoverConfig(),
         longest_saturation_s=sat_longest,
         final_omega_rad_s=np.array(omega), initial_omega_rad_s=omega0, gains=gains,
         config=config, rotor_names=params.rotor_names,
-        series=_series(rec, params.rotor_names) if record else {}, engine=engine)
+        series=sample_series(rec, params.rotor_names) if record else {}, engine=engine)
 
 
 # How the generated engine's early endings map to statuses.
@@ -189,7 +189,7 @@ def _prioritised(rows: list[tuple], thrust_max: list[float], f: float, t0: float
     return [hi if b > hi else (0.0 if b < 0.0 else b) for b, hi in zip(base, thrust_max)]
 
 
-def _series(rec: list[tuple], rotor_names: tuple[str, ...]) -> dict[str, np.ndarray]:
+def sample_series(rec: list[tuple], rotor_names: tuple[str, ...]) -> dict[str, np.ndarray]:
     """Sampled time series; attitude as roll/pitch/yaw (URDF rpy convention)."""
     if not rec:
         return {}
