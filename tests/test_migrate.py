@@ -245,17 +245,17 @@ def test_px4_airframe_matches_the_port(tmp_path):
     model = FIXTURES / "migrate" / "firefly_hex.xacro"
     code, _document, target = migrate(tmp_path, model, (), "--autopilot", "px4")
     assert code == 0
-    airframe = target / "px4" / "airframe_gz_firefly"
+    airframe = target / "airframes" / "4900_gz_firefly"     # PX4-gazebo-models' layout
     text = airframe.read_text()
     outputs = sorted(int(line.split()[2][len("SIM_GZ_EC_FUNC"):]) for line in text.splitlines()
                      if line.startswith("param set-default SIM_GZ_EC_FUNC"))
     assert outputs == [n + 1 for n in sorted(motor_numbers(original_robot(model)).values())]
     # The motors listen where PX4's gz bridge publishes (/<instance>/command/motor_speed).
-    sdf = etree.parse(str(target / "model.sdf"))
+    sdf = etree.parse(str(target / "models" / "firefly" / "model.sdf"))
     for motor in sdf.findall(f".//plugin[@filename='{MOTOR_SYSTEM}']"):
         assert motor.findtext("commandSubTopic") == "command/motor_speed"
         assert motor.find("robotNamespace") is None
-    port = load_robot(target / "model.sdf", {}, [])
+    port = load_robot(target / "models" / "firefly" / "model.sdf", {}, [])
     codes = {f.code for f in run_checks(port, flight_params=[load_px4_params(airframe)])
              if f.severity == "error"}
     assert not {c for c in codes if c.startswith("C")}, codes

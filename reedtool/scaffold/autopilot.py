@@ -79,7 +79,7 @@ def autopilot_files(spec, autopilot: str | None):
     frame: Airframe = spec.frame
     positions = frame.rotor_positions_m(spec["arm_length"], spec["rotor_offset_top"])
     if autopilot == "px4":
-        from reedtool.flightstack.px4 import RotorSpec, px4_airframe_text
+        from reedtool.flightstack.px4 import RotorSpec, px4_airframe_text, px4_hover_throttle
         from reedtool.scaffold.package_spec import STANDARD_GRAVITY_M_S2, total_mass_estimate_kg
 
         com = _com_m(spec, positions)
@@ -89,7 +89,8 @@ def autopilot_files(spec, autopilot: str | None):
                   for slot, position in zip(frame.rotors, positions)]
         weight_N = total_mass_estimate_kg(spec) * STANDARD_GRAVITY_M_S2
         hover_rad_s = np.sqrt(weight_N / (frame.rotor_count * spec["motor_constant"]))
-        throttle = float(np.clip(hover_rad_s / spec["max_rot_velocity"], 0.1, 0.8))
+        throttle = px4_hover_throttle([hover_rad_s] * len(rotors),
+                                      [spec["max_rot_velocity"]] * len(rotors))
         text = px4_airframe_text(spec.name, rotors, hover_throttle=throttle)
         path = PurePosixPath("px4", f"airframe_gz_{spec.name}")
     else:

@@ -1,0 +1,235 @@
+"""`--autopilot px4` writes PX4's Gazebo Sim contract, checked against PX4's own files.
+
+The expected values are written here from PX4's files (facts, not reedtool's output):
+PX4-gazebo-models models/x500_base/model.sdf (the four sensors, their rates and noise),
+models/x500/model.sdf (the motor systems), models/x500/model.config, worlds/default.sdf
+(spherical coordinates); PX4-Autopilot ROMFS/px4fmu_common/init.d-posix/airframes/
+4001_gz_x500 (the airframe), src/modules/simulation/gz_bridge/GZBridge.cpp (the topics the
+bridge subscribes to) and px4-rc.simulator (models/NAME, worlds/NAME.sdf). The port is read
+back with lxml and with libsdformat (tests/sdformat_oracle.py), not with reedtool's writer.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from cli_helpers import run_cli
+from lxml import etree
+
+from reedtool.io.fileio import reset_inputs
+
+FIXTURES = Path(__file__).parent / "fixtures"
+X500 = FIXTURES / "px4_x500_ref" / "models" / "x500"
+SEED_MODEL = FIXTURES / "seed000" / "reed_gazebo" / "urdf" / "mav_generic_odometry_sensor.gazebo"
+SEED_ARGS = ("mav_name:=reed_quad_x", "namespace:=reed_quad_x", "enable_mavlink_interface:=true",
+             "enable_ground_truth:=true", "enable_logging:=false", "log_file:=reed_quad_x",
+             "wait_to_record_bag:=false")
+MOTOR = "gz-sim-multicopter-motor-model-system"
+
+# PX4-gazebo-models models/x500_base/model.sdf: sensor name -> (type, update_rate), all on
+# base_link, where GZBridge.cpp subscribes (/world/W/model/M/link/base_link/sensor/NAME/...).
+PX4_SENSORS = {"imu_sensor": ("imu", "250"), "air_pressure_sensor": ("air_pressure", "50"),
+               "magnetometer_sensor": ("magnetometer", "100"), "navsat_sensor": ("navsat", "30")}
+# ... and their noise stddev (x500_base: IIM42653, BMP390, IIS2MDC).
+PX4_NOISE = {
+    "imu_sensor": {"imu/angular_velocity/x": "0.0008726646",
+                   "imu/angular_velocity/y": "0.0008726646",
+                   "imu/angular_velocity/z": "0.0008726646",
+                   "imu/linear_acceleration/x": "0.00637", "imu/linear_acceleration/y": "0.00637",
+                   "imu/linear_acceleration/z": "0.00686"},
+    "air_pressure_sensor": {"air_pressure/pressure": "3"},
+    "magnetometer_sensor": {"magnetometer/x": "0.0001", "magnetometer/y": "0.0001",
+                            "magnetometer/z": "0.0001"},
+}
+# PX4-gazebo-models models/x500/model.sdf: per motor (jointName, linkName, turningDirection,
+# motorNumber), and the constants every motor shares.
+PX4_MOTORS = [("rotor_0_joint", "rotor_0", "ccw", "0"), ("rotor_1_joint", "rotor_1", "ccw", "1"),
+              ("rotor_2_joint", "rotor_2", "cw", "2"), ("rotor_3_joint", "rotor_3", "cw", "3")]
+PX4_MOTOR_CONSTANTS = {"maxRotVelocity": 1000.0, "motorConstant": 8.54858e-06,
+                       "momentConstant": 0.016, "timeConstantUp": 0.0125,
+                       "timeConstantDown": 0.025, "rotorVelocitySlowdownSim": 10.0}
+# PX4-gazebo-models worlds/default.sdf <spherical_coordinates>.
+PX4_SPHERICAL = {"surface_model": "EARTH_WGS84", "world_frame_orientation": "ENU",
+                 "latitude_deg": 47.397971057728974, "longitude_deg": 8.546163739800146,
+                 "elevation": 488.0}
+# The gz-sim systems that run those four sensors (gz-sim's system names).
+SENSOR_SYSTEMS = {"gz::sim::systems::Imu", "gz::sim::systems::AirPressure",
+                  "gz::sim::systems::Magnetometer", "gz::sim::systems::NavSat"}
+# PX4-Autopilot airframes/4001_gz_x500, as written there.
+AIRFRAME_4001 = """PX4_SIMULATOR=${PX4_SIMULATOR:=gz}
+PX4_GZ_WORLD=${PX4_GZ_WORLD:=default}
+PX4_SIM_MODEL=${PX4_SIM_MODEL:=x500}
+param set-default SIM_GZ_EN 1
+param set-default CA_AIRFRAME 0
+param set-default CA_ROTOR_COUNT 4
+param set-default CA_ROTOR0_PX 0.13
+param set-default CA_ROTOR0_PY 0.22
+param set-default CA_ROTOR0_KM  0.05
+param set-default CA_ROTOR1_PX -0.13
+param set-default CA_ROTOR1_PY -0.20
+param set-default CA_ROTOR1_KM  0.05
+param set-default CA_ROTOR2_PX 0.13
+param set-default CA_ROTOR2_PY -0.22
+param set-default CA_ROTOR2_KM -0.05
+param set-default CA_ROTOR3_PX -0.13
+param set-default CA_ROTOR3_PY 0.20
+param set-default CA_ROTOR3_KM -0.05
+param set-default SIM_GZ_EC_FUNC1 101
+param set-default SIM_GZ_EC_FUNC2 102
+param set-default SIM_GZ_EC_FUNC3 103
+param set-default SIM_GZ_EC_FUNC4 104
+param set-default SIM_GZ_EC_MIN1 150
+param set-default SIM_GZ_EC_MIN2 150
+param set-default SIM_GZ_EC_MIN3 150
+param set-default SIM_GZ_EC_MIN4 150
+param set-default SIM_GZ_EC_MAX1 1000
+param set-default SIM_GZ_EC_MAX2 1000
+param set-default SIM_GZ_EC_MAX3 1000
+param set-default SIM_GZ_EC_MAX4 1000
+param set-default MPC_THR_HOVER 0.60
+"""
+
+
+def migrate_px4(tmp_path: Path, model: Path, args=()) -> tuple[dict, Path]:
+    reset_inputs()
+    code, text = run_cli("migrate", model, *args, "--to", "gz", "-o", tmp_path / "out",
+                         "--format", "json", "--autopilot", "px4")
+    assert code == 0, text
+    document = json.loads(text)
+    return document, Path(document["target"])
+
+
+def root_link(model: etree._Element) -> etree._Element:
+    children = {joint.findtext("child") for joint in model.iter("joint")}
+    roots = [link for link in model.findall("link") if link.get("name") not in children]
+    assert len(roots) == 1
+    return roots[0]
+
+
+def check_contract(target: Path, name: str) -> etree._Element:
+    """What every --autopilot px4 output must meet; returns the model element."""
+    import sdformat_oracle
+
+    files = {p.relative_to(target).as_posix() for p in target.rglob("*") if p.is_file()}
+    assert {f"models/{name}/model.sdf", f"models/{name}/model.config", f"worlds/{name}.sdf",
+            f"airframes/4900_gz_{name}"} <= files
+    model_dir = target / "models" / name
+    model = etree.parse(str(model_dir / "model.sdf")).getroot().find("model")
+    base = root_link(model)
+    assert base.get("name") == "base_link"
+    sensors = {s.get("name"): s for s in base.findall("sensor")}
+    for sensor_name, (kind, _rate) in PX4_SENSORS.items():
+        assert sensors[sensor_name].get("type") == kind
+        # gz's default topic, the one GZBridge.cpp subscribes to.
+        assert sensors[sensor_name].find("topic") is None
+    motors = model.findall(f"plugin[@filename='{MOTOR}']")
+    assert motors
+    for motor in motors:
+        assert motor.findtext("commandSubTopic") == "command/motor_speed"
+        assert motor.find("robotNamespace") is None
+        # gz-sim >= 8 reads actuator_number, gz-sim 7 motorNumber (MulticopterMotorModel.cc).
+        assert motor.findtext("actuator_number") == motor.findtext("motorNumber") is not None
+    config = etree.parse(str(model_dir / "model.config")).getroot()
+    assert config.findtext("name") == name
+    assert (config.find("sdf").get("version"), config.findtext("sdf")) == ("1.9", "model.sdf")
+    world = etree.parse(str(target / "worlds" / f"{name}.sdf")).getroot().find("world")
+    assert world.get("name") == name             # PX4_GZ_WORLD is the file's stem
+    assert SENSOR_SYSTEMS <= {p.get("name") for p in world.iter("plugin")}
+    spherical = world.find("spherical_coordinates")
+    for tag, value in PX4_SPHERICAL.items():
+        text = spherical.findtext(tag).strip()
+        assert (float(text) == value) if isinstance(value, float) else text == value
+    assert world.find("include") is None         # PX4 spawns the vehicle itself
+    assert sdformat_oracle.libsdformat_error(model_dir / "model.sdf", [target / "models"]) is None
+    assert sdformat_oracle.libsdformat_error(target / "worlds" / f"{name}.sdf",
+                                             [target / "models"]) is None
+    return model
+
+
+def test_x500_port_agrees_with_px4_x500_element_by_element(tmp_path):
+    from reedtool.checks.runner import run_checks
+    from reedtool.flightstack.px4 import load_px4_params, parse_px4_params
+    from reedtool.io.loader import load_robot
+
+    document, target = migrate_px4(tmp_path, X500)
+    assert not document["proof"]["differences"], document["proof"]["differences"]
+    model = check_contract(target, "x500")
+    base = root_link(model)
+    for sensor in base.findall("sensor"):
+        name = sensor.get("name")
+        assert sensor.findtext("update_rate").strip() == PX4_SENSORS[name][1]
+        for path, stddev in PX4_NOISE.get(name, {}).items():
+            assert float(sensor.find(path).findtext("noise/stddev")) == float(stddev), path
+    motors = {m.findtext("jointName"): m for m in model.findall(f"plugin[@filename='{MOTOR}']")}
+    assert sorted(motors) == [joint for joint, *_ in PX4_MOTORS]
+    for joint, link, spin, number in PX4_MOTORS:
+        motor = motors[joint]
+        assert (motor.findtext("linkName"), motor.findtext("turningDirection"),
+                motor.findtext("motorNumber")) == (link, spin, number)
+        for tag, value in PX4_MOTOR_CONSTANTS.items():
+            assert float(motor.findtext(tag)) == value, tag
+    # The airframe, against 4001_gz_x500 where the vehicles are the same: the model's
+    # rotor table (positions from the model, 0.174 m; 4001 describes the real frame's
+    # 0.13 x 0.22) with 4001's signs, outputs, idle and top speed.
+    ours = load_px4_params(target / "airframes" / "4900_gz_x500")
+    px4 = parse_px4_params(AIRFRAME_4001, "4001_gz_x500")
+    for key in ["SIM_GZ_EN", "CA_AIRFRAME", "CA_ROTOR_COUNT",
+                *(f"SIM_GZ_EC_{p}{k}" for p in ("FUNC", "MIN", "MAX") for k in range(1, 5))]:
+        assert ours.get(key).value == px4.get(key).value, key
+    for i in range(4):
+        for suffix in ("PX", "PY", "KM"):
+            mine, theirs = ours.get(f"CA_ROTOR{i}_{suffix}").value, px4.get(f"CA_ROTOR{i}_{suffix}").value
+            assert mine * theirs > 0, f"CA_ROTOR{i}_{suffix}: {mine} vs 4001's {theirs}"
+    text = (target / "airframes" / "4900_gz_x500").read_text()
+    assert "PX4_SIM_MODEL=${PX4_SIM_MODEL:=x500}" in text
+    assert "PX4_SIMULATOR=${PX4_SIMULATOR:=gz}" in text
+    # PX4's own airframe flies PX4's x500: on the port it finds no flight-stack error.
+    port = load_robot(target / "models" / "x500" / "model.sdf", {}, [target / "models"])
+    errors = [f for f in run_checks(port, flight_params=[px4]) if f.severity == "error"
+              and f.code.startswith("C")]
+    assert errors == []
+    mine = [f for f in run_checks(port, flight_params=[ours])
+            if f.code.startswith("C") and f.severity != "info"]
+    assert mine == []
+
+
+def test_seed_quad_port_takes_px4_names_and_places(tmp_path):
+    """The bundled seed: root 'reed_quad_x/base_link' becomes base_link, the RotorS IMU on
+    its own link moves to base_link with PX4's name, baro/mag/navsat are added; the proof
+    still reads the port back as the original (the rename is followed)."""
+    document, target = migrate_px4(tmp_path, SEED_MODEL, SEED_ARGS)
+    assert not document["proof"]["differences"], document["proof"]["differences"]
+    model = check_contract(target, "reed_quad_x")
+    assert model.find("link[@name='reed_quad_x/base_link']") is None
+    rows = {row["element"]: row for row in document["elements"]}
+    imu_rows = [r for e, r in rows.items() if "(imu)" in e and "imu_sensor" in r["output"]]
+    assert imu_rows and "moved from link" in imu_rows[0]["why"]
+
+
+@pytest.mark.parametrize("max_rad_s", [1100, 1500])
+def test_px4_takes_its_own_vehicles_top_speeds(tmp_path, max_rad_s):
+    """PX4's Classic iris (1100 rad/s) and typhoon_h480 (1500), px4vision's SIM_GZ_EC_MAX
+    1100: the 0..1000 of gz_bridge module.yaml is QGroundControl's range, not PX4's."""
+    from reedtool.commands.new_package import new_package
+    from reedtool.flightstack.px4 import load_px4_params
+    from reedtool.scaffold.package_spec import build_spec
+
+    spec = build_spec("fast", frame="quad-x", ros=2, flags={"max_rot_velocity": str(max_rad_s)},
+                      sim="gz")
+    result = new_package(spec, tmp_path, autopilot="px4")
+    airframe = next(f for f in result.files if f.parts[0] == "px4" and "airframe" in f.as_posix())
+    params = load_px4_params(result.target / airframe)
+    assert [params.get(f"SIM_GZ_EC_MAX{k}").value for k in range(1, 5)] == [max_rad_s] * 4
+
+
+def test_px4_refuses_a_speed_no_output_can_carry(tmp_path):
+    from reedtool.commands.new_package import new_package
+    from reedtool.errors import ReedtoolError
+    from reedtool.scaffold.package_spec import build_spec
+
+    spec = build_spec("rads", frame="quad-x", ros=2, flags={"max_rot_velocity": "70000"},
+                      sim="gz")
+    with pytest.raises(ReedtoolError, match="16-bit"):
+        new_package(spec, tmp_path, autopilot="px4")
