@@ -18,7 +18,7 @@ def load_robots(path: Path | str, mappings: Mapping[str, str] | None = None,
     an SDF world, each multirotor model (each model when none has motor plugins)."""
     path = Path(path)
     refuse_mesh(path)
-    if model_name is None and _sdf_path(path) is not None:
+    if model_name is None and _sdf_path(path) is not None and not _is_template(_sdf_path(path)):
         from reedtool.io.packages import PackageResolver
         from reedtool.io.sdf import load_sdf_models
 
@@ -75,7 +75,14 @@ def _model_dir_sdf(path: Path) -> Path:
 def _sdf_path(path: Path) -> Path | None:
     if path.is_dir():
         return _model_dir_sdf(path)
-    return path if path.suffix.lower() in SDF_SUFFIXES else None
+    return path if path.suffix.lower() in SDF_SUFFIXES or _is_template(path) else None
+
+
+def _is_template(path: Path) -> bool:
+    """PX4's Gazebo Classic `*.sdf.jinja` (io.sdf_jinja renders it as PX4 does)."""
+    from reedtool.io.sdf_jinja import is_sdf_jinja
+
+    return is_sdf_jinja(path)
 
 
 def load_robot(path: Path | str, mappings: Mapping[str, str] | None = None,
@@ -94,6 +101,12 @@ def load_robot(path: Path | str, mappings: Mapping[str, str] | None = None,
     refuse_mesh(path)
     if path.is_dir():
         path = _model_dir_sdf(path)
+    if _is_template(path):
+        from reedtool.io.sdf_jinja import load_sdf_jinja
+
+        resolver = PackageResolver(package_paths, model_path=path)
+        return _with_package_notes(load_sdf_jinja(path, resolver=resolver,
+                                                  model_name=model_name), resolver)
     if path.suffix.lower() in SDF_SUFFIXES:
         from reedtool.io.sdf import load_sdf_file
 

@@ -1,0 +1,162 @@
+"""PX4's Gazebo Classic templates (`*.sdf.jinja`), rendered as PX4 renders them.
+
+PX4-SITL_gazebo-classic keeps its models as Jinja templates and renders them at build
+time with scripts/jinja_gen.py: a jinja2 FileSystemLoader over the repository, default
+Undefined (an unknown name renders empty), and the context of jinja_gen's argument
+defaults (mavlink_tcp_port 4560, mavlink_udp_port 14560, serial_enabled 0, hil_mode 0,
+...), `np` (numpy), `rospack` None without ROS, `ros_version` 0, overridden by the
+repository's resources/px4_gazebo_jinja_parameters.json when there is one. reedtool does
+the same, and then reads the text as SDF.
+
+Findings point into the template: each line of the rendered text is matched to a
+template line (difflib: the lines a block of template text renders to, line by line;
+the lines a macro or expression expands to, to the template lines they replace), and
+every SourceLoc of the model in the template is moved to that line (the rendered line
+kept as `urdf_line`, the line of the expansion).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+from reedtool.errors import ReedtoolError
+
+SUFFIX = ".sdf.jinja"
+# scripts/jinja_gen.py argparse defaults (PX4-SITL_gazebo-classic).
+JINJA_GEN_DEFAULTS = {
+    "mavlink_tcp_port": 4560, "mavlink_udp_port": 14560, "serial_enabled": 0,
+    "serial_device": "/dev/ttyACM0", "serial_baudrate": 921600, "hil_mode": 0,
+    "mavlink_id": 1, "cam_component_id": 100, "gst_udp_host": "127.0.0.1",
+    "gst_udp_port": 5600, "external_render_ip": "", "video_uri": "udp://127.0.0.1:5600",
+    "mavlink_cam_udp_port": 14530, "udp_onboard_gimbal_host_ip": 13030,
+    "udp_onboard_gimbal_port_remote": 13030,
+}
+OVERRIDES = Path("resources") / "px4_gazebo_jinja_parameters.json"
+_MAX_ROOT_DEPTH = 4        # a template sits at <repo>/models/<model>/<model>.sdf.jinja
+
+
+def is_sdf_jinja(path: Path | str) -> bool:
+    return str(path).lower().endswith(SUFFIX)
+
+
+@dataclass
+class Rendered:
+    text: str
+    template_line: list[int]           # rendered line n (1-based) -> template_line[n - 1]
+
+
+def _env_dir(path: Path) -> Path:
+    """The repository jinja_gen.py is run with (the ancestor holding resources/ or
+    scripts/jinja_gen.py), else the template's own directory."""
+    for parent in list(path.parents)[:_MAX_ROOT_DEPTH]:
+        if (parent / OVERRIDES).is_file() or (parent / "scripts" / "jinja_gen.py").is_file():
+            return parent
+    return path.parent
+
+
+def _context(env_dir: Path) -> dict:
+    import numpy as np
+
+    context = {"np": np, "rospack": None, "ros_version": 0, **JINJA_GEN_DEFAULTS}
+    overrides = env_dir / OVERRIDES
+    if overrides.is_file():
+        from reedtool.io.fileio import read_text_file
+
+        try:
+            context.update(json.loads(read_text_file(overrides, what="jinja parameters")))
+        except json.JSONDecodeError as exc:
+            raise ReedtoolError(f"not JSON ({exc.msg})", file=overrides, line=exc.lineno,
+                                hint="jinja_gen.py reads it as a JSON object") from None
+    return context
+
+
+def render(path: Path) -> Rendered:
+    """The template's text as jinja_gen.py renders it, with the template line of each
+    rendered line."""
+    import jinja2
+
+    from reedtool.io.fileio import read_text_file
+
+    path = Path(path)
+    source = read_text_file(path, what="SDF template")
+    env_dir = _env_dir(path.resolve())
+    env = jinja2.Environment(loader=jinja2.FileSystemLoader(str(env_dir)))
+    try:
+        template = env.from_string(source)
+        text = template.render(_context(env_dir))
+    except jinja2.TemplateSyntaxError as exc:
+        raise ReedtoolError(f"Jinja template error: {exc.message}", file=path, line=exc.lineno,
+                            hint="PX4's jinja_gen.py would refuse it too") from None
+    except jinja2.TemplateError as exc:
+        raise ReedtoolError(f"Jinja template error: {exc}", file=path,
+                            hint="reedtool renders it with jinja_gen.py's default "
+                                 "arguments") from None
+    except Exception as exc:        # an expression of the template failed (np, arithmetic)
+        raise ReedtoolError(f"rendering the template failed: {type(exc).__name__}: {exc}",
+                            file=path, hint="reedtool renders it with jinja_gen.py's "
+                                            "default arguments") from None
+    return Rendered(text, _line_map(source.splitlines(), text.splitlines()))
+
+
+def _line_map(template: list[str], rendered: list[str]) -> list[int]:
+    matcher = difflib.SequenceMatcher(None, [line.strip() for line in template],
+                                      [line.strip() for line in rendered], autojunk=False)
+    out = [1] * len(rendered)
+    for tag, i1, i2, j1, j2 in matcher.get_opcodes():
+        for j in range(j1, j2):
+            if tag == "equal":
+                out[j] = i1 + (j - j1) + 1
+            elif i2 > i1:
+                out[j] = i1 + min(j - j1, i2 - i1 - 1) + 1
+            else:
+                out[j] = max(i1, 1)    # inserted: the template line before it
+    return out
+
+
+def _relocate(obj, file: str, line_map: list[int], seen: dict[int, object]):
+    """obj with every SourceLoc of `file` in it moved to the template line (SourceLoc is
+    frozen: a moved one is a new SourceLoc, put where the old one was)."""
+    from reedtool.model import SourceLoc
+
+    if obj is None or isinstance(obj, (str, bytes, int, float, bool)):
+        return obj
+    if id(obj) in seen:
+        return seen[id(obj)]
+    seen[id(obj)] = obj
+    if isinstance(obj, SourceLoc):
+        if obj.file == file and obj.line is not None and 1 <= obj.line <= len(line_map):
+            moved = dataclasses.replace(obj, line=line_map[obj.line - 1], urdf_line=obj.line)
+            seen[id(obj)] = moved
+            return moved
+        return obj
+    if isinstance(obj, list):
+        obj[:] = [_relocate(value, file, line_map, seen) for value in obj]
+    elif isinstance(obj, tuple) and not hasattr(obj, "_fields"):
+        moved = tuple(_relocate(value, file, line_map, seen) for value in obj)
+        seen[id(obj)] = moved
+        return moved
+    elif isinstance(obj, dict):
+        for key, value in obj.items():
+            obj[key] = _relocate(value, file, line_map, seen)
+    elif dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        for item in dataclasses.fields(obj):
+            value = getattr(obj, item.name, None)
+            moved = _relocate(value, file, line_map, seen)
+            if moved is not value:
+                object.__setattr__(obj, item.name, moved)
+    return obj
+
+
+def load_sdf_jinja(path: Path, *, resolver=None, model_name: str | None = None):
+    """The Robot of a rendered template, its locations in the template."""
+    from reedtool.io.sdf import parse_sdf
+
+    path = Path(path)
+    rendered = render(path)
+    robot = parse_sdf(rendered.text, path, resolver=resolver, model_name=model_name)
+    _relocate(robot, str(path), rendered.template_line, {})
+    return robot
