@@ -34,6 +34,7 @@ from reedtool.model import SourceLoc
 
 MOTOR_FUNCTION_BASE = 101          # PX4 output function "Motor 1"
 MAX_GZ_OUTPUTS = 8                 # SIM_GZ_EC has 8 channels (gz_bridge module.yaml)
+MAX_CLASSIC_OUTPUTS = 16           # PWM_MAIN outputs simulator_mavlink sends
 MAX_CA_ROTORS = 12
 
 # Documented ranges of the parameters reedtool reads or writes: (min, max, default, source).
@@ -65,6 +66,8 @@ PARAM_RANGES: dict[str, tuple[float, float, float | None, str]] = {
     "THR_MDL_FAC": (0.0, 1.0, 0.0, "PX4 parameter reference, THR_MDL_FAC (0..1)"),
 }
 
+# The shell variables of a SITL airframe that say which simulator and model it is for.
+_SHELL_VAR = re.compile(r"^\s*(PX4_SIMULATOR|PX4_SIM_MODEL|PX4_GZ_WORLD)=(?:\$\{\w+:=)?([^}\s]*)")
 _QGC_LINE = re.compile(r"^\s*(\d+)\t(\d+)\t([A-Za-z0-9_]+)\t(\S+)\t(\d+)\s*$")
 _PARAM_CMD = re.compile(r"^\s*param\s+(set-default|set)\s+([A-Za-z0-9_]+)\s+(\S+)")
 
@@ -113,6 +116,7 @@ class Px4Params:
     values: dict[str, ParamValue] = field(default_factory=dict)
     problems: list[tuple[str, SourceLoc]] = field(default_factory=list)
     kind: str = "px4"
+    shell: dict[str, tuple[str, SourceLoc]] = field(default_factory=dict)   # PX4_SIMULATOR=...
 
     @property
     def label(self) -> str:
@@ -158,6 +162,112 @@ class Px4Params:
     @property
     def uses_gz_outputs(self) -> bool:
         return any(self.has(f"SIM_GZ_EC_FUNC{k}") for k in range(1, MAX_GZ_OUTPUTS + 1))
+
+    def classic_outputs_of(self, ca_index: int) -> list[int]:
+        """The simulator_mavlink outputs k (PWM_MAIN, 1-based) whose function is CA rotor
+        `ca_index`; output i+1 for rotor i when the file sets no PWM_MAIN_FUNC."""
+        if not any(name.startswith("PWM_MAIN_FUNC") for name in self.values):
+            return [ca_index + 1]
+        return [k for k in range(1, MAX_CLASSIC_OUTPUTS + 1)
+                if self.get(f"PWM_MAIN_FUNC{k}").value == MOTOR_FUNCTION_BASE + ca_index]
+
+    def simulator(self) -> "SimulatorEvidence | None":
+        """Which Gazebo the airframe is for, and what says so; None when it does not say."""
+        return airframe_simulator(self)
+
+
+@dataclass
+class SimulatorEvidence:
+    simulator: str                 # "gz" (Gazebo Sim, gz_bridge) | "classic" (simulator_mavlink)
+    what: str                      # the line or name that says so
+    loc: SourceLoc
+
+
+def airframe_simulator(params: Px4Params) -> SimulatorEvidence | None:
+    """gz: SIM_GZ_EN 1, PX4_SIMULATOR=gz or SIM_GZ_EC_* parameters (px4-rc.simulator starts
+    the gz bridge on SIM_GZ_EN 1 or PX4_SIMULATOR=gz). Classic: PX4_SIMULATOR=gazebo-classic,
+    a gazebo-classic airframe name (PX4's NNNN_gazebo-classic_*), or PWM_MAIN_FUNC outputs
+    without any SIM_GZ parameter (simulator_mavlink sends PWM_MAIN as HIL_ACTUATOR_CONTROLS)."""
+    enabled = params.values.get("SIM_GZ_EN")
+    if enabled is not None and enabled.value == 1:
+        return SimulatorEvidence("gz", enabled.describe(), enabled.loc)
+    simulator = params.shell.get("PX4_SIMULATOR")
+    if simulator is not None and simulator[0] == "gz":
+        return SimulatorEvidence("gz", f"PX4_SIMULATOR={simulator[0]} ({simulator[1]})",
+                                 simulator[1])
+    gz = [v for v in params.values.values() if v.name.startswith("SIM_GZ_")]
+    if gz:
+        return SimulatorEvidence("gz", gz[0].describe(), gz[0].loc)
+    if simulator is not None and simulator[0] == "gazebo-classic":
+        return SimulatorEvidence("classic", f"PX4_SIMULATOR={simulator[0]} ({simulator[1]})",
+                                 simulator[1])
+    if "gazebo-classic" in Path(params.file).name:
+        return SimulatorEvidence("classic", f"the airframe name {Path(params.file).name}",
+                                 params.loc)
+    outputs = [v for v in params.values.values() if v.name.startswith("PWM_MAIN_FUNC")]
+    if outputs:
+        return SimulatorEvidence("classic", f"{outputs[0].describe()}, no SIM_GZ parameter",
+                                 outputs[0].loc)
+    return None
+
+
+# ------------------------------------------------------------ Classic SITL
+
+@dataclass
+class MavlinkChannel:
+    """One control channel of PX4-SITL_gazebo-classic's gazebo_mavlink_interface: while
+    armed it commands input_reference = (u + input_offset) * input_scaling +
+    zero_position_armed from actuator_controls[input_index] (gazebo_mavlink_interface.cpp),
+    u in 0..1 for a motor; the motor with motorNumber n reads the entry of channel n (the
+    n-th <channel>)."""
+
+    position: int                  # n: the motor number that reads it
+    input_index: int | None        # PWM_MAIN output input_index + 1 feeds it
+    offset: float
+    scaling: float
+    zero_armed: float
+    velocity: bool
+    loc: SourceLoc
+
+    def range_rad_s(self) -> tuple[float, float]:
+        """(speed at u = 0, speed at u = 1) while armed."""
+        return (self.offset * self.scaling + self.zero_armed,
+                (1.0 + self.offset) * self.scaling + self.zero_armed)
+
+    def describe(self) -> str:
+        return (f"mavlink channel {self.position} ({self.loc}): (u + {self.offset:g}) x "
+                f"{self.scaling:g} + {self.zero_armed:g}")
+
+
+def mavlink_channels(robot) -> list[MavlinkChannel]:
+    """The control channels of the model's gazebo_mavlink_interface, in order ([] when it
+    has none: RotorS' interface, or no interface)."""
+    from reedtool.physics.rotors import MAVLINK_PLUGINS
+
+    def number(node, tag: str, default: float) -> float:
+        text = node.findtext(tag)
+        try:
+            return float(text) if text is not None and text.strip() else default
+        except ValueError:
+            return math.nan
+
+    for _block, plugin in robot.plugins():
+        if plugin.library not in MAVLINK_PLUGINS:
+            continue
+        channels = plugin.node.find("control_channels")
+        if channels is None:
+            continue
+        out = []
+        for position, channel in enumerate(channels.findall("channel")):
+            index_text = (channel.findtext("input_index") or "").strip()
+            kind = (channel.findtext("joint_control_type") or "velocity").strip()
+            out.append(MavlinkChannel(position, int(index_text) if index_text.isdigit() else None,
+                                      number(channel, "input_offset", 0.0),
+                                      number(channel, "input_scaling", 1.0),
+                                      number(channel, "zero_position_armed", 0.0),
+                                      kind == "velocity", channel.loc))
+        return out
+    return []
 
 
 # ------------------------------------------------------------ CA_AIRFRAME
@@ -297,6 +407,10 @@ def parse_px4_params(text: str, file: str) -> Px4Params:
         if qgc:
             name, value_text = qgc.group(3), qgc.group(4)
             params.values[name] = ParamValue(name, _number(value_text, name, loc), value_text, loc)
+            continue
+        var = _SHELL_VAR.match(line)
+        if var:
+            params.shell[var.group(1)] = (var.group(2), loc)
             continue
         cmd = _PARAM_CMD.match(line)
         if cmd:

@@ -20,6 +20,7 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import json
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -102,9 +103,34 @@ def render(path: Path) -> Rendered:
     return Rendered(text, _line_map(source.splitlines(), text.splitlines()))
 
 
+def _normal(line: str) -> str:
+    """A line with its expressions and numbers blanked: a template line and what it
+    renders to compare equal (`rotor_{{ loop.index0 }}` and `rotor_2`)."""
+    line = re.sub(r"\{\{.*?\}\}", "#", line.strip())
+    return re.sub(r"#+", "#", re.sub(r"[-+]?\d[\d.eE+-]*", "#", line))
+
+
+def _template_keys(template: list[str]) -> list[str]:
+    """What each template line can match: its normal form; nothing for a macro's body (it
+    renders where the macro is called, and a finding there points at the call) or a
+    statement-only line (it renders nothing)."""
+    keys, depth = [], 0
+    for n, line in enumerate(template):
+        if re.search(r"\{%-?\s*macro\b", line):
+            depth += 1
+        silent = depth > 0 or re.fullmatch(r"\s*\{%.*?%\}\s*", line) is not None
+        if re.search(r"\{%-?\s*endmacro\b", line):
+            depth = max(depth - 1, 0)
+        keys.append(f"\0{n}" if silent else _normal(line))
+    return keys
+
+
 def _line_map(template: list[str], rendered: list[str]) -> list[int]:
-    matcher = difflib.SequenceMatcher(None, [line.strip() for line in template],
-                                      [line.strip() for line in rendered], autojunk=False)
+    """Rendered line -> template line. Lines a loop repeats are matched again against the
+    template before them (the loop's body); a macro's lines map to its call."""
+    t_norm = _template_keys(template)
+    r_norm = [_normal(line) for line in rendered]
+    matcher = difflib.SequenceMatcher(None, t_norm, r_norm, autojunk=False)
     out = [1] * len(rendered)
     for tag, i1, i2, j1, j2 in matcher.get_opcodes():
         for j in range(j1, j2):
@@ -114,7 +140,24 @@ def _line_map(template: list[str], rendered: list[str]) -> list[int]:
                 out[j] = i1 + min(j - j1, i2 - i1 - 1) + 1
             else:
                 out[j] = max(i1, 1)    # inserted: the template line before it
+        if tag in ("insert", "replace") and j2 - j1 > i2 - i1:
+            _repeats(t_norm[:i2], r_norm, j1, j2, out)
     return out
+
+
+def _repeats(t_norm: list[str], r_norm: list[str], j1: int, j2: int, out: list[int]) -> None:
+    """Rendered lines j1..j2 that repeat template text (a loop's later passes), matched
+    pass by pass: each round aligns what is left with the template once."""
+    start = j1
+    while start < j2:
+        again = difflib.SequenceMatcher(None, t_norm, r_norm[start:j2], autojunk=False)
+        blocks = [b for b in again.get_matching_blocks() if b.size]
+        if not blocks:
+            return
+        for block in blocks:
+            for n in range(block.size):
+                out[start + block.b + n] = block.a + n + 1
+        start += blocks[-1].b + blocks[-1].size
 
 
 def _relocate(obj, file: str, line_map: list[int], seen: dict[int, object]):
