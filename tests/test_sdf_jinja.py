@@ -97,3 +97,17 @@ def test_the_template_ports_to_a_model_libsdformat_loads(tmp_path):
     assert code == 0, text
     target = Path(json.loads(text)["target"])
     assert sdformat_oracle.libsdformat_error(target / "model.sdf") is None
+
+
+def test_an_sdf_including_a_template_reads_it_rendered(tmp_path):
+    """PX4's iris_opt_flow.sdf includes model://px4flow, a template: the include is
+    rendered too, and its elements keep the template's lines."""
+    outer = tmp_path / "outer.sdf"
+    outer.write_text("<?xml version='1.0'?>\n<sdf version='1.6'>\n  <model name='outer'>\n"
+                     "    <include>\n      <uri>model://quad_jinja</uri>\n    </include>\n"
+                     "  </model>\n</sdf>\n")
+    robot = load_robot(outer, {}, [MODEL_DIR.parent])
+    rotor = next(link for link in robot.links if link.name.endswith("rotor_1"))
+    assert rotor.loc.file == str(TEMPLATE)
+    loop_start = template_line("{%- for x, y, spin in rotors %}")
+    assert loop_start < rotor.loc.line < template_line("{%- endfor %}")

@@ -22,9 +22,11 @@ def load_robots(path: Path | str, mappings: Mapping[str, str] | None = None,
         from reedtool.io.packages import PackageResolver
         from reedtool.io.sdf import load_sdf_models
 
+        from reedtool.io.sdf_jinja import relocate_rendered
+
         sdf = _sdf_path(path)
         resolver = PackageResolver(package_paths, model_path=sdf)
-        return [_with_package_notes(robot, resolver)
+        return [_with_package_notes(relocate_rendered(robot), resolver)
                 for robot in load_sdf_models(sdf, resolver=resolver)]
     return [load_robot(path, mappings, package_paths, model_name=model_name)]
 
@@ -109,10 +111,11 @@ def load_robot(path: Path | str, mappings: Mapping[str, str] | None = None,
                                                   model_name=model_name), resolver)
     if path.suffix.lower() in SDF_SUFFIXES:
         from reedtool.io.sdf import load_sdf_file
+        from reedtool.io.sdf_jinja import relocate_rendered
 
         resolver = PackageResolver(package_paths, model_path=path)
-        return _with_package_notes(load_sdf_file(path, resolver=resolver,
-                                                 model_name=model_name), resolver)
+        return _with_package_notes(relocate_rendered(load_sdf_file(
+            path, resolver=resolver, model_name=model_name)), resolver)
     if model_name is not None:
         raise ReedtoolError("--model picks a model of an SDF file; this file is not SDF",
                             file=path, hint="drop --model")

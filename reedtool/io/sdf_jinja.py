@@ -40,6 +40,11 @@ OVERRIDES = Path("resources") / "px4_gazebo_jinja_parameters.json"
 _MAX_ROOT_DEPTH = 4        # a template sits at <repo>/models/<model>/<model>.sdf.jinja
 
 
+# Templates rendered since the last relocate_rendered(): path -> template line per rendered
+# line (an SDF model may include one: PX4's iris_opt_flow includes px4flow).
+_RENDERED: dict[str, list[int]] = {}
+
+
 def is_sdf_jinja(path: Path | str) -> bool:
     return str(path).lower().endswith(SUFFIX)
 
@@ -100,7 +105,9 @@ def render(path: Path) -> Rendered:
         raise ReedtoolError(f"rendering the template failed: {type(exc).__name__}: {exc}",
                             file=path, hint="reedtool renders it with jinja_gen.py's "
                                             "default arguments") from None
-    return Rendered(text, _line_map(source.splitlines(), text.splitlines()))
+    rendered = Rendered(text, _line_map(source.splitlines(), text.splitlines()))
+    _RENDERED[str(path)] = rendered.template_line
+    return rendered
 
 
 def _normal(line: str) -> str:
@@ -194,12 +201,20 @@ def _relocate(obj, file: str, line_map: list[int], seen: dict[int, object]):
     return obj
 
 
+def relocate_rendered(robot):
+    """Move the robot's locations in every template rendered while loading it (its own
+    file, or a template it includes) to the template's lines."""
+    for file, line_map in list(_RENDERED.items()):
+        robot = _relocate(robot, file, line_map, {})
+    _RENDERED.clear()
+    return robot
+
+
 def load_sdf_jinja(path: Path, *, resolver=None, model_name: str | None = None):
     """The Robot of a rendered template, its locations in the template."""
     from reedtool.io.sdf import parse_sdf
 
     path = Path(path)
     rendered = render(path)
-    robot = parse_sdf(rendered.text, path, resolver=resolver, model_name=model_name)
-    _relocate(robot, str(path), rendered.template_line, {})
-    return robot
+    return relocate_rendered(parse_sdf(rendered.text, path, resolver=resolver,
+                                       model_name=model_name))
