@@ -16,7 +16,10 @@ def _generate(tmp_path, frame: str, autopilot: str, ros: int = 2, sim: str | Non
     name = f"ap_{frame.replace('-', '_')}_{autopilot}"
     spec = build_spec(name, frame=frame, ros=ros, flags={}, sim=sim)
     result = new_package(spec, tmp_path, autopilot=autopilot)
-    extra = [f for f in result.files if f.parts[0] == autopilot]
+    # The rotor table: ardupilot/NAME.parm, px4/airframes/NNNN_gz_NAME (gz: with the model
+    # in PX4's layout beside it) or px4/airframe_gazebo-classic_NAME (Classic).
+    extra = [f for f in result.files if f.parts[0] == autopilot and (
+        f.suffix == ".parm" or "airframes" in f.parts or f.name.startswith("airframe"))]
     assert len(extra) == 1
     return result.target / model_path(spec), result.target / extra[0], spec
 
@@ -42,10 +45,17 @@ def test_generated_autopilot_file_is_clean(tmp_path, frame, autopilot):
 
 
 def test_rotors_classic_package_with_px4(tmp_path):
+    """A RotorS (Gazebo Classic) package gets a Classic airframe: PX4's simulator_mavlink
+    outputs (PWM_MAIN_FUNC), no SIM_GZ parameter (those start the gz bridge), so validate
+    finds no simulator mismatch (C435) and no gz command-range rule applies; the RotorS
+    interface declares no control channels, so there is no command range to compare."""
     model, table, _spec = _generate(tmp_path, "quad-x", "px4", ros=1, sim="classic")
-    findings = run_checks(load_robot(model), Selection(select=("C",)),
-                          flight_params=[px4.load_px4_params(table)])
-    assert sorted(f.code for f in findings) == ["C421"]
+    params = px4.load_px4_params(table)
+    assert params.simulator().simulator == "classic"
+    assert not any(name.startswith("SIM_GZ") for name in params.values)
+    assert [params.get(f"PWM_MAIN_FUNC{k}").value for k in range(1, 5)] == [101, 102, 103, 104]
+    findings = run_checks(load_robot(model), Selection(select=("C",)), flight_params=[params])
+    assert sorted(f.code for f in findings) == []
 
 
 def test_quad_x_airframe_values_by_hand(tmp_path):

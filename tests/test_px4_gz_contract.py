@@ -233,3 +233,35 @@ def test_px4_refuses_a_speed_no_output_can_carry(tmp_path):
                       sim="gz")
     with pytest.raises(ReedtoolError, match="16-bit"):
         new_package(spec, tmp_path, autopilot="px4")
+
+
+@pytest.mark.parametrize("frame", ["quad-x", "hex-x"])
+def test_new_package_gz_px4_writes_the_contract(tmp_path, frame):
+    """new-package --sim gz --autopilot px4: the ROS 2 package's model talks to PX4's
+    bridge (motors on command/motor_speed, no namespace, both numbers; PX4's sensors on
+    base_link, no velocity controller), and px4/ holds the same model in PX4's layout with
+    its airframe; PX4's airframe and the model agree (no flight-stack warning)."""
+    from reedtool.checks.runner import run_checks
+    from reedtool.commands.new_package import new_package
+    from reedtool.flightstack.px4 import load_px4_params
+    from reedtool.io.loader import load_robot
+    from reedtool.scaffold.package_spec import build_spec
+
+    name = f"px4_{frame.replace('-', '_')}"
+    spec = build_spec(name, frame=frame, ros=2, flags={}, sim="gz")
+    result = new_package(spec, tmp_path, autopilot="px4")
+    px4_dir = result.target / "px4"
+    model = check_contract(px4_dir, name)
+    assert len(model.findall(f"plugin[@filename='{MOTOR}']")) == spec.frame.rotor_count
+    xacro = (result.target / "urdf" / f"{name}.urdf.xacro").read_text()
+    assert "MulticopterVelocityControl" not in xacro
+    bridge = (result.target / "config" / f"{name}_bridge.yaml").read_text()
+    assert "cmd_vel" not in bridge
+    assert f"/world/{name}_world/model/{name}/link/base_link/sensor/imu_sensor/imu" in bridge
+    package_model = load_robot(result.target / "urdf" / f"{name}.urdf.xacro")
+    port = load_robot(px4_dir / "models" / name / "model.sdf", {}, [px4_dir / "models"])
+    airframe = load_px4_params(px4_dir / "airframes" / f"4900_gz_{name}")
+    for robot in (package_model, port):
+        found = [f for f in run_checks(robot, flight_params=[airframe])
+                 if f.code.startswith("C") and f.severity != "info"]
+        assert found == []

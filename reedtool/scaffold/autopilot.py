@@ -67,8 +67,10 @@ def _com_m(spec, positions: np.ndarray) -> np.ndarray:
     return spec["mass_rotor"] * positions.sum(axis=0) / total_mass_estimate_kg(spec)
 
 
-def autopilot_files(spec, autopilot: str | None):
-    """The RenderedFiles for `--autopilot`, or [] without it."""
+def autopilot_files(spec, autopilot: str | None, rendered=()):
+    """The RenderedFiles for `--autopilot`, or [] without it. PX4 on gz: the airframe and
+    the model in PX4-gazebo-models' layout under px4/ (scaffold.px4_gz_contract), ported
+    from the package's own model (`rendered`, the package's files)."""
     from reedtool.scaffold.render import RenderedFile
 
     if autopilot is None:
@@ -91,8 +93,18 @@ def autopilot_files(spec, autopilot: str | None):
         hover_rad_s = np.sqrt(weight_N / (frame.rotor_count * spec["motor_constant"]))
         throttle = px4_hover_throttle([hover_rad_s] * len(rotors),
                                       [spec["max_rot_velocity"]] * len(rotors))
-        text = px4_airframe_text(spec.name, rotors, hover_throttle=throttle)
-        path = PurePosixPath("px4", f"airframe_gz_{spec.name}")
+        if spec.sim == "gz":
+            from reedtool.scaffold.px4_gz_contract import airframe_path, package_px4_files
+
+            text = px4_airframe_text(spec.name, rotors, hover_throttle=throttle, world=spec.name)
+            return [RenderedFile(PurePosixPath("px4", *airframe_path(spec.name).parts),
+                                 text.encode("utf-8"), 0o644),
+                    *(RenderedFile(PurePosixPath("px4", *path.parts), data, 0o644)
+                      for path, data in package_px4_files(spec.name, rendered))]
+        # Gazebo Classic (RotorS): PX4's simulator_mavlink outputs, no gz bridge.
+        text = px4_airframe_text(spec.name, rotors, hover_throttle=throttle,
+                                 simulator="classic")
+        path = PurePosixPath("px4", f"airframe_gazebo-classic_{spec.name}")
     else:
         from reedtool.flightstack.ardupilot import parm_text
 
@@ -105,11 +117,31 @@ def autopilot_files(spec, autopilot: str | None):
 
 def autopilot_context(spec, autopilot: str | None) -> dict:
     """Template variables for --autopilot: `ardupilot_block`, the ArduPilotPlugin and its
-    LiftDrag blades for a gz-sim multirotor (scaffold.ardupilot_gz), else empty."""
+    LiftDrag blades for a gz-sim multirotor (scaffold.ardupilot_gz); `px4` and PX4's gz
+    contract (scaffold.px4_gz_contract: the sensors, the world's spherical coordinates)."""
+    context = {"ardupilot_block": "", "px4": False}
     if autopilot == "ardupilot" and spec.kind == "multirotor" and spec.sim == "gz":
         from reedtool.scaffold.ardupilot_gz import package_block
 
         positions = spec.frame.rotor_positions_m(spec["arm_length"], spec["rotor_offset_top"])
-        return {"ardupilot_block": package_block(spec, positions, _com_m(spec, positions))}
-    return {"ardupilot_block": ""}
+        context["ardupilot_block"] = package_block(spec, positions, _com_m(spec, positions))
+    if autopilot == "px4" and spec.kind == "multirotor" and spec.sim == "gz":
+        from reedtool.scaffold.px4_gz_contract import (
+            MAGNETIC_FIELD_T,
+            PX4_SENSORS,
+            SPHERICAL_COORDINATES,
+            _px4_sensor,
+        )
+        from reedtool.scaffold.sdf_writer import elements_text
+
+        sensors = []
+        for sensor in PX4_SENSORS:
+            body = [c for c in _px4_sensor(sensor).children
+                    if c.tag not in ("always_on", "update_rate")]
+            sensors.append({"name": sensor.name, "type": sensor.type,
+                            "update_rate_hz": sensor.update_rate_hz,
+                            "xml": elements_text(body, indent=6)})
+        context.update(px4=True, px4_sensors=sensors, px4_spherical=SPHERICAL_COORDINATES,
+                       px4_magnetic_field=MAGNETIC_FIELD_T)
+    return context
 

@@ -358,3 +358,37 @@ file if yours does. Check the pair before flying:
 
     reedtool validate models/{name}/model.sdf --airframe {airframe}
 """
+
+
+def package_px4_files(name: str, rendered) -> list[tuple[PurePosixPath, bytes]]:
+    """new-package --sim gz --autopilot px4: the package's model (urdf/NAME.urdf.xacro, as
+    rendered) ported to PX4's layout: models/NAME (model.sdf, model.config, meshes),
+    worlds/NAME.sdf, README.md. The package is written to a scratch directory so the
+    xacro expands as it will in the package (package:// meshes)."""
+    import tempfile
+    from pathlib import Path
+
+    from reedtool.io.loader import load_robot
+    from reedtool.scaffold.gz_port import PortOptions, plan_port
+    from reedtool.scaffold.sdf_writer import port_files
+
+    with tempfile.TemporaryDirectory(prefix="reedtool-px4-") as scratch:
+        root = Path(scratch) / name
+        for file in rendered:
+            path = root.joinpath(*file.path.parts)
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(file.data)
+        model = root / "urdf" / f"{name}.urdf.xacro"
+        robot = load_robot(model, {}, [Path(scratch)])
+        port = plan_port(robot, name, PortOptions(autopilot="px4"))
+        apply_px4_contract(port)
+        source = f"package {name}, urdf/{name}.urdf.xacro"
+        written, _rows = port_files(port, source)
+    out = []
+    for file in written.files:
+        if file.path == PurePosixPath("worlds", f"{name}.sdf"):
+            out.append((file.path, px4_world_sdf(name)))
+        else:
+            out.append((px4_layout(name, file.path), file.data))
+    out.append((PurePosixPath("README.md"), readme_text(name, "new-package").encode("utf-8")))
+    return out
