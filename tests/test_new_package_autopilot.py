@@ -102,3 +102,44 @@ def test_ardupilot_gz_package_is_driven_by_the_plugin(tmp_path, frame):
     assert 'name="gz::sim::systems::MulticopterMotorModel"' not in text
     assert 'name="gz::sim::systems::MulticopterVelocityControl"' not in text
 
+
+
+def test_ardupilot_on_gazebo_classic_is_refused_with_the_reason(tmp_path):
+    """ardupilot_gazebo's ArduPilotPlugin supports Gazebo Garden and later (its README): a
+    ROS 1 / RotorS package (Gazebo Classic) would carry no plugin SITL talks to."""
+    from reedtool.commands.new_package import new_package
+    from reedtool.errors import ReedtoolError
+
+    spec = build_spec("ap_ros1", frame="quad-x", ros=1, flags={}, sim="classic")
+    with pytest.raises(ReedtoolError, match="needs Gazebo Sim") as refusal:
+        new_package(spec, tmp_path, autopilot="ardupilot")
+    assert "--ros 2 --sim gz" in refusal.value.hint
+    assert not (tmp_path / "ap_ros1").exists()
+
+
+def test_ardupilot_package_readme_and_bridge_match_the_model(tmp_path):
+    """The README starts SITL the way ardupilot_gazebo's README does (sim_vehicle.py with
+    the JSON model) with the .parm and the address and port the model's ArduPilotPlugin
+    listens on (read from the expanded model, not from the writer); the bridge offers no
+    topic the model does not publish or read (no velocity controller: no cmd_vel)."""
+    import re
+
+    from lxml import etree
+
+    from reedtool.io.xacro_expand import expand_xacro
+
+    model, _table, spec = _generate(tmp_path, "quad-x", "ardupilot")
+    package = model.parent.parent
+    urdf = etree.fromstring(expand_xacro(model, {}, []).urdf_xml.encode())
+    plugin = next(p for p in urdf.iter("plugin") if p.get("name") == "ArduPilotPlugin")
+    addr, port = plugin.findtext("fdm_addr"), plugin.findtext("fdm_port_in")
+    readme = (package / "README.md").read_text()
+    assert re.search(r"sim_vehicle\.py -v ArduCopter -f JSON --add-param-file=\S*ardupilot/"
+                     + spec.name + r"\.parm", readme)
+    assert f"{addr}:{port}" in readme
+    assert "cmd_vel" not in readme and "velocity controller" not in readme.split("no velocity controller")[-1]
+    bridge = (package / "config" / f"{spec.name}_bridge.yaml").read_text()
+    gz_topics = re.findall(r'gz_topic_name: "([^"]+)"', bridge)
+    text = model.read_text().replace("${namespace}", spec.name)
+    for topic in gz_topics:
+        assert topic == "/clock" or topic in text, topic

@@ -18,6 +18,7 @@ Both files are written from the frame catalogue entry the model is rendered from
 from __future__ import annotations
 
 import dataclasses
+import re
 from pathlib import PurePosixPath
 
 import numpy as np
@@ -54,7 +55,20 @@ def ardupilot_frame(frame: Airframe) -> tuple[Airframe, int, int, list[int]]:
 
 
 def prepare_spec(spec, autopilot: str | None):
-    """The spec to render for an autopilot (ArduPilot may need the spins of its frame)."""
+    """The spec to render for an autopilot (ArduPilot may need the spins of its frame).
+
+    ArduPilot SITL reaches a Gazebo model only through ardupilot_gazebo's ArduPilotPlugin,
+    which is built for Gazebo Sim (Garden and later, ArduPilot/ardupilot_gazebo README); a
+    RotorS package (Gazebo Classic, ROS 1) could carry no plugin ArduPilot talks to, so
+    it is refused rather than written with a .parm nothing reads."""
+    if autopilot == "ardupilot" and spec.kind == "multirotor" and spec.sim != "gz":
+        raise ReedtoolError(
+            "--autopilot ardupilot needs Gazebo Sim: ArduPilot SITL drives a Gazebo model "
+            "through ardupilot_gazebo's ArduPilotPlugin, which supports Gazebo Garden and "
+            f"later, and a {'ROS 1 ' if spec.ros == 1 else ''}RotorS package runs on Gazebo "
+            "Classic, where the model would have no plugin ArduPilot talks to",
+            hint="use --ros 2 --sim gz --autopilot ardupilot: the model then carries the "
+                 "ArduPilotPlugin and its LiftDrag blades")
     if autopilot == "ardupilot" and spec.kind == "multirotor":
         spec.frame = ardupilot_frame(spec.frame)[0]
     return spec
@@ -124,7 +138,11 @@ def autopilot_context(spec, autopilot: str | None) -> dict:
         from reedtool.scaffold.ardupilot_gz import package_block
 
         positions = spec.frame.rotor_positions_m(spec["arm_length"], spec["rotor_offset_top"])
-        context["ardupilot_block"] = package_block(spec, positions, _com_m(spec, positions))
+        block = package_block(spec, positions, _com_m(spec, positions))
+        context["ardupilot_block"] = block
+        # The README says where SITL must send its servo outputs: what the block says.
+        context["ardupilot_fdm"] = {tag: re.search(f"<{tag}>([^<]*)</{tag}>", block).group(1)
+                                    for tag in ("fdm_addr", "fdm_port_in")}
     if autopilot == "px4" and spec.kind == "multirotor" and spec.sim == "gz":
         from reedtool.scaffold.px4_gz_contract import (
             MAGNETIC_FIELD_T,
