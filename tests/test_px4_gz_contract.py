@@ -203,9 +203,12 @@ def test_seed_quad_port_takes_px4_names_and_places(tmp_path):
     assert not document["proof"]["differences"], document["proof"]["differences"]
     model = check_contract(target, "reed_quad_x")
     assert model.find("link[@name='reed_quad_x/base_link']") is None
-    rows = {row["element"]: row for row in document["elements"]}
-    imu_rows = [r for e, r in rows.items() if "(imu)" in e and "imu_sensor" in r["output"]]
-    assert imu_rows and "moved from link" in imu_rows[0]["why"]
+    imu_rows = [r for r in document["elements"] if 'name="imu_sensor"' in r["output"]]
+    assert len(imu_rows) == 1 and "moved from link 'reed_quad_x/imu_link'" in imu_rows[0]["why"]
+    assert "rotors_gazebo_imu_plugin" in imu_rows[0]["element"]     # the row of its source
+    added = {r["output"].split('name="')[1].rstrip('">') for r in document["elements"]
+             if r["element"].startswith("(no ")}
+    assert added == {"air_pressure_sensor", "magnetometer_sensor", "navsat_sensor"}
 
 
 @pytest.mark.parametrize("max_rad_s", [1100, 1500])

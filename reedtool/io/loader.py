@@ -104,11 +104,12 @@ def load_robot(path: Path | str, mappings: Mapping[str, str] | None = None,
     if path.is_dir():
         path = _model_dir_sdf(path)
     if _is_template(path):
-        from reedtool.io.sdf_jinja import load_sdf_jinja
+        from reedtool.io.sdf import parse_sdf
+        from reedtool.io.sdf_jinja import relocate_rendered, render
 
         resolver = PackageResolver(package_paths, model_path=path)
-        return _with_package_notes(load_sdf_jinja(path, resolver=resolver,
-                                                  model_name=model_name), resolver)
+        robot = parse_sdf(render(path).text, path, resolver=resolver, model_name=model_name)
+        return _with_package_notes(relocate_rendered(robot), resolver)
     if path.suffix.lower() in SDF_SUFFIXES:
         from reedtool.io.sdf import load_sdf_file
         from reedtool.io.sdf_jinja import relocate_rendered

@@ -208,13 +208,3 @@ def relocate_rendered(robot):
         robot = _relocate(robot, file, line_map, {})
     _RENDERED.clear()
     return robot
-
-
-def load_sdf_jinja(path: Path, *, resolver=None, model_name: str | None = None):
-    """The Robot of a rendered template, its locations in the template."""
-    from reedtool.io.sdf import parse_sdf
-
-    path = Path(path)
-    rendered = render(path)
-    return relocate_rendered(parse_sdf(rendered.text, path, resolver=resolver,
-                                       model_name=model_name))

@@ -157,6 +157,8 @@ def _rename_root(port: GzPort, contract: Px4Contract) -> None:
     for element in [*port.plugins, *(s for link in port.links for s in link.sensors)]:
         _replace_text(element, old, ROOT_LINK)
     for row in port.rows:
+        if row.target_key is not None and row.target_key[0] == "joint":
+            row.why = row.why.replace(f"{old} -> ", f"{ROOT_LINK} -> ", 1)
         if row.target_key == ("link", old):
             row.target_key = ("link", ROOT_LINK)
             row.output = f"link {ROOT_LINK}"
@@ -217,19 +219,31 @@ def _place_sensors(port: GzPort, contract: Px4Contract) -> None:
                                "was (zero joint positions)")
             if topic is not None:
                 changes.append(f"<topic> {topic.text} left out (PX4 reads gz's default topic)")
-            if changes:
-                contract.rows.append(PortRow(
-                    root_loc, f"sensor {old_name} ({spec.type})", "mapped",
-                    f"link {ROOT_LINK}: <sensor type=\"{spec.type}\" name=\"{spec.name}\">",
-                    "for PX4's gz bridge: " + "; ".join(changes), target=sensor))
+            output = f"link {ROOT_LINK}: <sensor type=\"{spec.type}\" name=\"{spec.name}\">"
+            _amend(port, contract, sensor, output, "for PX4's gz bridge: " + "; ".join(changes)
+                   if changes else "", root_loc, f"sensor {old_name} ({spec.type})")
             for _other_link, other in found[1:]:
-                contract.rows.append(PortRow(
-                    root_loc, f"sensor {other.attrib.get('name', '?')} ({spec.type})",
-                    "mapped", f"kept as '{other.attrib.get('name', '?')}'",
-                    f"a second {spec.type}: PX4's gz bridge reads {spec.name} only",
-                    target=other))
+                name = other.attrib.get("name", "?")
+                _amend(port, contract, other, None,
+                       f"a second {spec.type}: PX4's gz bridge reads {spec.name} only",
+                       root_loc, f"sensor {name} ({spec.type})")
         if SENSOR_SYSTEMS[spec.type] not in port.world_systems:
             port.world_systems.append(SENSOR_SYSTEMS[spec.type])
+
+
+def _amend(port: GzPort, contract: Px4Contract, sensor: Element, output: str | None,
+           why: str, loc, label: str) -> None:
+    """Say what the contract did to a sensor on the row that wrote it (a row of its own
+    when no row did)."""
+    if not why:
+        return
+    rows = [row for row in port.rows if row.target is sensor]
+    for row in rows:
+        if output is not None:
+            row.output = output
+        row.why += f"; {why}"
+    if not rows:
+        contract.rows.append(PortRow(loc, label, "mapped", output or "", why, target=sensor))
 
 
 def _source_note(spec: Px4Sensor) -> str:
