@@ -268,3 +268,33 @@ def test_new_package_gz_px4_writes_the_contract(tmp_path, frame):
         found = [f for f in run_checks(robot, flight_params=[airframe])
                  if f.code.startswith("C") and f.severity != "info"]
         assert found == []
+
+
+@pytest.mark.parametrize("edits, reasons", [
+    ({}, []),                                                        # PX4's x500: reachable
+    ({"x500_base": ("base_link", "body")}, ["base_link"]),           # no link base_link
+    ({"x500": ("<commandSubTopic>command/motor_speed", "<commandSubTopic>gazebo/command/motor_speed")},
+     ["motor"]),                                                     # RotorS' topic
+])
+def test_validate_says_when_px4s_bridge_cannot_reach_the_model(tmp_path, edits, reasons):
+    """C439 with a gz airframe (4001_gz_x500): GZBridge.cpp reads the sensors of the link
+    named base_link, GZMixingInterfaceESC.cpp publishes /<model>/command/motor_speed."""
+    import shutil
+
+    from reedtool.checks.runner import run_checks
+    from reedtool.flightstack.px4 import parse_px4_params
+    from reedtool.io.loader import load_robot
+
+    models = tmp_path / "models"
+    shutil.copytree(X500.parent, models)
+    for name, (old, new) in edits.items():
+        path = models / name / "model.sdf"
+        text = path.read_text()
+        assert old in text
+        path.write_text(text.replace(old, new))
+    robot = load_robot(models / "x500" / "model.sdf", {}, [models])
+    found = [f for f in run_checks(robot, flight_params=[parse_px4_params(AIRFRAME_4001, "4001")])
+             if f.code == "C439"]
+    assert len(found) == len(reasons)
+    for finding, reason in zip(sorted(found, key=lambda f: f.message), sorted(reasons)):
+        assert finding.severity == "error" and reason in finding.message

@@ -19,7 +19,8 @@ between SIM_GZ_EC_MINk and SIM_GZ_EC_MAXk; a Gazebo Classic model through simula
 and the model's gazebo_mavlink_interface, speed = (u + input_offset) * input_scaling +
 zero_position_armed of its control channel (SIM_GZ_EC_* are never read). The command-range
 rules use the one that applies (C419-C424 for gz, C436-C438 for Classic); an airframe for
-the other Gazebo is one finding (C435), not a cascade.
+the other Gazebo is one finding (C435), not a cascade. C439: a gz model PX4's bridge cannot
+reach (no base_link, motors off command/motor_speed).
 
 Positions are compared as PX4 does its allocation: about the centre of gravity, in FRD
 (x forward, y right, z down). A position that differs but keeps the rotor in the same
@@ -768,6 +769,45 @@ def px4_simulator_mismatch(ctx: CheckContext) -> Iterator[Issue]:
         yield Issue(f"{params.label} is for {names[airframe.simulator]} ({airframe.what}), "
                     f"but the model is for {names[model[0]]}: {model[1]}",
                     airframe.loc, "simulator", hint=fix)
+
+
+@rule("C439", "px4-gz-bridge-unreachable", "error",
+      "PX4's gz bridge cannot reach the model: no link named base_link, or motors off "
+      "command/motor_speed.", clause="flight-stack")
+def px4_gz_bridge_unreachable(ctx: CheckContext) -> Iterator[Issue]:
+    """With a Gazebo Sim airframe, PX4's gz bridge reads the IMU, barometer, magnetometer
+    and GNSS of the link named base_link (/world/W/model/M/link/base_link/sensor/...,
+    GZBridge.cpp) and publishes motor speeds on /M/command/motor_speed
+    (GZMixingInterfaceESC.cpp), which a MulticopterMotorModel hears with commandSubTopic
+    command/motor_speed under the model's name. A model without a base_link gives PX4
+    no sensors; a motor on another topic is never commanded. `migrate --autopilot px4` and
+    `new-package --sim gz --autopilot px4` write both as PX4's x500 has them.
+
+    Severity (error, flight-stack): PX4 cannot fly the model.
+    """
+    from reedtool.flightstack.px4 import PX4_BRIDGE_LINK, PX4_MOTOR_TOPIC
+
+    for params in _px4(ctx):
+        model = _model_simulator(ctx)
+        airframe = params.simulator()
+        if model is None or model[0] != "gz" or airframe is None or airframe.simulator != "gz":
+            continue
+        if PX4_BRIDGE_LINK not in ctx.robot.link_map:
+            yield Issue(f"{params.label} is for PX4's gz bridge ({airframe.what}), which reads "
+                        f"its sensors from a link named '{PX4_BRIDGE_LINK}'; the model has none "
+                        f"(its root is '{ctx.robot.base_link}')", ctx.robot.loc,
+                        PX4_BRIDGE_LINK, hint="`reedtool migrate MODEL --to gz --autopilot px4` "
+                                              "writes PX4's gz contract")
+        off = [r for r in _all_rotors(ctx) if r.kind == "gz"
+               and (r.plugin.param("commandSubTopic") or "").strip().strip("/") != PX4_MOTOR_TOPIC]
+        if off:
+            first = off[0]
+            topic = first.plugin.param("commandSubTopic")
+            yield Issue(f"{len(off)} motor(s) of the model do not listen where PX4's gz bridge "
+                        f"publishes (/<model>/{PX4_MOTOR_TOPIC}): {_rotor_label(first)} has "
+                        f"commandSubTopic '{topic or ''}'", first.loc, first.name,
+                        hint=f"<commandSubTopic>{PX4_MOTOR_TOPIC}</commandSubTopic> and no "
+                             "<robotNamespace>, as PX4's x500")
 
 
 def _channel_of(ctx: CheckContext, rotor: "Rotor"):

@@ -33,6 +33,10 @@ from reedtool.errors import ReedtoolError
 from reedtool.model import SourceLoc
 
 MOTOR_FUNCTION_BASE = 101          # PX4 output function "Motor 1"
+# PX4's gz bridge: the link whose sensors it reads and the topic its ESC outputs go to,
+# below the model instance (GZBridge.cpp, GZMixingInterfaceESC.cpp).
+PX4_BRIDGE_LINK = "base_link"
+PX4_MOTOR_TOPIC = "command/motor_speed"
 MAX_GZ_OUTPUTS = 8                 # SIM_GZ_EC has 8 channels (gz_bridge module.yaml)
 MAX_CLASSIC_OUTPUTS = 16           # PWM_MAIN outputs simulator_mavlink sends
 MAX_CA_ROTORS = 12
