@@ -88,12 +88,16 @@ def migrate(request: MigrateRequest) -> MigrateResult:
 
     contract = None
     extra_plugins, extra_files = [], []
+    if request.autopilot == "px4":
+        # First: the root's new name is the one every later part refers to.
+        from reedtool.scaffold.px4_gz_contract import apply_px4_contract
+
+        contract = apply_px4_contract(port)
     if request.velocity_control:
         extra_plugins.append(velocity_control(original, port))
     if request.autopilot == "px4":
-        from reedtool.scaffold.px4_gz_contract import airframe_path, apply_px4_contract, readme_text
+        from reedtool.scaffold.px4_gz_contract import airframe_path, readme_text
 
-        contract = apply_px4_contract(port)
         extra_files.append(WrittenFile(airframe_path(name),
                                        px4_airframe(original, name).encode("utf-8")))
         extra_files.append(WrittenFile(PurePosixPath("README.md"),
