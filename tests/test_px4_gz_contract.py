@@ -255,6 +255,14 @@ def test_new_package_gz_px4_writes_the_contract(tmp_path, frame):
     result = new_package(spec, tmp_path, autopilot="px4")
     px4_dir = result.target / "px4"
     model = check_contract(px4_dir, name)
+    import sdformat_oracle
+
+    # The ROS package's own world: PX4's sensor systems and spherical coordinates too.
+    world_file = result.target / "worlds" / f"{name}.sdf"
+    assert sdformat_oracle.libsdformat_error(world_file) is None
+    world = etree.parse(str(world_file)).getroot().find("world")
+    assert SENSOR_SYSTEMS <= {p.get("name") for p in world.iter("plugin")}
+    assert float(world.findtext("spherical_coordinates/latitude_deg")) == PX4_SPHERICAL["latitude_deg"]
     assert len(model.findall(f"plugin[@filename='{MOTOR}']")) == spec.frame.rotor_count
     xacro = (result.target / "urdf" / f"{name}.urdf.xacro").read_text()
     assert "MulticopterVelocityControl" not in xacro
