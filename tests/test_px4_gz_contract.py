@@ -306,3 +306,25 @@ def test_validate_says_when_px4s_bridge_cannot_reach_the_model(tmp_path, edits, 
     assert len(found) == len(reasons)
     for finding, reason in zip(sorted(found, key=lambda f: f.message), sorted(reasons)):
         assert finding.severity == "error" and reason in finding.message
+
+
+def test_tilted_rotors_get_their_thrust_axes(tmp_path):
+    """A tilted rotor's CA_ROTORi_AX/AY/AZ is its thrust axis in FRD (PX4's default is
+    straight up, (0, 0, -1)): the airframe of a tilted hexacopter port validates clean
+    against the port (C418/C426 compare the axes) and each axis is a unit vector."""
+    from reedtool.checks.runner import run_checks
+    from reedtool.flightstack.px4 import load_px4_params
+    from reedtool.io.loader import load_robot
+
+    document, target = migrate_px4(tmp_path, FIXTURES / "rotors_neo" / "neo_balanced_tilt.sdf")
+    name = target.name
+    params = load_px4_params(target / "airframes" / f"4900_gz_{name}")
+    tilted = [i for i in range(params.rotor_count) if params.has(f"CA_ROTOR{i}_AX")]
+    assert tilted
+    for i in tilted:
+        axis = [params.get(f"CA_ROTOR{i}_A{c}").value for c in "XYZ"]
+        assert sum(v * v for v in axis) == pytest.approx(1.0, abs=3e-6)   # 6 printed digits
+    port = load_robot(target / "models" / name / "model.sdf", {}, [])
+    found = [f for f in run_checks(port, flight_params=[params])
+             if f.code.startswith("C") and f.severity != "info"]
+    assert found == []

@@ -254,7 +254,7 @@ def px4_airframe(robot, name: str) -> str:
                             f"({', '.join(missing) or 'no rotors'})", file=robot.source_file,
                             hint="`reedtool validate` lists the rotors and their numbers")
     specs = [RotorSpec(r.motor_number, r.position_m - props.com_m, r.turning_sign,
-                       r.moment_constant, r.max_rot_velocity_rad_s) for r in rotors]
+                       r.moment_constant, r.max_rot_velocity_rad_s, r.axis) for r in rotors]
     trim = solve_trim(props.mass_kg, props.com_m, rotors)
     throttle = px4_hover_throttle(trim.omega_rad_s, [r.max_rot_velocity_rad_s for r in rotors]) \
         if trim.feasible else 0.5

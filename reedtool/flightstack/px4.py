@@ -476,6 +476,7 @@ class RotorSpec:
     turning_sign: int              # +1 ccw, -1 cw
     moment_constant: float
     max_rot_velocity_rad_s: float
+    axis_flu: np.ndarray | None = None   # thrust direction; None: straight up
 
 
 # The hard ceiling of a SIM_GZ_EC_MIN/MAX value: the mixer keeps output limits as
@@ -493,6 +494,18 @@ def px4_idle_rad_s(max_rad_s: float) -> int:
     """PX4's gz idle for a rotor of this top speed: 150 rad/s, or 0 for a rotor so slow
     that 150 would be a quarter of its range or more."""
     return PX4_GZ_IDLE_RAD_S if PX4_GZ_IDLE_RAD_S < max_rad_s / 4 else 0
+
+
+def _axis_frd(axis_flu) -> np.ndarray | None:
+    """The unit thrust axis in FRD, None when it is PX4's default, straight up (0, 0, -1)."""
+    if axis_flu is None:
+        return None
+    axis = frd_from_flu(np.asarray(axis_flu, dtype=float))
+    norm = float(np.linalg.norm(axis))
+    if not math.isfinite(norm) or norm <= 0:
+        return None
+    axis = np.round(axis / norm, 9) + 0.0
+    return None if np.allclose(axis, UPWARD_FRD, rtol=0, atol=1e-9) else axis
 
 
 def px4_hover_throttle(omega_hover_rad_s, max_rad_s) -> float:
@@ -538,7 +551,11 @@ def px4_airframe_text(name: str, rotors: list[RotorSpec], *, hover_throttle: flo
         lines += [f"param set-default CA_ROTOR{i}_PX {p[0]:.6g}",
                   f"param set-default CA_ROTOR{i}_PY {p[1]:.6g}",
                   f"param set-default CA_ROTOR{i}_PZ {p[2]:.6g}",
-                  f"param set-default CA_ROTOR{i}_KM {km:.6g}", ""]
+                  f"param set-default CA_ROTOR{i}_KM {km:.6g}"]
+        axis = _axis_frd(rotor.axis_flu)
+        if axis is not None:     # PX4's default is (0, 0, -1): up
+            lines += [f"param set-default CA_ROTOR{i}_A{c} {v:.6g}" for c, v in zip("XYZ", axis)]
+        lines.append("")
     outputs = "SIM_GZ_EC_FUNC" if simulator == "gz" else "PWM_MAIN_FUNC"
     for k, rotor in enumerate(order, start=1):
         lines.append(f"param set-default {outputs}{rotor.actuator_index + 1} "
