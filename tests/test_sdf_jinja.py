@@ -111,3 +111,12 @@ def test_an_sdf_including_a_template_reads_it_rendered(tmp_path):
     assert rotor.loc.file == str(TEMPLATE)
     loop_start = template_line("{%- for x, y, spin in rotors %}")
     assert loop_start < rotor.loc.line < template_line("{%- endfor %}")
+
+
+def test_rendered_xml_errors_point_at_the_template_line(tmp_path):
+    bad = tmp_path / "m.sdf.jinja"
+    bad.write_text("<sdf version='1.6'>\n{%- set n = 2 -%}\n  <model name='m'>\n"
+                   "    <link name='a'></linc>\n  </model>\n</sdf>\n")
+    code, text = run_cli("validate", bad)
+    assert code == 2
+    assert f"{bad}:4:" in text                      # the template's line, not the rendered 3

@@ -108,7 +108,15 @@ def load_robot(path: Path | str, mappings: Mapping[str, str] | None = None,
         from reedtool.io.sdf_jinja import relocate_rendered, render
 
         resolver = PackageResolver(package_paths, model_path=path)
-        robot = parse_sdf(render(path).text, path, resolver=resolver, model_name=model_name)
+        rendered = render(path)
+        try:
+            robot = parse_sdf(rendered.text, path, resolver=resolver, model_name=model_name)
+        except ReedtoolError as exc:     # at the template's line, as every finding is
+            if exc.file != str(path) or not exc.line or exc.line > len(rendered.template_line):
+                raise
+            raise ReedtoolError(exc.message, file=exc.file,
+                                line=rendered.template_line[exc.line - 1],
+                                hint=exc.hint) from None
         return _with_package_notes(relocate_rendered(robot), resolver)
     if path.suffix.lower() in SDF_SUFFIXES:
         from reedtool.io.sdf import load_sdf_file
