@@ -120,3 +120,20 @@ def test_rendered_xml_errors_point_at_the_template_line(tmp_path):
     code, text = run_cli("validate", bad)
     assert code == 2
     assert f"{bad}:4:" in text                      # the template's line, not the rendered 3
+
+
+def test_every_model_of_a_world_keeps_template_lines(tmp_path):
+    """A world that includes the template twice: both models point into the template."""
+    from reedtool.io.loader import load_robots
+
+    world = tmp_path / "two.sdf"
+    include = ("    <include>\n      <name>{}</name>\n      <uri>model://quad_jinja</uri>\n"
+               "    </include>\n")
+    world.write_text("<?xml version='1.0'?>\n<sdf version='1.6'>\n  <world name='w'>\n"
+                     + include.format("a") + include.format("b") + "  </world>\n</sdf>\n")
+    robots = load_robots(world, {}, [MODEL_DIR.parent])
+    assert len(robots) == 2
+    loop = (template_line("{%- for x, y, spin in rotors %}"), template_line("{%- endfor %}"))
+    for robot in robots:
+        rotor = next(link for link in robot.links if link.name.endswith("rotor_2"))
+        assert rotor.loc.file == str(TEMPLATE) and loop[0] < rotor.loc.line < loop[1]

@@ -22,12 +22,14 @@ def load_robots(path: Path | str, mappings: Mapping[str, str] | None = None,
         from reedtool.io.packages import PackageResolver
         from reedtool.io.sdf import load_sdf_models
 
-        from reedtool.io.sdf_jinja import relocate_rendered
+        from reedtool.io.sdf_jinja import relocate_rendered, take_rendered
 
         sdf = _sdf_path(path)
         resolver = PackageResolver(package_paths, model_path=sdf)
-        return [_with_package_notes(relocate_rendered(robot), resolver)
-                for robot in load_sdf_models(sdf, resolver=resolver)]
+        robots = load_sdf_models(sdf, resolver=resolver)
+        maps = take_rendered()
+        return [_with_package_notes(relocate_rendered(robot, maps), resolver)
+                for robot in robots]
     return [load_robot(path, mappings, package_paths, model_name=model_name)]
 
 

@@ -201,10 +201,17 @@ def _relocate(obj, file: str, line_map: list[int], seen: dict[int, object]):
     return obj
 
 
-def relocate_rendered(robot):
-    """Move the robot's locations in every template rendered while loading it (its own
-    file, or a template it includes) to the template's lines."""
-    for file, line_map in list(_RENDERED.items()):
-        robot = _relocate(robot, file, line_map, {})
+def take_rendered() -> dict[str, list[int]]:
+    """The line maps of the templates rendered since the last call (and forget them)."""
+    maps = dict(_RENDERED)
     _RENDERED.clear()
+    return maps
+
+
+def relocate_rendered(robot, maps: dict[str, list[int]] | None = None):
+    """Move the robot's locations in every template rendered while loading it (its own
+    file, or a template it includes) to the template's lines; `maps` from take_rendered()
+    when several robots come from one load (a world)."""
+    for file, line_map in (take_rendered() if maps is None else maps).items():
+        robot = _relocate(robot, file, line_map, {})
     return robot
