@@ -143,6 +143,10 @@ def _summary(result: NewPackageResult, spec) -> list[str]:
         lines.append(f"  reedtool hover-test {result.target / model}")
     if spec.sim == "gz":
         lines.append(f"  ros2 launch {spec.name} {spec.name}.launch.py   (after colcon build)")
+    if any(f.parts[:2] == ("px4", "README.md") for f in result.files):
+        lines.append(f"  PX4 SITL: {result.target / 'px4' / 'README.md'}")
+    elif any(f.parts[0] == "ardupilot" for f in result.files):
+        lines.append(f"  ArduPilot SITL: {result.target / 'README.md'} (sim_vehicle.py -f JSON)")
     return lines
 
 
