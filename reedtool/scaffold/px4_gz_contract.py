@@ -198,13 +198,16 @@ def _place_sensors(port: GzPort, contract: Px4Contract) -> None:
         else:
             link, sensor = found[0]
             old_name = sensor.attrib.get("name", "")
-            T_root_sensor = T_root[link.name] @ _pose_of(sensor)
+            # A pose is in its link's frame, or in the link its relative_to names.
+            pose_el = sensor.find("pose")
+            frame = pose_el.attrib.get("relative_to", link.name) if pose_el is not None \
+                else link.name
+            T_root_sensor = T_root.get(frame, T_root[link.name]) @ _pose_of(sensor)
             if link is not root:
                 link.sensors.remove(sensor)
                 root.sensors.append(sensor)
-            pose = sensor.find("pose")
-            if pose is not None:
-                sensor.children.remove(pose)
+            if pose_el is not None:
+                sensor.children.remove(pose_el)
             if not np.allclose(T_root_sensor, np.eye(4), rtol=0, atol=0):
                 sensor.children.insert(0, Element("pose", {}, _pose_text(T_root_sensor)))
             sensor.attrib["name"] = spec.name
