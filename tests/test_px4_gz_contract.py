@@ -328,3 +328,57 @@ def test_tilted_rotors_get_their_thrust_axes(tmp_path):
     found = [f for f in run_checks(port, flight_params=[params])
              if f.code.startswith("C") and f.severity != "info"]
     assert found == []
+
+
+def _quad_urdf(imu_xyz: str, imu_rpy: str, sensor_pose: str) -> str:
+    """A small URDF quad (gz motor systems) with an IMU sensor on its own link."""
+    rotors, motors = [], []
+    for i, (x, y, spin) in enumerate([(0.2, -0.2, "ccw"), (-0.2, 0.2, "ccw"),
+                                      (0.2, 0.2, "cw"), (-0.2, -0.2, "cw")]):
+        rotors.append(f"""
+  <link name="rotor_{i}"><inertial><mass value="0.01"/>
+    <inertia ixx="1e-5" ixy="0" ixz="0" iyy="1e-5" iyz="0" izz="2e-5"/></inertial>
+    <collision><geometry><cylinder radius="0.1" length="0.005"/></geometry></collision></link>
+  <joint name="rotor_{i}_joint" type="continuous"><parent link="base_link"/>
+    <child link="rotor_{i}"/><origin xyz="{x} {y} 0.05"/><axis xyz="0 0 1"/></joint>""")
+        motors.append(f"""
+  <gazebo><plugin filename="gz-sim-multicopter-motor-model-system"
+      name="gz::sim::systems::MulticopterMotorModel">
+    <jointName>rotor_{i}_joint</jointName><linkName>rotor_{i}</linkName>
+    <turningDirection>{spin}</turningDirection><timeConstantUp>0.0125</timeConstantUp>
+    <timeConstantDown>0.025</timeConstantDown><maxRotVelocity>1000</maxRotVelocity>
+    <motorConstant>8.54858e-06</motorConstant><momentConstant>0.016</momentConstant>
+    <commandSubTopic>command/motor_speed</commandSubTopic><actuator_number>{i}</actuator_number>
+    <motorType>velocity</motorType></plugin></gazebo>""")
+    return f"""<?xml version="1.0"?>
+<robot name="imuquad">
+  <link name="base_link"><inertial><mass value="1.5"/>
+    <inertia ixx="0.03" ixy="0" ixz="0" iyy="0.03" iyz="0" izz="0.05"/></inertial>
+    <collision><geometry><box size="0.3 0.3 0.1"/></geometry></collision></link>
+  <link name="imu_link"><inertial><mass value="0.015"/>
+    <inertia ixx="1e-5" ixy="0" ixz="0" iyy="1e-5" iyz="0" izz="1e-5"/></inertial></link>
+  <joint name="imu_joint" type="fixed"><parent link="base_link"/><child link="imu_link"/>
+    <origin xyz="{imu_xyz}" rpy="{imu_rpy}"/></joint>
+  <gazebo reference="imu_link"><sensor name="my_imu" type="imu">
+    <pose>{sensor_pose}</pose><always_on>1</always_on><update_rate>200</update_rate>
+    <topic>/imuquad/imu</topic></sensor></gazebo>{''.join(rotors)}{''.join(motors)}
+</robot>
+"""
+
+
+def test_an_imu_on_another_link_moves_to_base_link_where_it_was(tmp_path):
+    """The IMU keeps its place: imu_link at (0.1, 0, 0.05) yawed 90°, the sensor 0.02 m
+    along imu_link's x, so in base_link it sits at (0.1, 0.02, 0.05), yawed 90°
+    (hand-composed); its rate (200 Hz) is the model's, its name and topic PX4's."""
+    import math
+
+    source = tmp_path / "imuquad.urdf"
+    source.write_text(_quad_urdf("0.1 0 0.05", "0 0 1.5707963267948966", "0.02 0 0 0 0 0"))
+    _document, target = migrate_px4(tmp_path, source)
+    model = check_contract(target, "imuquad")
+    imu = root_link(model).find("sensor[@name='imu_sensor']")
+    values = [float(v) for v in imu.findtext("pose").split()]
+    # Composition of two poses written with repr() floats: round-off ~1e-16.
+    assert values == pytest.approx([0.1, 0.02, 0.05, 0.0, 0.0, math.pi / 2], abs=1e-12)
+    assert imu.findtext("update_rate").strip() == "200"
+    assert model.find("link[@name='imu_link']/sensor") is None
