@@ -1,4 +1,4 @@
-"""Flight-stack cross-check (C413-C434): PX4 airframes and ArduPilot frames against the model.
+"""Flight-stack cross-check (C413-C439): PX4 airframes and ArduPilot frames against the model.
 
 Good pairs are hand-written fixtures in the shape of PX4's 4001_gz_x500 + x500 and of
 ArduPilot's quad X .parm + iris; each bad case is one edit of them. Expected numbers are

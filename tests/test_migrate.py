@@ -59,9 +59,13 @@ def assert_loads_in_libsdformat(target: Path, document: dict) -> None:
     carries it and migrate says so); anything else is a port reedtool broke."""
     import sdformat_oracle
 
-    assert sdformat_oracle.libsdformat_error(target / "model.sdf", [target.parent]) is None
+    # PX4's layout (--autopilot px4) holds the model under models/NAME, as PX4-gazebo-models
+    models = target / "models" if (target / "models").is_dir() else target.parent
+    model_sdf = models / target.name / "model.sdf" if models != target.parent \
+        else target / "model.sdf"
+    assert sdformat_oracle.libsdformat_error(model_sdf, [models]) is None
     world = target / "worlds" / f"{target.name}.sdf"
-    error = sdformat_oracle.libsdformat_error(world, [target.parent])
+    error = sdformat_oracle.libsdformat_error(world, [models])
     port_errors = [f for f in document["proof"]["side_by_side"]["findings"]["port"]
                    if f.split(" ")[1].startswith("error")]
     assert error is None or port_errors, (world, error)
@@ -264,17 +268,17 @@ def test_px4_airframe_matches_the_port(tmp_path):
     model = FIXTURES / "migrate" / "firefly_hex.xacro"
     code, _document, target = migrate(tmp_path, model, (), "--autopilot", "px4")
     assert code == 0
-    airframe = target / "px4" / "airframe_gz_firefly"
+    airframe = target / "airframes" / "4900_gz_firefly"     # PX4-gazebo-models' layout
     text = airframe.read_text()
     outputs = sorted(int(line.split()[2][len("SIM_GZ_EC_FUNC"):]) for line in text.splitlines()
                      if line.startswith("param set-default SIM_GZ_EC_FUNC"))
     assert outputs == [n + 1 for n in sorted(motor_numbers(original_robot(model)).values())]
     # The motors listen where PX4's gz bridge publishes (/<instance>/command/motor_speed).
-    sdf = etree.parse(str(target / "model.sdf"))
+    sdf = etree.parse(str(target / "models" / "firefly" / "model.sdf"))
     for motor in sdf.findall(f".//plugin[@filename='{MOTOR_SYSTEM}']"):
         assert motor.findtext("commandSubTopic") == "command/motor_speed"
         assert motor.find("robotNamespace") is None
-    port = load_robot(target / "model.sdf", {}, [])
+    port = load_robot(target / "models" / "firefly" / "model.sdf", {}, [])
     codes = {f.code for f in run_checks(port, flight_params=[load_px4_params(airframe)])
              if f.severity == "error"}
     assert not {c for c in codes if c.startswith("C")}, codes

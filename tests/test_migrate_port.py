@@ -576,3 +576,34 @@ def test_a_navsat_world_has_spherical_coordinates(tmp_path):
         "<homeLongitude>149.16523</homeLongitude>"))
     _code, _document, target = migrate(tmp_path / "b", models / "iris_gps" / "model.sdf")
     assert where(target) == (-35.363261, 149.16523, 488.0)
+
+
+def test_px4_contract_moves_are_proved_in_the_base_frame(tmp_path):
+    """--autopilot px4 renames the iris' IMU plugin to imu_sensor and moves it to base_link,
+    posed where it was: the proof holds it to the same place in the base frame (EQUAL), and
+    fails when the written sensor is 1 cm off that place."""
+    from reedtool.assembly.migration import MigrateRequest, prove
+    from reedtool.io.loader import load_robot
+    from reedtool.scaffold.gz_port import PortOptions, plan_port
+    from reedtool.scaffold.px4_gz_contract import apply_px4_contract
+
+    code, document, target = migrate(tmp_path, IRIS_GPS, "--autopilot", "px4")
+    assert code == 0, document["proof"]["differences"]
+    sdf = target / "models" / target.name / "model.sdf"
+    tree = etree.parse(str(sdf))
+    imu = tree.find(".//link[@name='base_link']/sensor[@name='imu_sensor']")
+    assert imu is not None
+    pose = imu.find("pose")
+    if pose is None:
+        pose = etree.SubElement(imu, "pose")
+        pose.text = "0 0 0 0 0 0"
+    xyz_rpy = [float(v) for v in pose.text.split()]
+    xyz_rpy[0] += 0.01
+    pose.text = " ".join(repr(v) for v in xyz_rpy)
+    tree.write(str(sdf))
+    robot = load_robot(IRIS_GPS, {}, [])
+    port = plan_port(robot, target.name, PortOptions(autopilot="px4"))
+    contract = apply_px4_contract(port)
+    proof = prove(robot, sdf, port, MigrateRequest(IRIS_GPS, tmp_path, fly=False), contract)
+    differences = {(d.section, d.quantity) for d in proof.differences if "imu" in d.subject}
+    assert differences == {("sensors", "T_base_sensor")}

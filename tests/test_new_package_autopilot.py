@@ -16,7 +16,10 @@ def _generate(tmp_path, frame: str, autopilot: str, ros: int = 2, sim: str | Non
     name = f"ap_{frame.replace('-', '_')}_{autopilot}"
     spec = build_spec(name, frame=frame, ros=ros, flags={}, sim=sim)
     result = new_package(spec, tmp_path, autopilot=autopilot)
-    extra = [f for f in result.files if f.parts[0] == autopilot]
+    # The rotor table: ardupilot/NAME.parm, px4/airframes/NNNN_gz_NAME (gz: with the model
+    # in PX4's layout beside it) or px4/airframe_gazebo-classic_NAME (Classic).
+    extra = [f for f in result.files if f.parts[0] == autopilot and (
+        f.suffix == ".parm" or "airframes" in f.parts or f.name.startswith("airframe"))]
     assert len(extra) == 1
     return result.target / model_path(spec), result.target / extra[0], spec
 
@@ -42,10 +45,17 @@ def test_generated_autopilot_file_is_clean(tmp_path, frame, autopilot):
 
 
 def test_rotors_classic_package_with_px4(tmp_path):
+    """A RotorS (Gazebo Classic) package gets a Classic airframe: PX4's simulator_mavlink
+    outputs (PWM_MAIN_FUNC), no SIM_GZ parameter (those start the gz bridge), so validate
+    finds no simulator mismatch (C435) and no gz command-range rule applies; the RotorS
+    interface declares no control channels, so there is no command range to compare."""
     model, table, _spec = _generate(tmp_path, "quad-x", "px4", ros=1, sim="classic")
-    findings = run_checks(load_robot(model), Selection(select=("C",)),
-                          flight_params=[px4.load_px4_params(table)])
-    assert sorted(f.code for f in findings) == ["C421"]
+    params = px4.load_px4_params(table)
+    assert params.simulator().simulator == "classic"
+    assert not any(name.startswith("SIM_GZ") for name in params.values)
+    assert [params.get(f"PWM_MAIN_FUNC{k}").value for k in range(1, 5)] == [101, 102, 103, 104]
+    findings = run_checks(load_robot(model), Selection(select=("C",)), flight_params=[params])
+    assert sorted(f.code for f in findings) == []
 
 
 def test_quad_x_airframe_values_by_hand(tmp_path):
@@ -92,3 +102,44 @@ def test_ardupilot_gz_package_is_driven_by_the_plugin(tmp_path, frame):
     assert 'name="gz::sim::systems::MulticopterMotorModel"' not in text
     assert 'name="gz::sim::systems::MulticopterVelocityControl"' not in text
 
+
+
+def test_ardupilot_on_gazebo_classic_is_refused_with_the_reason(tmp_path):
+    """ardupilot_gazebo's ArduPilotPlugin supports Gazebo Garden and later (its README): a
+    ROS 1 / RotorS package (Gazebo Classic) would carry no plugin SITL talks to."""
+    from reedtool.commands.new_package import new_package
+    from reedtool.errors import ReedtoolError
+
+    spec = build_spec("ap_ros1", frame="quad-x", ros=1, flags={}, sim="classic")
+    with pytest.raises(ReedtoolError, match="needs Gazebo Sim") as refusal:
+        new_package(spec, tmp_path, autopilot="ardupilot")
+    assert "--ros 2 --sim gz" in refusal.value.hint
+    assert not (tmp_path / "ap_ros1").exists()
+
+
+def test_ardupilot_package_readme_and_bridge_match_the_model(tmp_path):
+    """The README starts SITL the way ardupilot_gazebo's README does (sim_vehicle.py with
+    the JSON model) with the .parm and the address and port the model's ArduPilotPlugin
+    listens on (read from the expanded model, not from the writer); the bridge offers no
+    topic the model does not publish or read (no velocity controller: no cmd_vel)."""
+    import re
+
+    from lxml import etree
+
+    from reedtool.io.xacro_expand import expand_xacro
+
+    model, _table, spec = _generate(tmp_path, "quad-x", "ardupilot")
+    package = model.parent.parent
+    urdf = etree.fromstring(expand_xacro(model, {}, []).urdf_xml.encode())
+    plugin = next(p for p in urdf.iter("plugin") if p.get("name") == "ArduPilotPlugin")
+    addr, port = plugin.findtext("fdm_addr"), plugin.findtext("fdm_port_in")
+    readme = (package / "README.md").read_text()
+    assert re.search(r"sim_vehicle\.py -v ArduCopter -f JSON --add-param-file=\S*ardupilot/"
+                     + spec.name + r"\.parm", readme)
+    assert f"{addr}:{port}" in readme
+    assert "cmd_vel" not in readme and "/enable" not in readme
+    bridge = (package / "config" / f"{spec.name}_bridge.yaml").read_text()
+    gz_topics = re.findall(r'gz_topic_name: "([^"]+)"', bridge)
+    text = model.read_text().replace("${namespace}", spec.name)
+    for topic in gz_topics:
+        assert topic == "/clock" or topic in text, topic

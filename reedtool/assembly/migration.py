@@ -93,12 +93,22 @@ def migrate(request: MigrateRequest) -> MigrateResult:
     port.target_dir = target
     from reedtool.scaffold.sdf_writer import WrittenFile, port_files
 
+    contract = None
     extra_plugins, extra_files = [], []
+    if request.autopilot == "px4":
+        # First: the root's new name is the one every later part refers to.
+        from reedtool.scaffold.px4_gz_contract import apply_px4_contract
+
+        contract = apply_px4_contract(port)
     if request.velocity_control:
         extra_plugins.append(velocity_control(original, port))
     if request.autopilot == "px4":
-        extra_files.append(WrittenFile(PurePosixPath("px4", f"airframe_gz_{name}"),
+        from reedtool.scaffold.px4_gz_contract import airframe_path, readme_text
+
+        extra_files.append(WrittenFile(airframe_path(name),
                                        px4_airframe(original, name).encode("utf-8")))
+        extra_files.append(WrittenFile(PurePosixPath("README.md"),
+                                       readme_text(name, "migrate").encode("utf-8")))
     elif request.autopilot == "ardupilot":
         from reedtool.scaffold.ardupilot_gz import ardupilot_port
 
@@ -113,6 +123,10 @@ def migrate(request: MigrateRequest) -> MigrateResult:
         extra_files.append(WrittenFile(PurePosixPath("urdf", f"{name}.urdf"), ros2_urdf(
             original, port, mesh_targets(port), extra_plugins)))
     written, mesh_rows = port_files(port, source, extra_plugins, extra_files)
+    model_file = PurePosixPath("model.sdf")
+    if contract is not None:
+        written.files = _px4_layout(written.files, name)
+        model_file = PurePosixPath("models", name, "model.sdf")
     rows = [*port.rows, *mesh_rows]
     if request.velocity_control:
         rows.append(PortRow(original.loc, "velocity controller (--velocity-control)", "mapped",
@@ -125,13 +139,14 @@ def migrate(request: MigrateRequest) -> MigrateResult:
         line = written.lines.get(id(row.target)) if row.target is not None else \
             written.lines.get(row.target_key) if row.target_key is not None else None
         if line is not None:
-            row.output = f"model.sdf:{line} {row.output}"
+            row.output = f"{model_file}:{line} {row.output}"
     # All or nothing: the port is written into a hidden directory beside the target and
     # read back there; only a port that could be read back is renamed into place.
     files = [RenderedFile(f.path, f.data, 0o644) for f in written.files]
     with staged_tree(target, files, force=request.force) as staged:
         try:
-            proof = prove(original, staged.path / "model.sdf", port, request)
+            proof = prove(original, staged.path.joinpath(*model_file.parts), port, request,
+                          contract)
         except ReedtoolError as exc:
             raise ReedtoolError(
                 f"migrate could not read back the port it wrote ({exc.message}); nothing "
@@ -142,7 +157,24 @@ def migrate(request: MigrateRequest) -> MigrateResult:
                          source)
 
 
-def prove(original, model_sdf: Path, port: GzPort, request: MigrateRequest):
+def _px4_layout(files, name: str):
+    """The flat port's files in PX4-gazebo-models' layout (models/NAME, worlds/NAME.sdf:
+    PX4's world, named as its file, without the vehicle PX4 spawns itself)."""
+    from reedtool.scaffold.px4_gz_contract import px4_layout, px4_world_sdf
+    from reedtool.scaffold.sdf_writer import WrittenFile
+
+    out = []
+    for file in files:
+        if file.path == PurePosixPath("worlds", f"{name}.sdf"):
+            out.append(WrittenFile(file.path, px4_world_sdf(name)))
+        elif file.path.parts[0] in ("airframes", "README.md"):
+            out.append(file)
+        else:
+            out.append(WrittenFile(px4_layout(name, file.path), file.data))
+    return out
+
+
+def prove(original, model_sdf: Path, port: GzPort, request: MigrateRequest, contract=None):
     """Read the written port back and compare it with the original.
 
     validate's rules run on both with the original's selection and severities (its
@@ -166,9 +198,9 @@ def prove(original, model_sdf: Path, port: GzPort, request: MigrateRequest):
     ported, _ = load_robot_for(model_sdf, ModelRequest(package_paths=list(models.package_paths)))
     selection = selection_for(load_config(request.model), models.select, models.ignore)
     proof = Proof()
-    fold = _fold_map(original, port)
+    fold = _fold_map(original, port, contract)
     compare_structure(original, ported, fold, proof)
-    compare_sensors(original, ported, fold, proof, port.added_sensors)
+    compare_sensors(original, ported, fold, proof, port.added_sensors, port.moved_sensors)
     compare_vehicle(original, ported, proof, request.hover_config or HoverConfig(),
                     fly=request.fly)
     # A macro call writes many elements at one line: the macro line tells them apart.
@@ -210,9 +242,12 @@ def outside_files(port: GzPort, model: Path) -> dict[str, str]:
     return out
 
 
-def _fold_map(original, port: GzPort) -> dict:
-    """Every original link -> (port link, T_portlink_link), from the plan's frames."""
+def _fold_map(original, port: GzPort, contract=None) -> dict:
+    """Every original link -> (port link, T_portlink_link), from the plan's frames (and the
+    root PX4's contract renamed to base_link)."""
     out = {link.name: (link.name, np.eye(4)) for link in port.links}
+    if contract is not None and contract.renamed_root is not None:
+        out[contract.renamed_root] = (port.links[0].name, np.eye(4))
     for frame in port.frames:
         out[frame.name] = (frame.attached_to, frame.T_link_frame)
     return out
@@ -256,7 +291,7 @@ def px4_airframe(robot, name: str) -> str:
     """The PX4 gz airframe of the model's lift rotors, through flightstack.px4's writer:
     CA rotors about the COM, SIM_GZ_EC_FUNC per actuator_number, MPC_THR_HOVER from the
     trim."""
-    from reedtool.flightstack.px4 import RotorSpec, px4_airframe_text
+    from reedtool.flightstack.px4 import RotorSpec, px4_airframe_text, px4_hover_throttle
     from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
     from reedtool.physics.rotors import discover_rotors, lift_rotors
     from reedtool.physics.trim import solve_trim
@@ -269,8 +304,8 @@ def px4_airframe(robot, name: str) -> str:
                             f"({', '.join(missing) or 'no rotors'})", file=robot.source_file,
                             hint="`reedtool validate` lists the rotors and their numbers")
     specs = [RotorSpec(r.motor_number, r.position_m - props.com_m, r.turning_sign,
-                       r.moment_constant, r.max_rot_velocity_rad_s) for r in rotors]
+                       r.moment_constant, r.max_rot_velocity_rad_s, r.axis) for r in rotors]
     trim = solve_trim(props.mass_kg, props.com_m, rotors)
-    throttle = float(np.clip(trim.hover_throttle_max, 0.1, 0.8)) if trim.feasible else 0.5
-    return px4_airframe_text(name, specs, hover_throttle=throttle).replace(
-        "generated by reedtool new-package", "generated by reedtool migrate")
+    throttle = px4_hover_throttle(trim.omega_rad_s, [r.max_rot_velocity_rad_s for r in rotors]) \
+        if trim.feasible else 0.5
+    return px4_airframe_text(name, specs, hover_throttle=throttle, world=name, tool="migrate")

@@ -495,15 +495,22 @@ def _classic_imu_terms(sensor: SensorRecord) -> dict[str, float]:
 
 
 def compare_sensors(original: Robot, port: Robot, fold: dict, proof: Proof,
-                    added=()) -> None:
+                    added=(), moved=None) -> None:
     """Every sensor of the original against the port's: present, type, link (after
     folding), pose in that link, update rate, noise. A sensor the port drops by the table
     (scaffold.gz_sensors) is a note, as the report lists it; one that vanishes or moves is
-    a difference."""
+    a difference. `moved`: original name -> (port name, port link) of the sensors a port
+    renames and moves on purpose (PX4's contract puts its four on base_link): those are
+    held to the same place in the robot's base frame instead of in their link."""
+    from reedtool.physics.kinematics import link_poses
+
     check = _Comparer(proof)
     size_m = max(_size_m(original), 1.0)
     mine, dropped = sensor_inventory(original)
     theirs, _ = sensor_inventory(port)
+    moved = moved or {}
+    poses_original = link_poses(original) if moved else {}
+    poses_port = link_poses(port) if moved else {}
     proof.notes += [f"sensor {text}: dropped by the port (see the report)" for text in dropped]
     unmatched = list(theirs)
     rows = []
@@ -511,16 +518,27 @@ def compare_sensors(original: Robot, port: Robot, fold: dict, proof: Proof,
         survivor, T_fold = fold.get(sensor.link, (sensor.link, np.eye(4)))
         subject = f"{sensor.name} ({sensor.type})"
         candidates = [s for s in unmatched if s.type == sensor.type]
-        match = next((s for s in candidates if s.name == sensor.name), None) or \
-            next((s for s in candidates if s.link == survivor), None)
+        if sensor.name in moved:
+            new_name, survivor = moved[sensor.name]
+            match = next((s for s in candidates if s.name == new_name), None)
+        else:
+            match = next((s for s in candidates if s.name == sensor.name), None) or \
+                next((s for s in candidates if s.link == survivor), None)
         proof.compared["sensors"] = proof.compared.get("sensors", 0) + 1
         if match is None:
             check.differ("sensors", subject, "present", True, False)
             continue
         unmatched.remove(match)
         check.same("sensors", subject, "link", survivor, match.link)
-        check.numbers("sensors", subject, "T_link_sensor", T_fold @ sensor.T_link_sensor,
-                      match.T_link_sensor, size_m)
+        if sensor.name in moved:
+            check.numbers("sensors", subject, "T_base_sensor",
+                          poses_original.get(sensor.link, np.full((4, 4), np.nan))
+                          @ sensor.T_link_sensor,
+                          poses_port.get(match.link, np.full((4, 4), np.nan))
+                          @ match.T_link_sensor, size_m)
+        else:
+            check.numbers("sensors", subject, "T_link_sensor", T_fold @ sensor.T_link_sensor,
+                          match.T_link_sensor, size_m)
         if sensor.rate_hz is not None:
             check.numbers("sensors", subject, "update_rate_hz", sensor.rate_hz,
                           match.rate_hz if match.rate_hz is not None else math.nan,

@@ -14,6 +14,14 @@ the servo output whose SERVOn_FUNCTION is 32 + m (default: output m); a model wi
 ArduPilotPlugin reads output c + 1 in `<control channel="c">`, a model without it is
 matched by motor number (motor m = actuator m - 1).
 
+Which Gazebo. PX4 commands a Gazebo Sim model through the gz bridge, output k = the speed
+between SIM_GZ_EC_MINk and SIM_GZ_EC_MAXk; a Gazebo Classic model through simulator_mavlink
+and the model's gazebo_mavlink_interface, speed = (u + input_offset) * input_scaling +
+zero_position_armed of its control channel (SIM_GZ_EC_* are never read). The command-range
+rules use the one that applies (C419-C424 for gz, C436-C438 for Classic); an airframe for
+the other Gazebo is one finding (C435), not a cascade. C439: a gz model PX4's bridge cannot
+reach (no base_link, motors off command/motor_speed).
+
 Positions are compared as PX4 does its allocation: about the centre of gravity, in FRD
 (x forward, y right, z down). A position that differs but keeps the rotor in the same
 quadrant within 20° of bearing still allocates roll and pitch with the right signs
@@ -118,20 +126,64 @@ def _px4_kind(params: "Px4Params"):
     return kind if kind is not None and kind.rotor_table else None
 
 
+def _model_simulator(ctx: CheckContext):
+    """(simulator, what says so) of the model: Classic with a MAVLink interface or Classic
+    motor plugins (PX4's gazebo_motor_model, RotorS'), gz with gz-sim motor systems."""
+    from reedtool.physics.rotors import MAVLINK_PLUGINS
+
+    for _block, plugin in ctx.robot.plugins():
+        if plugin.library in MAVLINK_PLUGINS:
+            return "classic", f"its {plugin.filename} ({plugin.loc})"
+    for rotor in _all_rotors(ctx):
+        if rotor.kind in ("px4", "rotors"):
+            return "classic", f"its Classic motor plugin {rotor.plugin.filename} ({rotor.loc})"
+        if rotor.kind == "gz":
+            return "gz", f"its gz-sim motor system ({rotor.loc})"
+    return None
+
+
+def _simulator(ctx: CheckContext, params: "Px4Params") -> str | None:
+    """The Gazebo whose command path applies: 'gz' or 'classic'; None when model and
+    airframe are for different ones (C435 says so, the command rules stay silent)."""
+    model = _model_simulator(ctx)
+    airframe = params.simulator()
+    if model is not None and airframe is not None and model[0] != airframe.simulator:
+        return None
+    if model is not None:
+        return model[0]
+    return airframe.simulator if airframe is not None else "gz"
+
+
 def _px4_pairs(ctx: CheckContext, params: "Px4Params"
                ) -> list[tuple["Px4Rotor", int, "Rotor"]]:
-    """(CA rotor, gz output k, model rotor on actuator k-1) for every connected pair; none
-    when CA_AIRFRAME selects no rotor table (rovers, helicopters)."""
+    """(CA rotor, output k, model rotor output k drives) for every connected pair; none
+    when CA_AIRFRAME selects no rotor table (rovers, helicopters). gz: output k (by
+    SIM_GZ_EC_FUNC) drives actuator k-1. Classic: output k (by PWM_MAIN_FUNC) feeds the
+    mavlink channels of input_index k-1, read by the motor of the channel's position
+    (motor k-1 without channels)."""
+    from reedtool.flightstack.px4 import mavlink_channels
+
     if _px4_kind(params) is None:
         return []
     by_actuator = {_actuator(r): r for r in _all_rotors(ctx) if _actuator(r) is not None}
+    classic = params.simulator() is not None and params.simulator().simulator == "classic" \
+        or (not params.uses_gz_outputs and (_model_simulator(ctx) or ("",))[0] == "classic")
+    channels = mavlink_channels(ctx.robot) if classic else []
     pairs = []
     for ca in params.rotors():
-        outputs = params.outputs_of(ca.index) if params.uses_gz_outputs else [ca.index + 1]
-        for k in outputs:
-            if k - 1 in by_actuator:
-                pairs.append((ca, k, by_actuator[k - 1]))
+        if not classic:
+            outputs = params.outputs_of(ca.index) if params.uses_gz_outputs else [ca.index + 1]
+            pairs += [(ca, k, by_actuator[k - 1]) for k in outputs if k - 1 in by_actuator]
+            continue
+        for k in params.classic_outputs_of(ca.index):
+            motors = [c.position for c in channels if c.input_index == k - 1] \
+                if channels else [k - 1]
+            pairs += [(ca, k, by_actuator[m]) for m in motors if m in by_actuator]
     return pairs
+
+
+def _gz_commands(ctx: CheckContext, params: "Px4Params") -> bool:
+    return _simulator(ctx, params) == "gz"
 
 
 # --------------------------------------------------------------- PX4: table shape
@@ -175,7 +227,7 @@ def px4_output_mapping(ctx: CheckContext) -> Iterator[Issue]:
     rotors = _all_rotors(ctx)
     by_actuator = {_actuator(r): r for r in rotors if _actuator(r) is not None}
     for params in _px4(ctx):
-        if not rotors or not params.uses_gz_outputs:
+        if not rotors or not params.uses_gz_outputs or not _gz_commands(ctx, params):
             continue
         ca_count = min(params.rotor_count or 0, 12)
         for i in range(ca_count):
@@ -211,7 +263,8 @@ def px4_output_mapping(ctx: CheckContext) -> Iterator[Issue]:
 
 # --------------------------------------------------------------- PX4: per rotor
 
-def _describes_other(ctx: CheckContext, ca: "Px4Rotor", rotor: "Rotor") -> str:
+def _describes_other(ctx: CheckContext, params: "Px4Params", ca: "Px4Rotor",
+                     rotor: "Rotor") -> str:
     for other in _all_rotors(ctx):
         if other is rotor:
             continue
@@ -221,7 +274,8 @@ def _describes_other(ctx: CheckContext, ca: "Px4Rotor", rotor: "Rotor") -> str:
                 and np.sign(ca.km) == other.turning_sign:
             return (f"CA_ROTOR{ca.index} describes {_rotor_label(other)}: CA rotor i must "
                     "describe the motor its output drives (swap the CA_ROTOR entries or "
-                    "the SIM_GZ_EC_FUNC values)")
+                    f"the {'SIM_GZ_EC_FUNC' if _gz_commands(ctx, params) else 'PWM_MAIN_FUNC'} "
+                    "values)")
     return ""
 
 
@@ -260,7 +314,7 @@ def px4_rotor_position(ctx: CheckContext) -> Iterator[Issue]:
             gap = _gap(ca_bearing, model_bearing)
             if gap <= BEARING_TOL_DEG and _same_quadrant(ca.position_frd_m, model):
                 continue
-            hint = _describes_other(ctx, ca, rotor) or (
+            hint = _describes_other(ctx, params, ca, rotor) or (
                 f"param set-default CA_ROTOR{ca.index}_PX {model[0]:.4g}; "
                 f"CA_ROTOR{ca.index}_PY {model[1]:.4g}")
             yield Issue(f"{ca.where('PX', 'PY')}: bearing {ca_bearing:.1f}° from the nose, but "
@@ -514,6 +568,8 @@ def px4_command_above_max(ctx: CheckContext) -> Iterator[Issue]:
     thrust that does not exist.
     """
     for params in _px4(ctx):
+        if not _gz_commands(ctx, params):
+            continue
         for ca, k, rotor in _px4_pairs(ctx, params):
             high, low = params.get(f"SIM_GZ_EC_MAX{k}"), params.get(f"SIM_GZ_EC_MIN{k}")
             limit = rotor.max_rot_velocity_rad_s
@@ -541,6 +597,8 @@ def px4_command_below_max(ctx: CheckContext) -> Iterator[Issue]:
     less thrust.
     """
     for params in _px4(ctx):
+        if not _gz_commands(ctx, params):
+            continue
         for ca, k, rotor in _px4_pairs(ctx, params):
             high = params.get(f"SIM_GZ_EC_MAX{k}")
             limit = rotor.max_rot_velocity_rad_s
@@ -581,6 +639,8 @@ def px4_idle_command(ctx: CheckContext) -> Iterator[Issue]:
     """
     hover = _hover_speeds(ctx)
     for params in _px4(ctx):
+        if not _gz_commands(ctx, params):
+            continue
         for ca, k, rotor in _px4_pairs(ctx, params):
             low, high = params.get(f"SIM_GZ_EC_MIN{k}"), params.get(f"SIM_GZ_EC_MAX{k}")
             if low.value >= high.value:
@@ -602,12 +662,19 @@ def _hover_throttle(ctx: CheckContext, params: "Px4Params") -> tuple[float, floa
 
     hover = _hover_speeds(ctx)
     pairs = _px4_pairs(ctx, params)
-    if not hover or not pairs or ctx.omnidirectional:
+    simulator = _simulator(ctx, params)
+    if not hover or not pairs or ctx.omnidirectional or simulator is None:
         return None     # 6-DoF hover (reversible rotors): no single collective throttle
     factor = params.get("THR_MDL_FAC").value
     needed = []
     for ca, k, rotor in pairs:
-        low, high = params.get(f"SIM_GZ_EC_MIN{k}").value, params.get(f"SIM_GZ_EC_MAX{k}").value
+        if simulator == "gz":
+            low, high = params.get(f"SIM_GZ_EC_MIN{k}").value, params.get(f"SIM_GZ_EC_MAX{k}").value
+        else:
+            channel = _channel_of(ctx, rotor)
+            if channel is None:
+                return None
+            low, high = channel.range_rad_s()
         if id(rotor) not in hover:
             continue                                 # a pusher: not part of the hover
         if high <= low:
@@ -619,11 +686,17 @@ def _hover_throttle(ctx: CheckContext, params: "Px4Params") -> tuple[float, floa
     return float(np.mean(needed)), params.get("MPC_THR_HOVER").value
 
 
-def _hover_message(params: "Px4Params", needed: float, setting: float) -> str:
+def _ranges(ctx: CheckContext, params: "Px4Params") -> str:
+    return "SIM_GZ_EC_MIN/MAX" if _simulator(ctx, params) == "gz" else \
+        "the mavlink interface's channels"
+
+
+def _hover_message(params: "Px4Params", needed: float, setting: float,
+                   ranges: str = "SIM_GZ_EC_MIN/MAX") -> str:
     value = params.get("MPC_THR_HOVER")
     written = str(value.loc) if value.explicit else "not set: PX4's default"
     return (f"MPC_THR_HOVER {setting:.2f} ({written}); the model hovers at a thrust setpoint "
-            f"of {needed:.3f} (trim speeds through SIM_GZ_EC_MIN/MAX and THR_MDL_FAC "
+            f"of {needed:.3f} (trim speeds through {ranges} and THR_MDL_FAC "
             f"{params.get('THR_MDL_FAC').value:g}), {abs(needed - setting):.3f} apart")
 
 
@@ -642,7 +715,8 @@ def px4_hover_throttle(ctx: CheckContext) -> Iterator[Issue]:
     for params in _px4(ctx):
         values = _hover_throttle(ctx, params)
         if values and abs(values[0] - values[1]) <= HOVER_THROTTLE_TOL:
-            yield Issue(_hover_message(params, *values), params.get("MPC_THR_HOVER").loc,
+            yield Issue(_hover_message(params, *values, _ranges(ctx, params)),
+                        params.get("MPC_THR_HOVER").loc,
                         "MPC_THR_HOVER")
 
 
@@ -659,9 +733,182 @@ def px4_hover_throttle_mismatch(ctx: CheckContext) -> Iterator[Issue]:
     for params in _px4(ctx):
         values = _hover_throttle(ctx, params)
         if values and abs(values[0] - values[1]) > HOVER_THROTTLE_TOL:
-            yield Issue(_hover_message(params, *values), params.get("MPC_THR_HOVER").loc,
+            yield Issue(_hover_message(params, *values, _ranges(ctx, params)),
+                        params.get("MPC_THR_HOVER").loc,
                         "MPC_THR_HOVER",
                         hint=f"param set-default MPC_THR_HOVER {min(max(values[0], 0.1), 0.8):.2f}")
+
+
+# --------------------------------------------------------------- PX4: which Gazebo
+
+@rule("C435", "px4-simulator-mismatch", "error",
+      "The PX4 airframe is for the other Gazebo than the model (Gazebo Sim vs Classic).",
+      clause="flight-stack")
+def px4_simulator_mismatch(ctx: CheckContext) -> Iterator[Issue]:
+    """PX4 flies a Gazebo Sim model through its gz bridge (the airframe sets SIM_GZ_EN 1
+    and SIM_GZ_EC_*; px4-rc.simulator starts gz_bridge) and a Gazebo Classic model
+    through simulator_mavlink and the model's gazebo_mavlink_interface (PWM_MAIN outputs,
+    the mavlink channels' input_scaling; SIM_GZ_EC_* is never read). An airframe for the
+    one on a model for the other starts the wrong simulator interface: nothing commands the
+    motors. One finding; the command-range rules of either side stay silent, since
+    neither set of numbers is what will command this model.
+
+    Severity (error, flight-stack): PX4 cannot command the model's motors at all.
+    """
+    for params in _px4(ctx):
+        model = _model_simulator(ctx)
+        airframe = params.simulator()
+        if model is None or airframe is None or model[0] == airframe.simulator:
+            continue
+        names = {"gz": "Gazebo Sim (gz bridge)", "classic": "Gazebo Classic (simulator_mavlink)"}
+        fix = ("use the model's Classic airframe (PX4's NNNN_gazebo-classic_*), or port the "
+               "model with `reedtool migrate MODEL --to gz --autopilot px4`"
+               if model[0] == "classic" else
+               "use a gz airframe (SIM_GZ_EN 1, SIM_GZ_EC_*): `reedtool migrate` and "
+               "`new-package --autopilot px4` write one")
+        yield Issue(f"{params.label} is for {names[airframe.simulator]} ({airframe.what}), "
+                    f"but the model is for {names[model[0]]}: {model[1]}",
+                    airframe.loc, "simulator", hint=fix)
+
+
+@rule("C439", "px4-gz-bridge-unreachable", "error",
+      "PX4's gz bridge cannot reach the model: no link named base_link, or motors off "
+      "command/motor_speed.", clause="flight-stack")
+def px4_gz_bridge_unreachable(ctx: CheckContext) -> Iterator[Issue]:
+    """With a Gazebo Sim airframe, PX4's gz bridge reads the IMU, barometer, magnetometer
+    and GNSS of the link named base_link (/world/W/model/M/link/base_link/sensor/...,
+    GZBridge.cpp) and publishes motor speeds on /M/command/motor_speed
+    (GZMixingInterfaceESC.cpp), which a MulticopterMotorModel hears with commandSubTopic
+    command/motor_speed under the model's name. A model without a base_link gives PX4
+    no sensors; a motor on another topic is never commanded. `migrate --autopilot px4` and
+    `new-package --sim gz --autopilot px4` write both as PX4's x500 has them.
+
+    Severity (error, flight-stack): PX4 cannot fly the model.
+    """
+    from reedtool.flightstack.px4 import PX4_BRIDGE_LINK, PX4_MOTOR_TOPIC
+
+    for params in _px4(ctx):
+        model = _model_simulator(ctx)
+        airframe = params.simulator()
+        if model is None or model[0] != "gz" or airframe is None or airframe.simulator != "gz":
+            continue
+        if PX4_BRIDGE_LINK not in ctx.robot.link_map:
+            yield Issue(f"{params.label} is for PX4's gz bridge ({airframe.what}), which reads "
+                        f"its sensors from a link named '{PX4_BRIDGE_LINK}'; the model has none "
+                        f"(its root is '{ctx.robot.base_link}')", ctx.robot.loc,
+                        PX4_BRIDGE_LINK, hint="`reedtool migrate MODEL --to gz --autopilot px4` "
+                                              "writes PX4's gz contract")
+        off = [r for r in _all_rotors(ctx) if r.kind == "gz"
+               and (r.plugin.param("commandSubTopic") or "").strip().strip("/") != PX4_MOTOR_TOPIC]
+        if off:
+            first = off[0]
+            topic = first.plugin.param("commandSubTopic")
+            yield Issue(f"{len(off)} motor(s) of the model do not listen where PX4's gz bridge "
+                        f"publishes (/<model>/{PX4_MOTOR_TOPIC}): {_rotor_label(first)} has "
+                        f"commandSubTopic '{topic or ''}'", first.loc, first.name,
+                        hint=f"<commandSubTopic>{PX4_MOTOR_TOPIC}</commandSubTopic> and no "
+                             "<robotNamespace>, as PX4's x500")
+
+
+def _channel_of(ctx: CheckContext, rotor: "Rotor"):
+    """The mavlink control channel the Classic motor reads (the channel at its motor
+    number), when it is a velocity channel."""
+    from reedtool.flightstack.px4 import mavlink_channels
+
+    channels = mavlink_channels(ctx.robot)
+    number = rotor.motor_number
+    if number is None or not 0 <= number < len(channels) or not channels[number].velocity:
+        return None
+    return channels[number]
+
+
+def _classic_pairs(ctx: CheckContext):
+    """(params, rotor, channel) of every Classic-commanded motor, once per motor."""
+    for params in _px4(ctx):
+        if _simulator(ctx, params) != "classic":
+            continue
+        seen = set()
+        for _ca, _k, rotor in _px4_pairs(ctx, params):
+            channel = _channel_of(ctx, rotor)
+            if channel is not None and id(rotor) not in seen:
+                seen.add(id(rotor))
+                yield params, rotor, channel
+
+
+@rule("C436", "px4-classic-command-above-max", "warning",
+      "The mavlink interface commands more than the Classic motor's maxRotVelocity.",
+      clause="suspicious")
+def px4_classic_command_above_max(ctx: CheckContext) -> Iterator[Issue]:
+    """Gazebo Classic SITL: PX4's motor output u (0..1) becomes the speed (u +
+    input_offset) * input_scaling + zero_position_armed of the motor's control channel
+    (PX4-SITL_gazebo-classic gazebo_mavlink_interface.cpp), and the motor model clamps it
+    at maxRotVelocity. A top command above the limit is a part of PX4's range that does
+    nothing (typhoon_h480: 100 + 1500 against 1500, 6 %).
+
+    Severity (warning, suspicious): the vehicle flies; PX4 believes in a reserve of
+    thrust that does not exist.
+    """
+    for params, rotor, channel in _classic_pairs(ctx):
+        low, high = channel.range_rad_s()
+        limit = rotor.max_rot_velocity_rad_s
+        if not math.isfinite(limit) or not high > limit * (1 + RANGE_REL_TOL):
+            continue
+        lost = (high - limit) / max(high - low, 1e-9)
+        yield Issue(f"{channel.describe()} commands up to {high:g} rad/s, above "
+                    f"maxRotVelocity {limit:g} of {_rotor_label(rotor)}: the top "
+                    f"{100 * lost:.0f} % of PX4's output does nothing", channel.loc,
+                    f"channel {channel.position}",
+                    hint=f"input_scaling {(limit - channel.zero_armed) / (1 + channel.offset):g} "
+                         f"makes u = 1 reach maxRotVelocity")
+
+
+@rule("C437", "px4-classic-command-below-max", "warning",
+      "The mavlink interface never commands the Classic motor's maxRotVelocity.",
+      clause="suspicious")
+def px4_classic_command_below_max(ctx: CheckContext) -> Iterator[Issue]:
+    """As C436, with PX4's full output below maxRotVelocity: the vehicle has (top /
+    maxRotVelocity)² of the thrust the model was built with. It may be a deliberate limit;
+    the finding gives the fraction.
+
+    Severity (warning, suspicious): the vehicle flies with less thrust than the model has.
+    """
+    for params, rotor, channel in _classic_pairs(ctx):
+        _low, high = channel.range_rad_s()
+        limit = rotor.max_rot_velocity_rad_s
+        if not math.isfinite(limit) or not 0 < high < limit * (1 - RANGE_REL_TOL):
+            continue
+        yield Issue(f"{channel.describe()} commands at most {high:g} rad/s, below "
+                    f"maxRotVelocity {limit:g} of {_rotor_label(rotor)}: PX4 reaches "
+                    f"{100 * (high / limit) ** 2:.0f} % of the rotor's thrust", channel.loc,
+                    f"channel {channel.position}",
+                    hint=f"input_scaling {(limit - channel.zero_armed) / (1 + channel.offset):g} "
+                         f"makes u = 1 reach maxRotVelocity")
+
+
+@rule("C438", "px4-classic-idle-command", "error",
+      "The mavlink interface's armed idle is not below the Classic motor's hover speed.",
+      clause="flight-stack")
+def px4_classic_idle_command(ctx: CheckContext) -> Iterator[Issue]:
+    """At zero output the armed Classic motor turns at input_offset * input_scaling +
+    zero_position_armed. At or above the speed it needs to hover the vehicle climbs at
+    zero throttle and cannot descend; a range that does not grow with u (input_scaling
+    <= 0) cannot command it at all.
+
+    Severity (error, flight-stack): PX4 cannot command the motor below what it needs.
+    """
+    hover = _hover_speeds(ctx)
+    for params, rotor, channel in _classic_pairs(ctx):
+        low, high = channel.range_rad_s()
+        if not high > low:
+            yield Issue(f"{channel.describe()}: the command does not grow with PX4's output "
+                        f"({low:g} to {high:g} rad/s) for {_rotor_label(rotor)}", channel.loc,
+                        f"channel {channel.position}", hint="input_scaling must be positive")
+        elif hover and id(rotor) in hover and low >= hover[id(rotor)]:
+            yield Issue(f"{channel.describe()} idles at {low:g} rad/s, at or above the "
+                        f"{hover[id(rotor)]:.0f} rad/s {_rotor_label(rotor)} needs to hover: "
+                        "at zero throttle the vehicle still climbs", channel.loc,
+                        f"channel {channel.position}",
+                        hint=f"zero_position_armed well below {hover[id(rotor)]:.0f} rad/s")
 
 
 @rule("C425", "px4-param-out-of-range", "warning",

@@ -89,7 +89,7 @@ def new_package(spec, output_dir: Path, *, force: bool = False, mesh_units: str 
     files = render_tree(template_sets(spec.kind, spec.ros, spec.sim), context)
     if mesh_data is not None:
         files.append(RenderedFile(PurePosixPath("meshes", context["mesh_file"]), mesh_data, 0o644))
-    files += autopilot_files(spec, autopilot)
+    files += autopilot_files(spec, autopilot, files)
     backup = write_tree(target, files, force=force)
     return NewPackageResult(target, sorted(f.path for f in files), backup, context, body)
 
@@ -113,7 +113,8 @@ def _summary(result: NewPackageResult, spec) -> list[str]:
         lines.append(f"mass {ctx['p']['mass']} kg body, {ctx['total_mass_kg']} kg total; "
                      f"{len(ctx['wheels'])} wheels, {ctx['drive'].replace('_', '-')} on cmd_vel")
     model = model_path(spec)
-    autopilot = next((f for f in result.files if f.parts[0] in ("px4", "ardupilot")), None)
+    autopilot = next((f for f in result.files if f.parts[0] == "ardupilot" or (
+        f.parts[0] == "px4" and ("airframes" in f.parts or f.name.startswith("airframe")))), None)
     option = {"px4": "--airframe", "ardupilot": "--autopilot-params"}
     check = f" {option[autopilot.parts[0]]} {result.target / autopilot}" if autopilot else ""
     lines.append("next:")
@@ -122,6 +123,10 @@ def _summary(result: NewPackageResult, spec) -> list[str]:
         lines.append(f"  reedtool hover-test {result.target / model}")
     if spec.sim == "gz":
         lines.append(f"  ros2 launch {spec.name} {spec.name}.launch.py   (after colcon build)")
+    if any(f.parts[:2] == ("px4", "README.md") for f in result.files):
+        lines.append(f"  PX4 SITL: {result.target / 'px4' / 'README.md'}")
+    elif any(f.parts[0] == "ardupilot" for f in result.files):
+        lines.append(f"  ArduPilot SITL: {result.target / 'README.md'} (sim_vehicle.py -f JSON)")
     return lines
 
 

@@ -59,6 +59,8 @@ def agreement_line(params, rotor_count: int, model: str) -> str:
         compared = [f"CA_ROTOR0..{last}" if last > 0 else "CA_ROTOR0"]
         if params.uses_gz_outputs:
             compared.append("SIM_GZ_EC_*")
+        elif any(name.startswith("PWM_MAIN_FUNC") for name in params.values):
+            compared.append("PWM_MAIN_FUNC")
     else:
         compared = ["FRAME_CLASS/FRAME_TYPE", "SERVOn_FUNCTION"]
     rotors = f"{rotor_count} rotor" + ("s" if rotor_count != 1 else "")

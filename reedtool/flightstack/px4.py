@@ -33,7 +33,12 @@ from reedtool.errors import ReedtoolError
 from reedtool.model import SourceLoc
 
 MOTOR_FUNCTION_BASE = 101          # PX4 output function "Motor 1"
+# PX4's gz bridge: the link whose sensors it reads and the topic its ESC outputs go to,
+# below the model instance (GZBridge.cpp, GZMixingInterfaceESC.cpp).
+PX4_BRIDGE_LINK = "base_link"
+PX4_MOTOR_TOPIC = "command/motor_speed"
 MAX_GZ_OUTPUTS = 8                 # SIM_GZ_EC has 8 channels (gz_bridge module.yaml)
+MAX_CLASSIC_OUTPUTS = 16           # PWM_MAIN outputs simulator_mavlink sends
 MAX_CA_ROTORS = 12
 
 # Documented ranges of the parameters reedtool reads or writes: (min, max, default, source).
@@ -48,8 +53,11 @@ PARAM_RANGES: dict[str, tuple[float, float, float | None, str]] = {
     "CA_ROTOR#_AY": (-100.0, 100.0, 0.0, _CA),
     "CA_ROTOR#_AZ": (-100.0, 100.0, -1.0, _CA),
     "CA_ROTOR#_KM": (-1.0, 1.0, 0.05, _CA),
+    # 0..1000 is what QGroundControl offers (module.yaml); PX4 itself takes up to
+    # GZ_OUTPUT_CEILING (px4vision: 1100). C425 leaves these to C419/C420/C424.
     "SIM_GZ_EC_MIN#": (0.0, 1000.0, 0.0, _GZ),
     "SIM_GZ_EC_MAX#": (0.0, 1000.0, 1000.0, _GZ),
+    "SIM_GZ_EC_DIS#": (0.0, 1000.0, 0.0, _GZ),
     "CA_AIRFRAME": (0, 14, 0, _CA),
     "CA_ROTOR#_TILT": (0, 4, 0, _CA),
     "CA_SV_TL_COUNT": (0, 4, 0, _CA),
@@ -62,13 +70,15 @@ PARAM_RANGES: dict[str, tuple[float, float, float | None, str]] = {
     "THR_MDL_FAC": (0.0, 1.0, 0.0, "PX4 parameter reference, THR_MDL_FAC (0..1)"),
 }
 
+# The shell variables of a SITL airframe that say which simulator and model it is for.
+_SHELL_VAR = re.compile(r"^\s*(PX4_SIMULATOR|PX4_SIM_MODEL|PX4_GZ_WORLD)=(?:\$\{\w+:=)?([^}\s]*)")
 _QGC_LINE = re.compile(r"^\s*(\d+)\t(\d+)\t([A-Za-z0-9_]+)\t(\S+)\t(\d+)\s*$")
 _PARAM_CMD = re.compile(r"^\s*param\s+(set-default|set)\s+([A-Za-z0-9_]+)\s+(\S+)")
 
 
 def range_key(name: str) -> str:
     """CA_ROTOR3_KM -> CA_ROTOR#_KM, SIM_GZ_EC_MAX2 -> SIM_GZ_EC_MAX#: the PARAM_RANGES key."""
-    return re.sub(r"\d+", "#", name) if re.search(r"(ROTOR\d+_|EC_M(IN|AX)\d+$|SV_TL\d+_)", name) \
+    return re.sub(r"\d+", "#", name) if re.search(r"(ROTOR\d+_|EC_(MIN|MAX|DIS)\d+$|SV_TL\d+_)", name) \
         else name
 
 
@@ -110,6 +120,7 @@ class Px4Params:
     values: dict[str, ParamValue] = field(default_factory=dict)
     problems: list[tuple[str, SourceLoc]] = field(default_factory=list)
     kind: str = "px4"
+    shell: dict[str, tuple[str, SourceLoc]] = field(default_factory=dict)   # PX4_SIMULATOR=...
 
     @property
     def label(self) -> str:
@@ -155,6 +166,112 @@ class Px4Params:
     @property
     def uses_gz_outputs(self) -> bool:
         return any(self.has(f"SIM_GZ_EC_FUNC{k}") for k in range(1, MAX_GZ_OUTPUTS + 1))
+
+    def classic_outputs_of(self, ca_index: int) -> list[int]:
+        """The simulator_mavlink outputs k (PWM_MAIN, 1-based) whose function is CA rotor
+        `ca_index`; output i+1 for rotor i when the file sets no PWM_MAIN_FUNC."""
+        if not any(name.startswith("PWM_MAIN_FUNC") for name in self.values):
+            return [ca_index + 1]
+        return [k for k in range(1, MAX_CLASSIC_OUTPUTS + 1)
+                if self.get(f"PWM_MAIN_FUNC{k}").value == MOTOR_FUNCTION_BASE + ca_index]
+
+    def simulator(self) -> "SimulatorEvidence | None":
+        """Which Gazebo the airframe is for, and what says so; None when it does not say."""
+        return airframe_simulator(self)
+
+
+@dataclass
+class SimulatorEvidence:
+    simulator: str                 # "gz" (Gazebo Sim, gz_bridge) | "classic" (simulator_mavlink)
+    what: str                      # the line or name that says so
+    loc: SourceLoc
+
+
+def airframe_simulator(params: Px4Params) -> SimulatorEvidence | None:
+    """gz: SIM_GZ_EN 1, PX4_SIMULATOR=gz or SIM_GZ_EC_* parameters (px4-rc.simulator starts
+    the gz bridge on SIM_GZ_EN 1 or PX4_SIMULATOR=gz). Classic: PX4_SIMULATOR=gazebo-classic,
+    a gazebo-classic airframe name (PX4's NNNN_gazebo-classic_*), or PWM_MAIN_FUNC outputs
+    without any SIM_GZ parameter (simulator_mavlink sends PWM_MAIN as HIL_ACTUATOR_CONTROLS)."""
+    enabled = params.values.get("SIM_GZ_EN")
+    if enabled is not None and enabled.value == 1:
+        return SimulatorEvidence("gz", enabled.describe(), enabled.loc)
+    simulator = params.shell.get("PX4_SIMULATOR")
+    if simulator is not None and simulator[0] == "gz":
+        return SimulatorEvidence("gz", f"PX4_SIMULATOR={simulator[0]} ({simulator[1]})",
+                                 simulator[1])
+    gz = [v for v in params.values.values() if v.name.startswith("SIM_GZ_")]
+    if gz:
+        return SimulatorEvidence("gz", gz[0].describe(), gz[0].loc)
+    if simulator is not None and simulator[0] == "gazebo-classic":
+        return SimulatorEvidence("classic", f"PX4_SIMULATOR={simulator[0]} ({simulator[1]})",
+                                 simulator[1])
+    if "gazebo-classic" in Path(params.file).name:
+        return SimulatorEvidence("classic", f"the airframe name {Path(params.file).name}",
+                                 params.loc)
+    outputs = [v for v in params.values.values() if v.name.startswith("PWM_MAIN_FUNC")]
+    if outputs:
+        return SimulatorEvidence("classic", f"{outputs[0].describe()}, no SIM_GZ parameter",
+                                 outputs[0].loc)
+    return None
+
+
+# ------------------------------------------------------------ Classic SITL
+
+@dataclass
+class MavlinkChannel:
+    """One control channel of PX4-SITL_gazebo-classic's gazebo_mavlink_interface: while
+    armed it commands input_reference = (u + input_offset) * input_scaling +
+    zero_position_armed from actuator_controls[input_index] (gazebo_mavlink_interface.cpp),
+    u in 0..1 for a motor; the motor with motorNumber n reads the entry of channel n (the
+    n-th <channel>)."""
+
+    position: int                  # n: the motor number that reads it
+    input_index: int | None        # PWM_MAIN output input_index + 1 feeds it
+    offset: float
+    scaling: float
+    zero_armed: float
+    velocity: bool
+    loc: SourceLoc
+
+    def range_rad_s(self) -> tuple[float, float]:
+        """(speed at u = 0, speed at u = 1) while armed."""
+        return (self.offset * self.scaling + self.zero_armed,
+                (1.0 + self.offset) * self.scaling + self.zero_armed)
+
+    def describe(self) -> str:
+        return (f"mavlink channel {self.position} ({self.loc}): (u + {self.offset:g}) x "
+                f"{self.scaling:g} + {self.zero_armed:g}")
+
+
+def mavlink_channels(robot) -> list[MavlinkChannel]:
+    """The control channels of the model's gazebo_mavlink_interface, in order ([] when it
+    has none: RotorS' interface, or no interface)."""
+    from reedtool.physics.rotors import MAVLINK_PLUGINS
+
+    def number(node, tag: str, default: float) -> float:
+        text = node.findtext(tag)
+        try:
+            return float(text) if text is not None and text.strip() else default
+        except ValueError:
+            return math.nan
+
+    for _block, plugin in robot.plugins():
+        if plugin.library not in MAVLINK_PLUGINS:
+            continue
+        channels = plugin.node.find("control_channels")
+        if channels is None:
+            continue
+        out = []
+        for position, channel in enumerate(channels.findall("channel")):
+            index_text = (channel.findtext("input_index") or "").strip()
+            kind = (channel.findtext("joint_control_type") or "velocity").strip()
+            out.append(MavlinkChannel(position, int(index_text) if index_text.isdigit() else None,
+                                      number(channel, "input_offset", 0.0),
+                                      number(channel, "input_scaling", 1.0),
+                                      number(channel, "zero_position_armed", 0.0),
+                                      kind == "velocity", channel.loc))
+        return out
+    return []
 
 
 # ------------------------------------------------------------ CA_AIRFRAME
@@ -295,6 +412,10 @@ def parse_px4_params(text: str, file: str) -> Px4Params:
             name, value_text = qgc.group(3), qgc.group(4)
             params.values[name] = ParamValue(name, _number(value_text, name, loc), value_text, loc)
             continue
+        var = _SHELL_VAR.match(line)
+        if var:
+            params.shell[var.group(1)] = (var.group(2), loc)
+            continue
         cmd = _PARAM_CMD.match(line)
         if cmd:
             verb, name, value_text = cmd.groups()
@@ -355,37 +476,100 @@ class RotorSpec:
     turning_sign: int              # +1 ccw, -1 cw
     moment_constant: float
     max_rot_velocity_rad_s: float
+    axis_flu: np.ndarray | None = None   # thrust direction; None: straight up
+
+
+# The hard ceiling of a SIM_GZ_EC_MIN/MAX value: the mixer keeps output limits as
+# uint16_t (PX4-Autopilot src/lib/mixer_module/mixer_module.hpp, _min_value/_max_value),
+# and the gz bridge sends the output as the rad/s of the motor command. The 0..1000 of
+# gz_bridge module.yaml is only the range QGroundControl offers: PX4's own
+# 4006_gz_px4vision airframe sets SIM_GZ_EC_MAX 1100.
+GZ_OUTPUT_CEILING = 65535
+# The idle (SIM_GZ_EC_MINk) PX4's gz multicopter airframes arm with: 150 rad/s
+# (4001_gz_x500, 4006_gz_px4vision), used when it is below the rotor's maximum / 4.
+PX4_GZ_IDLE_RAD_S = 150
+
+
+def px4_idle_rad_s(max_rad_s: float) -> int:
+    """PX4's gz idle for a rotor of this top speed: 150 rad/s, or 0 for a rotor so slow
+    that 150 would be a quarter of its range or more."""
+    return PX4_GZ_IDLE_RAD_S if PX4_GZ_IDLE_RAD_S < max_rad_s / 4 else 0
+
+
+def _axis_frd(axis_flu) -> np.ndarray | None:
+    """The unit thrust axis in FRD, None when it is PX4's default, straight up (0, 0, -1)."""
+    if axis_flu is None:
+        return None
+    axis = frd_from_flu(np.asarray(axis_flu, dtype=float))
+    norm = float(np.linalg.norm(axis))
+    if not math.isfinite(norm) or norm <= 0:
+        return None
+    axis = np.round(axis / norm, 9) + 0.0
+    return None if np.allclose(axis, UPWARD_FRD, rtol=0, atol=1e-9) else axis
+
+
+def px4_hover_throttle(omega_hover_rad_s, max_rad_s) -> float:
+    """MPC_THR_HOVER for rotors hovering at these speeds, as px4_airframe_text commands
+    them (idle px4_idle_rad_s, THR_MDL_FAC 0: u = (ω - MIN) / (MAX - MIN)), averaged, in
+    PX4's 0.1..0.8."""
+    us = [(w - px4_idle_rad_s(top)) / (round(top) - px4_idle_rad_s(top))
+          for w, top in zip(omega_hover_rad_s, max_rad_s)]
+    return float(np.clip(np.mean(us), 0.1, 0.8)) if us else 0.5
 
 
 def px4_airframe_text(name: str, rotors: list[RotorSpec], *, hover_throttle: float,
-                      idle_rad_s: float = 0.0) -> str:
-    """A PX4 gz airframe script for the rotors (numbered by actuator index)."""
+                      idle_rad_s: float | None = None, world: str | None = None,
+                      tool: str = "new-package", simulator: str = "gz") -> str:
+    """A PX4 SITL airframe script for the rotors (numbered by actuator index).
+
+    gz: SIM_GZ_EC_MIN/MAX/DIS are integer parameters (PX4 stores them as int32): MAX is
+    maxRotVelocity rounded to the nearest integer, MIN PX4's gz idle (px4_idle_rad_s)
+    unless `idle_rad_s` is given, DIS 0 (stopped while disarmed, as PX4's default).
+    classic (Gazebo Classic, simulator_mavlink): PWM_MAIN_FUNCk outputs and no SIM_GZ
+    parameter; the speed range is the model's mavlink interface's.
+    """
     order = sorted(rotors, key=lambda r: r.actuator_index)
     max_rad_s = max(r.max_rot_velocity_rad_s for r in order)
-    if max_rad_s > PARAM_RANGES["SIM_GZ_EC_MAX#"][1]:
-        raise ReedtoolError(f"max_rot_velocity {max_rad_s:g} rad/s is above what PX4 can command "
-                            "through SIM_GZ_EC_MAX (at most 1000 rad/s, gz_bridge module.yaml)",
-                            hint="use a max_rot_velocity of at most 1000 rad/s with --autopilot px4")
-    lines = ["#!/bin/sh", "#", f"# @name {name} (generated by reedtool new-package)", "#",
-             "# @type Multicopter", "#", "", ". ${R}etc/init.d/rc.mc_defaults", "",
-             "PX4_SIMULATOR=${PX4_SIMULATOR:=gz}", f"PX4_SIM_MODEL=${{PX4_SIM_MODEL:={name}}}", "",
-             "param set-default SIM_GZ_EN 1", "", "param set-default CA_AIRFRAME 0",
-             f"param set-default CA_ROTOR_COUNT {len(order)}", ""]
+    if simulator == "gz" and (not math.isfinite(max_rad_s) or round(max_rad_s) > GZ_OUTPUT_CEILING):
+        raise ReedtoolError(f"max_rot_velocity {max_rad_s:g} rad/s is above what PX4 can "
+                            f"command through SIM_GZ_EC_MAX (an unsigned 16-bit output, at "
+                            f"most {GZ_OUTPUT_CEILING} rad/s)",
+                            hint="check maxRotVelocity: it is in rad/s")
+    lines = ["#!/bin/sh", "#", f"# @name {name} (generated by reedtool {tool})", "#",
+             "# @type Quadrotor" if len(order) == 4 else "# @type Multicopter", "#", "",
+             ". ${R}etc/init.d/rc.mc_defaults", "",
+             f"PX4_SIMULATOR=${{PX4_SIMULATOR:={'gz' if simulator == 'gz' else 'gazebo-classic'}}}"]
+    if world is not None:
+        lines.append(f"PX4_GZ_WORLD=${{PX4_GZ_WORLD:={world}}}")
+    lines += [f"PX4_SIM_MODEL=${{PX4_SIM_MODEL:={name}}}", ""]
+    if simulator == "gz":
+        lines += ["param set-default SIM_GZ_EN 1", ""]
+    lines += ["param set-default CA_AIRFRAME 0", f"param set-default CA_ROTOR_COUNT {len(order)}", ""]
     for i, rotor in enumerate(order):
         p = np.round(frd_from_flu(rotor.position_flu_m), 9) + 0.0   # no "-0" in the file
         km = rotor.turning_sign * min(abs(rotor.moment_constant), 1.0)
         lines += [f"param set-default CA_ROTOR{i}_PX {p[0]:.6g}",
                   f"param set-default CA_ROTOR{i}_PY {p[1]:.6g}",
                   f"param set-default CA_ROTOR{i}_PZ {p[2]:.6g}",
-                  f"param set-default CA_ROTOR{i}_KM {km:.6g}", ""]
+                  f"param set-default CA_ROTOR{i}_KM {km:.6g}"]
+        axis = _axis_frd(rotor.axis_flu)
+        if axis is not None:     # PX4's default is (0, 0, -1): up
+            lines += [f"param set-default CA_ROTOR{i}_A{c} {v:.6g}" for c, v in zip("XYZ", axis)]
+        lines.append("")
+    outputs = "SIM_GZ_EC_FUNC" if simulator == "gz" else "PWM_MAIN_FUNC"
     for k, rotor in enumerate(order, start=1):
-        lines.append(f"param set-default SIM_GZ_EC_FUNC{rotor.actuator_index + 1} "
+        lines.append(f"param set-default {outputs}{rotor.actuator_index + 1} "
                      f"{MOTOR_FUNCTION_BASE + k - 1}")
-    lines.append("")
-    for rotor in order:
-        k = rotor.actuator_index + 1
-        lines.append(f"param set-default SIM_GZ_EC_MIN{k} {idle_rad_s:g}")
-        lines.append(f"param set-default SIM_GZ_EC_MAX{k} {rotor.max_rot_velocity_rad_s:g}")
+    ranges = [] if simulator != "gz" else [
+        ("DIS", lambda r: 0),
+        ("MIN", lambda r: round(idle_rad_s) if idle_rad_s is not None
+         else px4_idle_rad_s(r.max_rot_velocity_rad_s)),
+        ("MAX", lambda r: round(r.max_rot_velocity_rad_s))]
+    for tag, value in ranges:
+        lines.append("")
+        for rotor in order:
+            lines.append(f"param set-default SIM_GZ_EC_{tag}{rotor.actuator_index + 1} "
+                         f"{value(rotor)}")
     lines += ["", f"param set-default MPC_THR_HOVER {hover_throttle:.2f}",
               "param set-default THR_MDL_FAC 0", ""]
     return "\n".join(lines)

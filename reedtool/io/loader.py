@@ -18,14 +18,18 @@ def load_robots(path: Path | str, mappings: Mapping[str, str] | None = None,
     an SDF world, each multirotor model (each model when none has motor plugins)."""
     path = Path(path)
     refuse_mesh(path)
-    if model_name is None and _sdf_path(path) is not None:
+    if model_name is None and _sdf_path(path) is not None and not _is_template(_sdf_path(path)):
         from reedtool.io.packages import PackageResolver
         from reedtool.io.sdf import load_sdf_models
 
+        from reedtool.io.sdf_jinja import relocate_rendered, take_rendered
+
         sdf = _sdf_path(path)
         resolver = PackageResolver(package_paths, model_path=sdf)
-        return [_with_package_notes(robot, resolver)
-                for robot in load_sdf_models(sdf, resolver=resolver)]
+        robots = load_sdf_models(sdf, resolver=resolver)
+        maps = take_rendered()
+        return [_with_package_notes(relocate_rendered(robot, maps), resolver)
+                for robot in robots]
     return [load_robot(path, mappings, package_paths, model_name=model_name)]
 
 
@@ -75,7 +79,14 @@ def _model_dir_sdf(path: Path) -> Path:
 def _sdf_path(path: Path) -> Path | None:
     if path.is_dir():
         return _model_dir_sdf(path)
-    return path if path.suffix.lower() in SDF_SUFFIXES else None
+    return path if path.suffix.lower() in SDF_SUFFIXES or _is_template(path) else None
+
+
+def _is_template(path: Path) -> bool:
+    """PX4's Gazebo Classic `*.sdf.jinja` (io.sdf_jinja renders it as PX4 does)."""
+    from reedtool.io.sdf_jinja import is_sdf_jinja
+
+    return is_sdf_jinja(path)
 
 
 def load_robot(path: Path | str, mappings: Mapping[str, str] | None = None,
@@ -94,12 +105,28 @@ def load_robot(path: Path | str, mappings: Mapping[str, str] | None = None,
     refuse_mesh(path)
     if path.is_dir():
         path = _model_dir_sdf(path)
-    if path.suffix.lower() in SDF_SUFFIXES:
-        from reedtool.io.sdf import load_sdf_file
+    if _is_template(path):
+        from reedtool.io.sdf import parse_sdf
+        from reedtool.io.sdf_jinja import relocate_rendered, render
 
         resolver = PackageResolver(package_paths, model_path=path)
-        return _with_package_notes(load_sdf_file(path, resolver=resolver,
-                                                 model_name=model_name), resolver)
+        rendered = render(path)
+        try:
+            robot = parse_sdf(rendered.text, path, resolver=resolver, model_name=model_name)
+        except ReedtoolError as exc:     # at the template's line, as every finding is
+            if exc.file != str(path) or not exc.line or exc.line > len(rendered.template_line):
+                raise
+            raise ReedtoolError(exc.message, file=exc.file,
+                                line=rendered.template_line[exc.line - 1],
+                                hint=exc.hint) from None
+        return _with_package_notes(relocate_rendered(robot), resolver)
+    if path.suffix.lower() in SDF_SUFFIXES:
+        from reedtool.io.sdf import load_sdf_file
+        from reedtool.io.sdf_jinja import relocate_rendered
+
+        resolver = PackageResolver(package_paths, model_path=path)
+        return _with_package_notes(relocate_rendered(load_sdf_file(
+            path, resolver=resolver, model_name=model_name)), resolver)
     if model_name is not None:
         raise ReedtoolError("--model picks a model of an SDF file; this file is not SDF",
                             file=path, hint="drop --model")

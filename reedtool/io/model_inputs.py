@@ -37,6 +37,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Mapping, Sequence
 
+from reedtool.errors import ReedtoolError
+
 # Every model file a ROS/Gazebo package uses (`.urdf.xacro` ends in `.xacro`). RotorS keeps
 # its top-level models in `.gazebo` files (mav_generic_odometry_sensor.gazebo includes
 # <mav>_base.xacro); worlds are `.world`. .pre-commit-hooks.yaml matches the same list.
@@ -134,7 +136,7 @@ def _top_level(files: list[Path], include_tree: Callable[[Path], Sequence[Path]]
     # picked by `$(arg mav_name)` reads like a library and still makes it a part. SDF is
     # not xacro, and a .urdf is read as written: neither includes a xacro part.
     for file in files:
-        if file.suffix.lower() not in (".sdf", ".world", ".urdf"):
+        if file.suffix.lower() not in (".sdf", ".world", ".urdf") and not _is_sdf_template(file):
             included.update(p.resolve() for p in include_tree(file)[1:])
             for pattern in (include_globs(file) if include_globs else ()):
                 included.update(c.resolve() for c in candidates
@@ -156,8 +158,30 @@ def _model_files(directory: Path, recursive: bool,
                  suffixes: Sequence[str] = MODEL_SUFFIXES) -> list[Path]:
     pattern = "**/*" if recursive else "*"
     return sorted(p for p in directory.glob(pattern)
-                  if p.is_file() and p.suffix.lower() in suffixes
+                  if p.is_file() and (p.suffix.lower() in suffixes
+                                      or (".sdf" in suffixes and _is_sdf_template(p)))
                   and not any(part.startswith(".") for part in p.relative_to(directory).parts))
+
+
+def _template_model_dir(path: Path) -> bool:
+    """A PX4 Classic model directory: model.config naming X.sdf, and X.sdf.jinja beside it."""
+    if not (path / "model.config").is_file():
+        return False
+    from reedtool.io.resources import model_sdf_in_dir
+
+    try:
+        return _is_sdf_template(model_sdf_in_dir(path))
+    except ReedtoolError:   # an unreadable model.config: the loader says what is wrong
+        return False
+
+
+def _is_sdf_template(path: Path) -> bool:
+    """PX4's Classic models are `*.sdf.jinja` templates (io.sdf_jinja renders them); the
+    `.sdf` a build renders beside one is the same model, and the template is what the
+    user edits."""
+    from reedtool.io.sdf_jinja import is_sdf_jinja
+
+    return is_sdf_jinja(path)
 
 
 # Neighbours larger than this are not followed: a model that includes a part is a small
@@ -229,6 +253,8 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
                                            suffixes=PACKAGE_SUFFIXES)]
         else:
             files = _model_files(path, recursive=True)
+        templates = {f.with_name(f.name[:-len(".jinja")]) for f in files if _is_sdf_template(f)}
+        files = [f for f in files if f not in templates]
         models = _top_level(files, include_tree, include_globs)
         if not models:
             out.append(Target(raw, None, "no model file (" + ", ".join(MODEL_SUFFIXES)
@@ -287,7 +313,7 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
         elif path.exists() and not path.is_dir():
             add_file(path)
         elif path.is_dir():
-            if (path / "model.sdf").is_file():
+            if (path / "model.sdf").is_file() or _template_model_dir(path):
                 add(path)
             else:
                 add_directory(path, raw)

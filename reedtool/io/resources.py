@@ -60,6 +60,10 @@ def model_sdf_in_dir(model_dir: Path) -> Path:
             raise ReedtoolError(f"{config} names no <sdf> file")
         _version, name = max(entries, key=lambda entry: _version_key(entry[0]))
         path = model_dir / name
+        if not path.is_file() and (model_dir / f"{name}.jinja").is_file():
+            # PX4-SITL_gazebo-classic: model.config names iris.sdf, which its build renders
+            # from iris.sdf.jinja (reedtool renders it too: io.sdf_jinja).
+            return model_dir / f"{name}.jinja"
         if not path.is_file():
             raise ReedtoolError(f"{config} names '{name}', which does not exist")
         return path

@@ -201,8 +201,12 @@ def _apply_overrides(include: etree._Element, model: etree._Element, sources: So
 
 def _read(path: Path, sources: SourceMap) -> tuple[etree._Element, SourceFile]:
     from reedtool.io.fileio import read_xml_file
+    from reedtool.io.sdf_jinja import is_sdf_jinja, render
 
-    text, _encoding = read_xml_file(path, what="SDF file")
+    if is_sdf_jinja(path):      # an included PX4 Classic model (iris_opt_flow -> px4flow)
+        text = render(path).text
+    else:
+        text, _encoding = read_xml_file(path, what="SDF file")
     root, tolerated = parse_tolerant(text, path)
     source = SourceFile(path, text.splitlines())
     sources.tolerated += [(source, t) for t in tolerated]

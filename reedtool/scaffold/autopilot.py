@@ -18,6 +18,7 @@ Both files are written from the frame catalogue entry the model is rendered from
 from __future__ import annotations
 
 import dataclasses
+import re
 from pathlib import PurePosixPath
 
 import numpy as np
@@ -54,7 +55,20 @@ def ardupilot_frame(frame: Airframe) -> tuple[Airframe, int, int, list[int]]:
 
 
 def prepare_spec(spec, autopilot: str | None):
-    """The spec to render for an autopilot (ArduPilot may need the spins of its frame)."""
+    """The spec to render for an autopilot (ArduPilot may need the spins of its frame).
+
+    ArduPilot SITL reaches a Gazebo model only through ardupilot_gazebo's ArduPilotPlugin,
+    which is built for Gazebo Sim (Garden and later, ArduPilot/ardupilot_gazebo README); a
+    RotorS package (Gazebo Classic, ROS 1) could carry no plugin ArduPilot talks to, so
+    it is refused rather than written with a .parm nothing reads."""
+    if autopilot == "ardupilot" and spec.kind == "multirotor" and spec.sim != "gz":
+        raise ReedtoolError(
+            "--autopilot ardupilot needs Gazebo Sim: ArduPilot SITL drives a Gazebo model "
+            "through ardupilot_gazebo's ArduPilotPlugin, which supports Gazebo Garden and "
+            f"later, and a {'ROS 1 ' if spec.ros == 1 else ''}RotorS package runs on Gazebo "
+            "Classic, where the model would have no plugin ArduPilot talks to",
+            hint="use --ros 2 --sim gz --autopilot ardupilot: the model then carries the "
+                 "ArduPilotPlugin and its LiftDrag blades")
     if autopilot == "ardupilot" and spec.kind == "multirotor":
         spec.frame = ardupilot_frame(spec.frame)[0]
     return spec
@@ -69,8 +83,10 @@ def _com_m(spec, positions: np.ndarray) -> np.ndarray:
     return moment / total_mass_estimate_kg(spec)
 
 
-def autopilot_files(spec, autopilot: str | None):
-    """The RenderedFiles for `--autopilot`, or [] without it."""
+def autopilot_files(spec, autopilot: str | None, rendered=()):
+    """The RenderedFiles for `--autopilot`, or [] without it. PX4 on gz: the airframe and
+    the model in PX4-gazebo-models' layout under px4/ (scaffold.px4_gz_contract), ported
+    from the package's own model (`rendered`, the package's files)."""
     from reedtool.scaffold.render import RenderedFile
 
     if autopilot is None:
@@ -83,7 +99,7 @@ def autopilot_files(spec, autopilot: str | None):
 
     positions = rotor_positions_m(spec)
     if autopilot == "px4":
-        from reedtool.flightstack.px4 import RotorSpec, px4_airframe_text
+        from reedtool.flightstack.px4 import RotorSpec, px4_airframe_text, px4_hover_throttle
         from reedtool.scaffold.package_spec import STANDARD_GRAVITY_M_S2, total_mass_estimate_kg
 
         com = _com_m(spec, positions)
@@ -93,9 +109,20 @@ def autopilot_files(spec, autopilot: str | None):
                   for slot, position in zip(frame.rotors, positions)]
         weight_N = total_mass_estimate_kg(spec) * STANDARD_GRAVITY_M_S2
         hover_rad_s = np.sqrt(weight_N / (frame.rotor_count * spec["motor_constant"]))
-        throttle = float(np.clip(hover_rad_s / spec["max_rot_velocity"], 0.1, 0.8))
-        text = px4_airframe_text(spec.name, rotors, hover_throttle=throttle)
-        path = PurePosixPath("px4", f"airframe_gz_{spec.name}")
+        throttle = px4_hover_throttle([hover_rad_s] * len(rotors),
+                                      [spec["max_rot_velocity"]] * len(rotors))
+        if spec.sim == "gz":
+            from reedtool.scaffold.px4_gz_contract import airframe_path, package_px4_files
+
+            text = px4_airframe_text(spec.name, rotors, hover_throttle=throttle, world=spec.name)
+            return [RenderedFile(PurePosixPath("px4", *airframe_path(spec.name).parts),
+                                 text.encode("utf-8"), 0o644),
+                    *(RenderedFile(PurePosixPath("px4", *path.parts), data, 0o644)
+                      for path, data in package_px4_files(spec.name, rendered))]
+        # Gazebo Classic (RotorS): PX4's simulator_mavlink outputs, no gz bridge.
+        text = px4_airframe_text(spec.name, rotors, hover_throttle=throttle,
+                                 simulator="classic")
+        path = PurePosixPath("px4", f"airframe_gazebo-classic_{spec.name}")
     else:
         from reedtool.flightstack.ardupilot import parm_text
 
@@ -108,13 +135,37 @@ def autopilot_files(spec, autopilot: str | None):
 
 def autopilot_context(spec, autopilot: str | None) -> dict:
     """Template variables for --autopilot: `ardupilot_block`, the ArduPilotPlugin and its
-    LiftDrag blades for a gz-sim multirotor (scaffold.ardupilot_gz), else empty."""
+    LiftDrag blades for a gz-sim multirotor (scaffold.ardupilot_gz); `px4` and PX4's gz
+    contract (scaffold.px4_gz_contract: the sensors, the world's spherical coordinates)."""
+    context = {"ardupilot_block": "", "px4": False}
     if autopilot == "ardupilot" and spec.kind == "multirotor" and spec.sim == "gz":
         from reedtool.scaffold.ardupilot_gz import package_block
 
         from reedtool.scaffold.package_spec import rotor_positions_m
 
         positions = rotor_positions_m(spec)
-        return {"ardupilot_block": package_block(spec, positions, _com_m(spec, positions))}
-    return {"ardupilot_block": ""}
+        block = package_block(spec, positions, _com_m(spec, positions))
+        context["ardupilot_block"] = block
+        # The README says where SITL must send its servo outputs: what the block says.
+        context["ardupilot_fdm"] = {tag: re.search(f"<{tag}>([^<]*)</{tag}>", block).group(1)
+                                    for tag in ("fdm_addr", "fdm_port_in")}
+    if autopilot == "px4" and spec.kind == "multirotor" and spec.sim == "gz":
+        from reedtool.scaffold.px4_gz_contract import (
+            MAGNETIC_FIELD_T,
+            PX4_SENSORS,
+            SPHERICAL_COORDINATES,
+            _px4_sensor,
+        )
+        from reedtool.scaffold.sdf_writer import elements_text
+
+        sensors = []
+        for sensor in PX4_SENSORS:
+            body = [c for c in _px4_sensor(sensor).children
+                    if c.tag not in ("always_on", "update_rate")]
+            sensors.append({"name": sensor.name, "type": sensor.type,
+                            "update_rate_hz": sensor.update_rate_hz,
+                            "xml": elements_text(body, indent=6)})
+        context.update(px4=True, px4_sensors=sensors, px4_spherical=SPHERICAL_COORDINATES,
+                       px4_magnetic_field=MAGNETIC_FIELD_T)
+    return context
 
