@@ -30,6 +30,10 @@ _ROUTED_KINDS = frozenset({
     "xml-declaration-late",     # S124
     "sdf-short-pose",           # S125
     "package-duplicate",        # S150
+    *(f"sdf-refused-{kind}" for kind in (   # S160-S168: libsdformat's structural refusals
+        "double-colon", "name-collision", "reserved-name", "canonical-link", "attached-to",
+        "relative-to", "joint-frames", "model-without-link", "version")),
+    "absolute-uri",             # S169
 })
 # libsdformat's joint types (sdf/1.x/joint.sdf): what an SDF <joint type=> may be.
 SDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "ball", "screw",

@@ -64,8 +64,10 @@ from lxml import etree
 from reedtool.errors import ReedtoolError
 from reedtool.io.fileio import magnitude_problem
 from reedtool.frames import make_T, matrix_to_rpy, rpy_to_matrix
+from reedtool.io.meshes import machine_path
 from reedtool.io.resources import resolve_model_file_uri
 from reedtool.io.sdf_include import SourceFile, SourceMap, expand_includes
+from reedtool.io.sdf_refusals import document_refusals, parse_version
 from reedtool.io.tolerant_xml import (
     late_declaration_issues,
     local_tag,
@@ -123,7 +125,10 @@ def load_sdf_models(path: Path | str, *, resolver=None) -> list[Robot]:
     root, sources, resolver = _document(text, path, resolver)
     models = _candidate_models(root, path, sources)
     with_motors = [m for m in models if _has_motor_plugin(m)]
-    return [_read_model(m, path, resolver, sources) for m in (with_motors or models)]
+    robots = [_read_model(m, path, resolver, sources) for m in (with_motors or models)]
+    # What libsdformat refuses refuses the whole file: said once, with the first model.
+    robots[0].parse_issues += _refusals(root, sources)
+    return robots
 
 
 def parse_sdf(xml_text: str, file: Path | str, *, resolver=None,
@@ -131,7 +136,32 @@ def parse_sdf(xml_text: str, file: Path | str, *, resolver=None,
     file = Path(file)
     root, sources, resolver = _document(xml_text, file, resolver)
     model = _pick_model(root, file, sources, model_name)
-    return _read_model(model, file, resolver, sources)
+    robot = _read_model(model, file, resolver, sources)
+    robot.parse_issues += _refusals(root, sources)
+    return robot
+
+
+def _refusals(root: etree._Element, sources: SourceMap) -> list[ParseIssue]:
+    """libsdformat's structural refusals of the expanded document (reedtool.io.sdf_refusals)."""
+    versions: dict[Path, tuple[int, int]] = {}
+
+    def version_of(el: etree._Element) -> tuple[int, int]:
+        source = sources.file_of(el)
+        if source.path not in versions:
+            match = _SDF_VERSION.search("\n".join(source.lines[:200]))
+            versions[source.path] = parse_version(match.group(1) if match else None) or (1, 6)
+        return versions[source.path]
+
+    def loc(el: etree._Element) -> SourceLoc:
+        return SourceLoc(str(sources.file_of(el).path), sources.line_of(el))
+
+    issues = document_refusals(root, loc=loc, version_of=version_of)
+    for uri, file, line in sources.include_uris:
+        if machine_path(uri):
+            issues.append(ParseIssue("absolute-uri", f"<include> <uri>{uri}</uri> names a "
+                                     "file by its absolute path", SourceLoc(str(file), line),
+                                     uri))
+    return issues
 
 
 def _document(xml_text: str, file: Path, resolver):
