@@ -66,6 +66,23 @@ CASES = [
     # link kept by preserveFixedJoint, a limited revolute joint; the car a mesh in metres.
     ("clean_arm.urdf", []),
     ("clean_car.urdf", []),
+    # libsdformat's structural refusals (S160-S168); tests/test_sdformat_outputs.py shows
+    # libsdformat refusing each bad fixture and loading each good one.
+    ("S160_bad_double_colon_1_9.sdf", ["S160"]),
+    ("S160_good_double_colon_1_6.sdf", []),
+    ("S161_bad_link_named_as_joint.sdf", ["S101", "S161", "S165", "S166"]),
+    ("S161_bad_duplicate_visual.sdf", ["S161"]),
+    ("S161_good_renamed_below_1_7.sdf", []),   # PX4 rover_differential's caster shape
+    ("S162_bad_link_named_world.sdf", ["S162", "S166"]),
+    ("S163_bad_canonical_link.sdf", ["S163"]),
+    ("S164_bad_attached_to_cycle.sdf", ["S164", "S164", "S165"]),
+    ("S165_bad_relative_to_own_joint.sdf", ["S101", "S165"]),
+    ("S165_good_frames_nested.sdf", []),
+    ("S166_bad_joint_child_is_parent.sdf", ["S109", "S166"]),
+    ("S167_bad_nested_without_link.sdf", ["S167"]),
+    ("S168_bad_no_version.sdf", ["S168"]),
+    # An absolute file:// mesh: machine-bound (S169), and missing here (S115).
+    ("S169_bad_absolute_mesh.urdf", ["S115", "S169"]),
 ]
 
 

@@ -447,6 +447,17 @@ class _ModelReader:
         return name
 
     # ------------------------------------------------------------ collect
+    def _renamed(self, scope: str, name: str, el: etree._Element) -> str:
+        """The name libsdformat gives a joint or frame: below SDF 1.7 one that takes a
+        sibling's name is renamed NAME_joint / NAME_frame with a warning (Model.cc), and
+        references to NAME keep meaning the first (1.7 on refuses it: S161)."""
+        if scope + name not in self.frames or self._version(el) >= (1, 7):
+            return name
+        renamed, i = f"{name}_{el.tag}", 0
+        while scope + renamed in self.frames:
+            renamed, i = f"{name}_{el.tag}{i}", i + 1
+        return renamed
+
     def _collect(self, model: etree._Element, scope: str) -> None:
         """Register every frame of `model` (and its nested models) under scoped names."""
         for el in model:
@@ -458,12 +469,14 @@ class _ModelReader:
                 self.frames[scope + name] = _FrameEntry(self._scoped(scope, rel), T, el)
                 self.link_els.append((scope + name, scope, el))
             elif el.tag == "joint":
+                name = self._renamed(scope, name, el)
                 T, rel = self._pose(el.find("pose"), name)
                 child = (el.findtext("child") or "").strip()
                 self.frames[scope + name] = _FrameEntry(
                     self._scoped(scope, rel) if rel else self._scoped(scope, child), T, el)
                 self.joint_els.append((scope + name, scope, el))
             elif el.tag == "frame":
+                name = self._renamed(scope, name, el)
                 T, rel = self._pose(el.find("pose"), name)
                 placement = el.get("placement_frame")   # set on merged-include proxy frames
                 self.frames[scope + name] = _FrameEntry(

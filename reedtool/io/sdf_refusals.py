@@ -190,9 +190,16 @@ class _Scope:
         self.model = model
         self.ctx = ctx
         self.elements: dict[str, etree._Element] = {}
+        # Below SDF 1.7 libsdformat renames a link, joint or frame that takes a sibling's
+        # name (`NAME_joint`, Model.cc): references to NAME mean the first one.
+        self.own_name: dict[etree._Element, str] = {}
         for el in model:
             if isinstance(el.tag, str) and el.tag in _FRAME_ELEMENTS and el.get("name"):
-                self.elements.setdefault(el.get("name"), el)
+                name = el.get("name")
+                first = self.elements.setdefault(name, el)
+                renamed = first is not el and first.tag != el.tag \
+                    and ctx.version_of(el) < (1, 7)
+                self.own_name[el] = f"{name}_{el.tag}" if renamed else name
         self.nested = {name: _Scope(el, ctx) for name, el in self.elements.items()
                        if el.tag == "model"}
 
@@ -309,7 +316,7 @@ def _attached_to(scope: _Scope, ctx: _Context) -> None:
     """parser.cc checkFrameAttachedToNames and checkFrameAttachedToGraph, every version:
     a <frame attached_to=> that names nothing, itself, or starts a cycle."""
     for el in scope.model.iterfind("frame"):
-        name = el.get("name") or ""
+        name = scope.own_name.get(el, el.get("name") or "")
         attached = el.get("attached_to")
         if not attached or attached == MODEL_FRAME:
             continue
@@ -331,7 +338,7 @@ def _joint_frames(scope: _Scope, ctx: _Context) -> None:
     joint's child that is `world` or the joint itself, a parent that is the joint itself,
     a parent or child naming no frame, and a parent and child resolving to one link."""
     for el in scope.model.iterfind("joint"):
-        name = el.get("name") or ""
+        name = scope.own_name.get(el, el.get("name") or "")
         parent = (el.findtext("parent") or "").strip()
         child = (el.findtext("child") or "").strip()
         if not parent or not child:
@@ -365,7 +372,7 @@ def _relative_to(scope: _Scope, ctx: _Context) -> None:
     for el in scope.model:
         if not isinstance(el.tag, str) or el.tag not in _FRAME_ELEMENTS:
             continue
-        name = el.get("name") or ""
+        name = scope.own_name.get(el, el.get("name") or "")
         pose = el.find("pose")
         explicit = pose.get("relative_to") if pose is not None else None
         if explicit:
