@@ -126,3 +126,29 @@ def test_double_colon_by_declared_version(tmp_path, version, refused):
     error = sdformat_oracle.libsdformat_error_text(text)
     assert (error is not None and not drake_only(error, version)) == refused, error
     assert ("S160" in validate_errors(path)) == refused
+
+
+def test_validate_never_imports_drake():
+    """Drake is the tests' judge, not a dependency: `reedtool validate` (an SDF with
+    includes and a world, through the console entry point) runs without importing it."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    fixtures = Path(__file__).parent / "fixtures"
+    script = (
+        "import sys\n"
+        "from reedtool.cli import main\n"
+        "for path in sys.argv[1:]:\n"
+        "    try:\n"
+        "        main(['validate', path])\n"
+        "    except SystemExit:\n"
+        "        pass\n"
+        "print('drake imported:', sorted(m for m in sys.modules if 'drake' in m))\n")
+    result = subprocess.run(
+        [sys.executable, "-c", script,
+         str(fixtures / "px4_gz" / "models" / "x500" / "model.sdf"),
+         str(fixtures / "validate" / "S160_bad_double_colon_1_9.sdf")],
+        capture_output=True, text=True, timeout=120)
+    assert "S160" in result.stdout, result.stdout + result.stderr   # validate did run
+    assert "drake imported: []" in result.stdout, result.stdout
