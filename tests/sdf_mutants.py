@@ -108,6 +108,23 @@ _CLASSIC = (
     "</joint></model></sdf>")
 
 
+_WORLD = (
+    '<sdf version="{v}"><world name="field">'
+    '<model name="ground_plane"><static>true</static><link name="link"><collision '
+    'name="collision"><geometry><plane><normal>0 0 1</normal></plane></geometry></collision>'
+    "</link></model>"
+    '<frame name="landing_pad" attached_to="ground_plane"><pose>2 0 0 0 0 0</pose></frame>'
+    '<include><uri>model://quad</uri><name>quad_0</name>'
+    '<pose relative_to="landing_pad">0 0 0.2 0 0 0</pose></include>'
+    '<model name="cart"><pose relative_to="landing_pad">1 0 0.1 0 0 0</pose>'
+    f'<link name="chassis">{_inertial(10.0)}<visual name="chassis_visual"><geometry><box>'
+    "<size>0.6 0.4 0.2</size></box></geometry></visual></link>"
+    f'<link name="wheel"><pose>0.3 0.25 0 1.5708 0 0</pose>{_inertial(0.5)}</link>'
+    '<joint name="wheel_joint" type="revolute"><parent>chassis</parent><child>wheel</child>'
+    "<axis><xyz>0 0 1</xyz><limit><lower>-1e16</lower><upper>1e16</upper></limit></axis>"
+    "</joint></model></world></sdf>")
+
+
 @dataclass(frozen=True)
 class Base:
     name: str
@@ -117,6 +134,7 @@ class Base:
     # The mutations worth running on this base (None: all); a version variant of a base
     # needs only those whose verdict depends on the version, to keep the corpus quick.
     only: tuple[str, ...] | None = None
+    top_path: str | None = None    # where the top file goes (default models/NAME/model.sdf)
 
     def write(self, root: Path, top_text: str | None = None,
               models: dict[str, str] | None = None) -> Path:
@@ -128,7 +146,7 @@ class Base:
                 f'<?xml version="1.0"?><model><name>{name}</name>'
                 f'<sdf version="{self.version}">model.sdf</sdf></model>')
             (folder / "model.sdf").write_text(text)
-        top = root / "models" / self.name / "model.sdf"
+        top = root / (self.top_path or f"models/{self.name}/model.sdf")
         top.parent.mkdir(parents=True, exist_ok=True)
         top.write_text(top_text if top_text is not None else self.top)
         return top
@@ -142,6 +160,11 @@ def bases() -> list[Base]:
         Base("iris", "1.6", _CLASSIC.format(v="1.6"), {"gps": _GPS.format(v="1.6")}),
         Base("iris", "1.7", _CLASSIC.format(v="1.7"), {"gps": _GPS.format(v="1.7")},
              _BY_VERSION),
+        # A world: a static ground plane, a world frame, the quad included relative to it
+        # (validate reads the quad, which has motors) and a cart beside it.
+        Base("field", "1.9", _WORLD.format(v="1.9"),
+             {"quad": _QUAD.format(v="1.9"), "quad_base": _QUAD_BASE.format(v="1.9")},
+             _WORLD_MUTATIONS, "worlds/field.sdf"),
         # A 1.9 file including a Classic 1.6 model: each file is read at its own version.
         Base("iris", "1.9", _CLASSIC.format(v="1.9"), {"gps": _GPS.format(v="1.6")},
              _BY_VERSION),
@@ -159,7 +182,13 @@ _BY_VERSION = ("dc_link", "dc_joint", "dc_frame", "dc_model", "dc_visual", "dup_
 # when it does not apply to that base.
 
 def _model(root):
-    return root.find("model")
+    """The model a mutation edits: the file's model, or in a world its last model."""
+    model = root.find("model")
+    return model if model is not None else root.find("world").findall("model")[-1]
+
+
+def _world(root):
+    return root.find("world")
 
 
 def _find(root, tag, name):
@@ -467,6 +496,85 @@ def no_version(root, v):
     return True
 
 
+def world_dup_model(root, v):
+    world = _world(root)
+    if world is None:
+        return False
+    world.append(copy.deepcopy(_model(root)))
+    return True
+
+
+def world_frame_missing(root, v):
+    world = _world(root)
+    if world is None:
+        return False
+    etree.SubElement(world, "frame", name="lost", attached_to="no_such_model")
+    return True
+
+
+def world_frame_cycle(root, v):
+    world = _world(root)
+    if world is None:
+        return False
+    etree.SubElement(world, "frame", name="ping", attached_to="pong")
+    etree.SubElement(world, "frame", name="pong", attached_to="ping")
+    return True
+
+
+def world_pose_missing(root, v):
+    world = _world(root)
+    if world is None:
+        return False
+    _pose(_model(root), "no_such_frame")
+    return True
+
+
+def world_frame_in_model(root, v):
+    """Accepted: a world frame attached to a frame inside a model, scoped."""
+    world = _world(root)
+    if world is None:
+        return False
+    etree.SubElement(world, "frame", name="wheel_hub", attached_to="cart::wheel_joint")
+    return True
+
+
+def static_link_double_colon(root, v):
+    """A link of the static ground plane, which validate does not read, named with '::'."""
+    world = _world(root)
+    if world is None:
+        return False
+    world.find("model").find("link").set("name", "ground::link")
+    return True
+
+
+def static_joint_child_missing(root, v):
+    world = _world(root)
+    if world is None:
+        return False
+    joint = etree.SubElement(world.find("model"), "joint", name="anchor", type="fixed")
+    etree.SubElement(joint, "parent").text = "link"
+    etree.SubElement(joint, "child").text = "no_such_link"
+    return True
+
+
+def static_duplicate_link(root, v):
+    world = _world(root)
+    if world is None:
+        return False
+    ground = world.find("model")
+    ground.append(copy.deepcopy(ground.find("link")))
+    return True
+
+
+_WORLD_MUTATIONS = (
+    "world_dup_model", "world_frame_missing", "world_frame_cycle", "world_pose_missing",
+    "world_frame_in_model", "static_link_double_colon", "static_joint_child_missing",
+    "static_duplicate_link", "dc_link", "dc_model", "dup_link", "link_named_as_joint",
+    "reserved_model_world", "joint_child_is_parent", "joint_child_missing",
+    "frame_attached_missing", "pose_relative_own_joint", "canonical_missing",
+    "nested_without_link", "dup_visual")
+
+
 MUTATIONS: list[Callable] = [
     dc_link, dc_joint, dc_frame, dc_model, dc_visual, dc_plugin_name,
     dup_link, dup_joint, link_named_as_joint, frame_named_as_link, dup_nested_model,
@@ -479,6 +587,9 @@ MUTATIONS: list[Callable] = [
     pose_relative_missing, pose_relative_itself, pose_relative_own_joint, pose_frame_cycle,
     canonical_missing, canonical_nested, nested_without_link, nested_without_link_static,
     visual_collision_same_name, no_version,
+    world_dup_model, world_frame_missing, world_frame_cycle, world_pose_missing,
+    world_frame_in_model, static_link_double_colon, static_joint_child_missing,
+    static_duplicate_link,
 ]
 # Applied to the included model file as well, where a base includes one.
 INCLUDED_MUTATIONS: list[Callable] = [
@@ -524,6 +635,8 @@ def mutants() -> list[Mutant]:
             if text is not None:
                 found.append(Mutant(base, mutate.__name__, text))
         for name, model_text in base.models.items():
+            if base.top_path:
+                continue   # a world's included models are the quad base's, mutated there
             for mutate in INCLUDED_MUTATIONS:
                 text = _mutated(model_text, mutate)
                 if text is not None:

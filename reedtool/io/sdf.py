@@ -125,9 +125,10 @@ def load_sdf_models(path: Path | str, *, resolver=None) -> list[Robot]:
     root, sources, resolver = _document(text, path, resolver)
     models = _candidate_models(root, path, sources)
     with_motors = [m for m in models if _has_motor_plugin(m)]
-    robots = [_read_model(m, path, resolver, sources) for m in (with_motors or models)]
+    read = with_motors or models
+    robots = [_read_model(m, path, resolver, sources) for m in read]
     # What libsdformat refuses refuses the whole file: said once, with the first model.
-    robots[0].parse_issues += _refusals(root, sources)
+    robots[0].parse_issues += _refusals(root, sources, read)
     return robots
 
 
@@ -137,12 +138,14 @@ def parse_sdf(xml_text: str, file: Path | str, *, resolver=None,
     root, sources, resolver = _document(xml_text, file, resolver)
     model = _pick_model(root, file, sources, model_name)
     robot = _read_model(model, file, resolver, sources)
-    robot.parse_issues += _refusals(root, sources)
+    robot.parse_issues += _refusals(root, sources, [model])
     return robot
 
 
-def _refusals(root: etree._Element, sources: SourceMap) -> list[ParseIssue]:
-    """libsdformat's structural refusals of the expanded document (reedtool.io.sdf_refusals)."""
+def _refusals(root: etree._Element, sources: SourceMap, read) -> list[ParseIssue]:
+    """libsdformat's structural refusals of the expanded document (reedtool.io.sdf_refusals);
+    `read`: the models read into robots, whose own rules (S105) report a joint's missing
+    parent or child."""
     versions: dict[Path, tuple[int, int]] = {}
 
     def version_of(el: etree._Element) -> tuple[int, int]:
@@ -155,7 +158,7 @@ def _refusals(root: etree._Element, sources: SourceMap) -> list[ParseIssue]:
     def loc(el: etree._Element) -> SourceLoc:
         return SourceLoc(str(sources.file_of(el).path), sources.line_of(el))
 
-    issues = document_refusals(root, loc=loc, version_of=version_of)
+    issues = document_refusals(root, loc=loc, version_of=version_of, read_models=read)
     for uri, file, line in sources.include_uris:
         if machine_path(uri):
             issues.append(ParseIssue("absolute-uri", f"<include> <uri>{uri}</uri> names a "

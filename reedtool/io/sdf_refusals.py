@@ -61,21 +61,25 @@ class _Context:
     version_of: Callable[[etree._Element], tuple[int, int]]
     top_version: tuple[int, int]
     issues: list
+    read_models: frozenset = frozenset()   # models read into robots: S105 is theirs
 
     def add(self, kind: str, message: str, el: etree._Element, subject: str | None) -> None:
         self.issues.append(ParseIssue(f"sdf-refused-{kind}", message, self.loc(el), subject))
 
 
-def document_refusals(root: etree._Element, *, loc, version_of) -> list[ParseIssue]:
+def document_refusals(root: etree._Element, *, loc, version_of,
+                      read_models=()) -> list[ParseIssue]:
     """Every structural refusal of the expanded `<sdf>` document `root`.
 
     `loc(el)`: the source location of an element; `version_of(el)`: the SDF version
-    (major, minor) declared by the file the element was read from.
+    (major, minor) declared by the file the element was read from; `read_models`: the
+    top-level models read into robots, whose joints naming no link S105 reports (in the
+    others, a static ground plane or a model beside the vehicle, it is reported here).
     """
     issues: list[ParseIssue] = []
     declared = root.get("version")
     top_version = parse_version(declared)
-    ctx = _Context(loc, version_of, top_version or (1, 6), issues)
+    ctx = _Context(loc, version_of, top_version or (1, 6), issues, frozenset(read_models))
     if top_version is None:
         # parser.cc readDoc: "<sdf> element has no version" and the file is not read.
         ctx.add("version", "<sdf> has no version= (or one that is not a number): "
@@ -85,6 +89,7 @@ def document_refusals(root: etree._Element, *, loc, version_of) -> list[ParseIss
     _double_colons(root, ctx)
     for world in root.iterfind("world"):
         _sibling_names(world, ctx, "world")
+        _world_frames(world, ctx)
         for model in world.iterfind("model"):
             _model(model, ctx)
     for model in root.iterfind("model"):
@@ -111,11 +116,13 @@ def _double_colons(root: etree._Element, ctx: _Context) -> None:
     walk(root)
 
 
-def _sibling_names(parent: etree._Element, ctx: _Context, what: str) -> None:
+def _sibling_names(parent: etree._Element, ctx: _Context, what: str,
+                   unread: bool = False) -> None:
     """World.cc/Model.cc Load: two frame-graph siblings of one name. Same-type duplicates
     are errors in every version ("already exists"); a link, joint, frame or model sharing
     a name with a sibling of another type is an error from SDF 1.7 on (below, libsdformat
-    renames it with a warning). Links and joints of one name are S106/S107's."""
+    renames it with a warning). Links and joints of one name are S106/S107's in the models
+    validate reads."""
     seen: dict[str, etree._Element] = {}
     types = _FRAME_ELEMENTS if what == "model" else ("model", "frame", "light")
     for el in parent:
@@ -126,7 +133,8 @@ def _sibling_names(parent: etree._Element, ctx: _Context, what: str) -> None:
         if first is None:
             seen[name] = el
             continue
-        if first.tag == el.tag and el.tag in ("link", "joint") and what == "model":
+        if first.tag == el.tag and el.tag in ("link", "joint") and what == "model" \
+                and not unread:
             continue   # S106 / S107
         if first.tag != el.tag and ctx.version_of(el) < (1, 7):
             continue
@@ -183,6 +191,46 @@ def _inside_plugin_or_nested(el: etree._Element, model: etree._Element) -> bool:
 
 # ------------------------------------------------------------------ frame graphs
 
+def _world_frames(world: etree._Element, ctx: _Context) -> None:
+    """parser.cc checkFrameAttachedToNames/Graph and checkPoseRelativeToGraph for a world,
+    every version: a world <frame attached_to=> or a model's or frame's <pose relative_to=>
+    naming no model or frame of the world (`model::frame` reaches into a model), naming
+    itself, or closing a cycle."""
+    scopes = {el.get("name"): _Scope(el, ctx) for el in world.iterfind("model")}
+    frames = {el.get("name"): el for el in world.iterfind("frame")}
+
+    def known(ref: str) -> bool:
+        if ref == "world" or ref in scopes or ref in frames:
+            return True
+        head, sep, rest = ref.partition("::")
+        return bool(sep) and head in scopes and scopes[head].find(rest) is not None
+
+    edges: dict[str, tuple[str, etree._Element]] = {}
+    for el in [*world.iterfind("model"), *world.iterfind("frame")]:
+        name = el.get("name") or ""
+        attached = el.get("attached_to") if el.tag == "frame" else None
+        if attached:
+            if attached == name:
+                ctx.add("attached-to", f"world frame '{name}' is attached to itself", el, name)
+            elif not known(attached):
+                ctx.add("attached-to", f"world frame '{name}' attached_to=\"{attached}\" names "
+                        "no model or frame of the world", el, name)
+            else:
+                edges[name] = (attached, el)
+        pose = el.find("pose")
+        relative_to = pose.get("relative_to") if pose is not None else None
+        if relative_to:
+            if relative_to == name:
+                ctx.add("relative-to", f"<{el.tag} name=\"{name}\"> is posed relative_to "
+                        "itself", pose, name)
+            elif not known(relative_to):
+                ctx.add("relative-to", f"<{el.tag} name=\"{name}\">: <pose relative_to="
+                        f"\"{relative_to}\"> names no model or frame of the world", pose, name)
+            else:
+                edges[name] = (relative_to, pose)
+    _cycles(edges, ctx, "attached_to/relative_to")
+
+
 class _Scope:
     """One <model>'s frame-graph nodes, with scoped lookup into nested models."""
 
@@ -237,11 +285,11 @@ def _model(model: etree._Element, ctx: _Context) -> None:
     if is_reserved_name(name):
         ctx.add("reserved-name", f"<model name=\"{name}\">: libsdformat reserves 'world' and "
                 "names of the form __x__", model, name)
-    _check_scope(_Scope(model, ctx), ctx)
+    _check_scope(_Scope(model, ctx), ctx, unread=model not in ctx.read_models)
 
 
-def _check_scope(scope: _Scope, ctx: _Context) -> None:
-    _sibling_names(scope.model, ctx, "model")
+def _check_scope(scope: _Scope, ctx: _Context, unread: bool = False) -> None:
+    _sibling_names(scope.model, ctx, "model", unread)
     _reserved_names(scope.model, ctx)
     for el in scope.model:
         if isinstance(el.tag, str) and el.tag in _UNIQUE_CHILDREN:
@@ -249,10 +297,10 @@ def _check_scope(scope: _Scope, ctx: _Context) -> None:
     _without_link(scope, ctx)
     _canonical_link(scope, ctx)
     _attached_to(scope, ctx)
-    _joint_frames(scope, ctx)
+    _joint_frames(scope, ctx, unread)
     _relative_to(scope, ctx)
     for nested in scope.nested.values():
-        _check_scope(nested, ctx)
+        _check_scope(nested, ctx, unread)
 
 
 def _is_true(text: str | None) -> bool:
@@ -333,10 +381,11 @@ def _attached_to(scope: _Scope, ctx: _Context) -> None:
                     el, name)
 
 
-def _joint_frames(scope: _Scope, ctx: _Context) -> None:
+def _joint_frames(scope: _Scope, ctx: _Context, unread: bool = False) -> None:
     """parser.cc checkScopedJointParentChildNames and Joint.cc Load, every version: a
     joint's child that is `world` or the joint itself, a parent that is the joint itself,
-    a parent or child naming no frame, and a parent and child resolving to one link."""
+    a parent or child naming no frame (in a model validate does not read; S105 reports
+    it in the others), and a parent and child resolving to one link."""
     for el in scope.model.iterfind("joint"):
         name = scope.own_name.get(el, el.get("name") or "")
         parent = (el.findtext("parent") or "").strip()
@@ -351,6 +400,9 @@ def _joint_frames(scope: _Scope, ctx: _Context) -> None:
                 problems.append(f"its {role} is the joint itself")
             elif ref == "__root__":
                 problems.append(f"its {role} '__root__' is not a frame")
+            elif unread and ref != "world" and ref.rpartition("::")[2] != MODEL_FRAME \
+                    and scope.find(ref) is None:
+                problems.append(f"its {role} '{ref}' names no link, joint, frame or model")
         if not problems and child != name and parent != name:
             parent_link, _ = _link_of(scope, parent)
             child_link, _ = _link_of(scope, child)
@@ -390,6 +442,11 @@ def _relative_to(scope: _Scope, ctx: _Context) -> None:
             edges[name] = ((el.findtext("child") or "").strip(), el)
         elif el.tag == "frame" and el.get("attached_to"):
             edges[name] = (el.get("attached_to"), el)
+    _cycles(edges, ctx, "relative_to")
+
+
+def _cycles(edges: dict[str, tuple[str, etree._Element]], ctx: _Context, what: str) -> None:
+    """Each cycle of `edges` (name -> (the name it depends on, element)) once."""
     reported: set[str] = set()
     for start in edges:
         path = [start]
@@ -400,8 +457,8 @@ def _relative_to(scope: _Scope, ctx: _Context) -> None:
                 cycle = path[path.index(node):]
                 if not reported.intersection(cycle):
                     reported.update(cycle)
-                    target, el = edges[cycle[0]]
-                    ctx.add("relative-to", "poses relative_to one another in a cycle: "
+                    _target, el = edges[cycle[0]]
+                    ctx.add("relative-to", f"poses {what} one another in a cycle: "
                             + " -> ".join([*cycle, node]), el, cycle[0])
                 break
             path.append(node)
