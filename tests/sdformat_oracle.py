@@ -36,9 +36,14 @@ from pydrake.multibody.plant import MultibodyPlant
 DRAKE_ONLY_REFUSALS = (
     (r"Drake does not support|is not supported by Drake", None,
      "a feature Drake's multibody plant does not model"),
-    (r"not defined in SDF\. Copying", None,
-     "an element the file's SDF version does not define: libsdformat copies it with a "
-     "warning (PX4's <gz_frame_id>, 1.6's <use_parent_model_frame> in a 1.7 file)"),
+    (r"not defined in SDF\. Copying|XML Attribute\[[^\]]*\] in element\[[^\]]*\] not "
+     r"defined in SDF", None,
+     "an element or attribute the file's SDF version does not define: libsdformat copies "
+     "or drops it with a warning (PX4's <gz_frame_id>, 1.6's <use_parent_model_frame> "
+     "or <pose frame=''> in a newer file)"),
+    (r"Drake must never use ParserConfig::GlobalConfig\(\)", None,
+     "a Drake assertion met by elements libsdformat loads with its global configuration "
+     "(particle emitters)"),
     (r"Non-unique name\[[^\]]*\] detected", (1, 7),
      "below SDF 1.7 libsdformat renames a link, joint or frame that takes a sibling's "
      "name, with a warning (Model.cc)"),

@@ -84,6 +84,8 @@ CASES = [
     # An absolute file:// mesh: machine-bound (S169), and missing here (S115).
     ("S169_bad_absolute_mesh.urdf", ["S115", "S169"]),
     ("S169_good_relative_mesh.urdf", []),
+    ("S170_bad_script_without_uri.sdf", ["S170"]),
+    ("S170_good_colour_material.sdf", []),
 ]
 
 

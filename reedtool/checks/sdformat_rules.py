@@ -1,4 +1,4 @@
-"""libsdformat's structural refusals (S160-S168) and machine-bound file references (S169).
+"""libsdformat's structural refusals (S160-S168, S170) and machine-bound file URIs (S169).
 
 Gazebo reads SDF through libsdformat, which refuses a file whose names or frame
 references break SDFormat's rules before any physics is built. reedtool.io.sdf_refusals
@@ -15,6 +15,15 @@ from typing import Iterator
 from reedtool.checks.context import CheckContext
 from reedtool.checks.finding import Issue
 from reedtool.checks.registry import rule
+
+
+def _has_gz_system(ctx: CheckContext) -> bool:
+    for _block, plugin in ctx.robot.plugins():
+        text = f"{plugin.filename or ''} {plugin.name or ''}".lower()
+        if any(mark in text for mark in ("gz-sim", "gz::sim", "ignition-gazebo",
+                                         "ignition::gazebo")):
+            return True
+    return False
 
 
 def _refusals(ctx: CheckContext, kind: str, hint: str) -> Iterator[Issue]:
@@ -177,6 +186,30 @@ def sdf_version_missing(ctx: CheckContext) -> Iterator[Issue]:
     """
     yield from _refusals(ctx, "version", "declare the version the file is written in, e.g. "
                                          "<sdf version=\"1.9\">")
+
+
+@rule("S170", "sdf-material-script-uri", "error",
+      "A material <script> has no <uri>: gz-sim's libsdformat refuses it.", clause="refused")
+def sdf_material_script_uri(ctx: CheckContext) -> Iterator[Issue]:
+    """Gazebo classic names a material by an OGRE script it finds in its own media paths
+    (`<script><name>Gazebo/Black</name></script>`). The libsdformat DOM that gz-sim loads
+    (Material.cc's `Load`) requires the script's `<uri>` and refuses the file without it,
+    so a Classic model's materials written into a gz model stop it from loading. Write
+    `<ambient>`/`<diffuse>` colours (what gz-sim draws) instead, or give the `<uri>`.
+
+    Reported for models made for gz-sim (a gz-sim system among their plugins): a Classic
+    model loads where it is meant to, and one without plugins (PX4 Classic's land_pad,
+    boxes and shelves) may be for either.
+
+    Applies from: every version (libsdformat 9's DOM already refused it; Gazebo classic
+    does not load materials through the DOM).
+
+    Severity (error, refused): gz-sim refuses the model.
+    """
+    if not _has_gz_system(ctx):
+        return
+    yield from _refusals(ctx, "script-uri", "replace the <script> with <ambient> and "
+                                            "<diffuse> colours, or give its <uri>")
 
 
 @rule("S169", "file-uri-absolute", "warning",

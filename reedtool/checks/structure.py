@@ -32,7 +32,7 @@ _ROUTED_KINDS = frozenset({
     "package-duplicate",        # S150
     *(f"sdf-refused-{kind}" for kind in (   # S160-S168: libsdformat's structural refusals
         "double-colon", "name-collision", "reserved-name", "canonical-link", "attached-to",
-        "relative-to", "joint-frames", "model-without-link", "version")),
+        "relative-to", "joint-frames", "model-without-link", "version", "script-uri")),
     "absolute-uri",             # S169
 })
 # libsdformat's joint types (sdf/1.x/joint.sdf): what an SDF <joint type=> may be.

@@ -87,6 +87,7 @@ def document_refusals(root: etree._Element, *, loc, version_of,
                 f"<sdf version=\"{declared}\"> is not a version: libsdformat does not read "
                 "the file", root, None)
     _double_colons(root, ctx)
+    _material_scripts(root, ctx)
     for world in root.iterfind("world"):
         _sibling_names(world, ctx, "world")
         _world_frames(world, ctx)
@@ -114,6 +115,29 @@ def _double_colons(root: etree._Element, ctx: _Context) -> None:
             walk(child)
 
     walk(root)
+
+
+def _material_scripts(root: etree._Element, ctx: _Context) -> None:
+    """Material.cc Load (the DOM gz-sim loads through), every version: a material
+    `<script>` without a `<uri>` ("A <script> element is missing a child <uri> element").
+    Gazebo classic reads the script by name from its own media paths and does not care."""
+    for script in root.iter("script"):
+        if script.getparent() is None or script.getparent().tag != "material" \
+                or _inside_plugin(script):
+            continue
+        if not (script.findtext("uri") or "").strip():
+            name = (script.findtext("name") or "").strip()
+            ctx.add("script-uri", f"material <script> '{name}' has no <uri>: the libsdformat "
+                    "DOM that gz-sim loads refuses it", script, name or None)
+
+
+def _inside_plugin(el: etree._Element) -> bool:
+    node = el.getparent()
+    while node is not None:
+        if not _validated(node):
+            return True
+        node = node.getparent()
+    return False
 
 
 def _sibling_names(parent: etree._Element, ctx: _Context, what: str,
