@@ -41,6 +41,8 @@ DRAKE_ONLY_REFUSALS = (
      "an element or attribute the file's SDF version does not define: libsdformat copies "
      "or drops it with a warning (PX4's <gz_frame_id>, 1.6's <use_parent_model_frame> "
      "or <pose frame=''> in a newer file)"),
+    (r"LinkJointGraph already has joint", None,
+     "Drake builds one joint between two links; libsdformat allows several"),
     (r"Drake must never use ParserConfig::GlobalConfig\(\)", None,
      "a Drake assertion met by elements libsdformat loads with its global configuration "
      "(particle emitters)"),

@@ -86,6 +86,8 @@ CASES = [
     ("S169_good_relative_mesh.urdf", []),
     ("S170_bad_script_without_uri.sdf", ["S170"]),
     ("S170_good_colour_material.sdf", []),
+    ("S171_bad_two_models.sdf", ["S171"]),
+    ("S171_good_models_in_world.sdf", []),
 ]
 
 

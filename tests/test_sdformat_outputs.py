@@ -100,19 +100,19 @@ def test_fixture_loads_in_libsdformat_or_validate_refuses_it(path):
 
 
 def test_the_structural_fixtures_are_what_libsdformat_says():
-    """Each S160-S168 and S170 bad fixture is refused by libsdformat, each good one
+    """Each S160-S168, S170 and S171 bad fixture is refused by libsdformat, each good one
     accepted (or refused by Drake alone, for the reason named)."""
     import sdformat_oracle
 
     checked = 0
     for path in sorted([*(FIXTURES / "validate").glob("S16*.sdf"),
-                        *(FIXTURES / "validate").glob("S170_*.sdf")]):
+                        *(FIXTURES / "validate").glob("S17[01]_*.sdf")]):
         error = _libsdformat_error(path)
         refused = error is not None and not sdformat_oracle.drake_only_reason(
             error, _declared_version(path))
         assert refused == ("_bad_" in path.name), (path.name, error)
         checked += 1
-    assert checked >= 14
+    assert checked >= 16
 
 
 # new-package's accepted combinations: gz needs ROS 2 and a multirotor; --autopilot a

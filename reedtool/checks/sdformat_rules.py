@@ -1,4 +1,5 @@
-"""libsdformat's structural refusals (S160-S168, S170) and machine-bound file URIs (S169).
+"""libsdformat's structural refusals (S160-S168, S170, S171) and machine-bound file URIs
+(S169).
 
 Gazebo reads SDF through libsdformat, which refuses a file whose names or frame
 references break SDFormat's rules before any physics is built. reedtool.io.sdf_refusals
@@ -132,7 +133,9 @@ def sdf_pose_relative_to_invalid(ctx: CheckContext) -> Iterator[Issue]:
     model or `__model__`), and following the poses must end at the model frame: a link
     posed relative to its own joint, whose pose is relative to that link (a joint's
     default), is a cycle. libsdformat's `checkPoseRelativeToGraph` (parser.cc; the graph
-    is built by Model.cc's `buildPoseRelativeToGraph`) refuses both.
+    is built by Model.cc's `buildPoseRelativeToGraph`) refuses both, and `Model::Load`
+    refuses a `relative_to` on the file's top model, which has no frame to refer to. In a
+    world, models and frames are posed relative to the world's models and frames.
 
     Applies from: every version (libsdformat converts a 1.6 file up and checks it too).
 
@@ -149,7 +152,8 @@ def sdf_joint_frames_invalid(ctx: CheckContext) -> Iterator[Issue]:
     """A joint moves its child relative to its parent, so the two must resolve to
     different links; the child cannot be `world`, and neither may be the joint itself.
     libsdformat's `checkJointParentChildNames` (parser.cc; Joint.cc's `Load` for a `world`
-    child) refuses the model. A parent or child naming nothing is S105.
+    child) refuses the model. A parent or child naming nothing is S105 (here for models
+    validate does not read as vehicles, and for a world's joints, SDF 1.10).
 
     Applies from: every version.
 
@@ -210,6 +214,21 @@ def sdf_material_script_uri(ctx: CheckContext) -> Iterator[Issue]:
         return
     yield from _refusals(ctx, "script-uri", "replace the <script> with <ambient> and "
                                             "<diffuse> colours, or give its <uri>")
+
+
+@rule("S171", "sdf-root-several-models", "error",
+      "An SDF file holds more than one top-level model, light or actor.", clause="refused")
+def sdf_root_several_models(ctx: CheckContext) -> Iterator[Issue]:
+    """Outside a `<world>`, an SDF file describes one thing: a model, a light or an actor.
+    libsdformat's `Root::Load` (Root.cc) refuses a second one ("Root object can only
+    contain one model"); several models belong in a world. reedtool reads the first.
+
+    Applies from: every version.
+
+    Severity (error, refused): libsdformat refuses the file.
+    """
+    yield from _refusals(ctx, "root-elements", "put the models in a <world>, or in files "
+                                               "of their own")
 
 
 @rule("S169", "file-uri-absolute", "warning",

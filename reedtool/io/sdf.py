@@ -438,11 +438,21 @@ class _ModelReader:
                 return self.canonical_link(nested_scope[:-2])
         return None
 
+    def _top_canonical(self) -> str | None:
+        """The top model's canonical link: its canonical_link=, else its first link."""
+        if self.canonical:
+            return self.canonical
+        return next((name for name, scope, _el in self.link_els if scope == ""), None)
+
     def body_of(self, name: str | None, _seen: tuple[str, ...] = ()) -> str | None:
         """A joint's parent/child as a link: a nested model -> its canonical link, a frame
         -> the link it is attached to; links and unknown names stay as written."""
         if name is None or name == "world" or name in _seen:
             return name
+        if name == MODEL_FRAME or name.endswith("::" + MODEL_FRAME):
+            # A joint naming its model's frame is attached to the model's canonical link.
+            scoped = name[:-len(MODEL_FRAME) - 2]
+            return (self.canonical_link(scoped) if scoped else self._top_canonical()) or name
         if name + "::" + MODEL_FRAME in self.frames:
             return self.canonical_link(name) or name
         if name in self.attached_to:
@@ -500,6 +510,7 @@ class _ModelReader:
     # ------------------------------------------------------------ elements
     def read(self, model: etree._Element) -> Robot:
         name = model.get("name", "")
+        self.canonical = model.get("canonical_link")
         self._collect(model, "")
         canonical = model.get("canonical_link")
         robot = Robot(name=name, loc=self.loc(model), source_file=self.file,

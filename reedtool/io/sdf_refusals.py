@@ -5,7 +5,7 @@ frame references libsdformat checks before that (sdformat's src/parser.cc and th
 `Load`s of Model, Link, Joint and Frame) are judged here on the document after include
 expansion, as libsdformat judges it after its own. Each check names the sdformat function
 it mirrors and the SDF versions it applies to; every finding is a `ParseIssue` whose kind
-starts with `sdf-refused-` (rules S160-S167 report them, one kind each).
+starts with `sdf-refused-` (rules S160-S168, S170 and S171 report them, one kind each).
 
 Versions: a file is read at the version its `<sdf version=>` declares. The `::` check
 (`recursiveSiblingNoDoubleColonInNames`) runs from 1.8 on, over the file and everything it
@@ -93,9 +93,28 @@ def document_refusals(root: etree._Element, *, loc, version_of,
         _world_frames(world, ctx)
         for model in world.iterfind("model"):
             _model(model, ctx)
+    _root_elements(root, ctx)
     for model in root.iterfind("model"):
         _model(model, ctx)
+        pose = model.find("pose")
+        if pose is not None and pose.get("relative_to"):
+            # Model.cc Load: a top-level model has no frame to be posed relative to.
+            ctx.add("relative-to", f"model '{model.get('name')}' is the file's top model: its "
+                    f"<pose relative_to=\"{pose.get('relative_to')}\"> must be left out",
+                    pose, model.get("name"))
     return issues
+
+
+def _root_elements(root: etree._Element, ctx: _Context) -> None:
+    """Root.cc Load, every version: an `<sdf>` holds one model, light or actor (or
+    worlds): "Root object can only contain one model"."""
+    elements = [el for el in root if isinstance(el.tag, str)
+                and el.tag in ("model", "light", "actor")]
+    for el in elements[1:]:
+        ctx.add("root-elements", f"<{el.tag} name=\"{el.get('name')}\"> is a second "
+                f"top-level element (the first: <{elements[0].tag} name=\""
+                f"{elements[0].get('name')}\">): libsdformat reads one model, light or "
+                "actor per file", el, el.get("name"))
 
 
 # ------------------------------------------------------------------ names
@@ -253,6 +272,40 @@ def _world_frames(world: etree._Element, ctx: _Context) -> None:
             else:
                 edges[name] = (relative_to, pose)
     _cycles(edges, ctx, "attached_to/relative_to")
+
+    def link_of(ref: str, seen: tuple = ()):
+        """The link (element) or "world" a world-level reference is attached to."""
+        if ref in ("", "world") or ref in seen:
+            return "world" if ref in ("", "world") else None
+        if ref in frames:
+            return link_of(frames[ref].get("attached_to") or "world", seen + (ref,))
+        head, sep, rest = ref.partition("::")
+        scope = scopes.get(ref) or (scopes.get(head) if sep else None)
+        if scope is None:
+            return None
+        return _link_of(scope, rest if sep and ref not in scopes else MODEL_FRAME)[0]
+
+    # World joints (SDF 1.10): World.cc Load and checkScopedJointParentChildNames.
+    for el in world.iterfind("joint"):
+        name = el.get("name") or ""
+        parent = (el.findtext("parent") or "").strip()
+        child = (el.findtext("child") or "").strip()
+        problems = []
+        for role, ref in (("parent", parent), ("child", child)):
+            if ref == name:
+                problems.append(f"its {role} is the joint itself")
+            elif not known(ref):
+                problems.append(f"its {role} '{ref}' names no model or frame of the world")
+        if child == "world":
+            problems.append("its child is 'world'")
+        elif not problems:
+            parent_link, child_link = link_of(parent), link_of(child)
+            if child_link == "world":
+                problems.append(f"its child '{child}' is attached to the world")
+            elif parent_link is not None and parent_link is child_link:
+                problems.append(f"its parent '{parent}' and child '{child}' are on one link")
+        for problem in problems:
+            ctx.add("joint-frames", f"world joint '{name}': {problem}", el, name)
 
 
 class _Scope:
