@@ -15,8 +15,11 @@ Three bases of our own, in the shapes of real models (the facts carry over, not 
 frame, model and visual names; duplicate and colliding sibling names; reserved names; a
 joint's child equal to its parent, `world` or nothing; frames attached to nothing, to
 themselves or in a cycle; poses relative to nothing or in a cycle; a canonical_link
-naming nothing; a model without links; no `<sdf version>`), plus mutations libsdformat
-must accept (a plugin's name with `::`, `::` in a 1.7 name).
+naming nothing; a model without links; no `<sdf version>`; two top-level models; a top
+model posed relative_to; world frames, poses and duplicate models; a static model's
+names), plus mutations libsdformat must accept (a plugin's name with `::`, a scoped
+canonical_link, a static model without links, a visual and a collision of one name, a
+world frame attached inside a model).
 """
 
 from __future__ import annotations
@@ -566,6 +569,30 @@ def static_duplicate_link(root, v):
     return True
 
 
+def root_two_models(root, v):
+    """A second model at the top of a model file (outside a world)."""
+    if root.find("model") is None:
+        return False
+    root.append(copy.deepcopy(root.find("model")))
+    root[-1].set("name", "copy")
+    return True
+
+
+def top_pose_relative(root, v):
+    """The file's top model posed relative to one of its links."""
+    model = root.find("model")
+    link = _first_link(root) if model is not None else None
+    if link is None:
+        return False
+    pose = model.find("pose")
+    if pose is None:
+        pose = etree.Element("pose")
+        pose.text = "0 0 0 0 0 0"
+        model.insert(0, pose)
+    pose.set("relative_to", link.get("name"))
+    return True
+
+
 _WORLD_MUTATIONS = (
     "world_dup_model", "world_frame_missing", "world_frame_cycle", "world_pose_missing",
     "world_frame_in_model", "static_link_double_colon", "static_joint_child_missing",
@@ -589,7 +616,7 @@ MUTATIONS: list[Callable] = [
     visual_collision_same_name, no_version,
     world_dup_model, world_frame_missing, world_frame_cycle, world_pose_missing,
     world_frame_in_model, static_link_double_colon, static_joint_child_missing,
-    static_duplicate_link,
+    static_duplicate_link, root_two_models, top_pose_relative,
 ]
 # Applied to the included model file as well, where a base includes one.
 INCLUDED_MUTATIONS: list[Callable] = [
