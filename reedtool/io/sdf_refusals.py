@@ -179,8 +179,9 @@ def _sibling_names(parent: etree._Element, ctx: _Context, what: str,
         if first.tag == el.tag and el.tag in ("link", "joint") and what == "model" \
                 and not unread:
             continue   # S106 / S107
-        if first.tag != el.tag and ctx.version_of(el) < (1, 7):
-            continue
+        if first.tag != el.tag and (ctx.version_of(el) < (1, 7) or "light" in (first.tag,
+                                                                               el.tag)):
+            continue   # renamed below 1.7; a light is no frame (World.cc only warns)
         ctx.add("name-collision", f"<{el.tag} name=\"{name}\"> in {what} "
                 f"'{parent.get('name')}' takes the name of a <{first.tag}> (line "
                 f"{ctx.loc(first).line}): libsdformat refuses two frames of one name",
