@@ -82,8 +82,8 @@ def document_refusals(root: etree._Element, *, loc, version_of,
     ctx = _Context(loc, version_of, top_version or (1, 6), issues, frozenset(read_models))
     if top_version is None:
         # parser.cc readDoc: "<sdf> element has no version" and the file is not read.
-        ctx.add("version", "<sdf> has no version= (or one that is not a number): "
-                "libsdformat does not read the file" if declared is None else
+        ctx.add("version", "<sdf> has no version=: libsdformat does not read the file"
+                if declared is None else
                 f"<sdf version=\"{declared}\"> is not a version: libsdformat does not read "
                 "the file", root, None)
     _double_colons(root, ctx)
@@ -96,13 +96,19 @@ def document_refusals(root: etree._Element, *, loc, version_of,
     _root_elements(root, ctx)
     for model in root.iterfind("model"):
         _model(model, ctx)
-        pose = model.find("pose")
-        if pose is not None and pose.get("relative_to"):
-            # Model.cc Load: a top-level model has no frame to be posed relative to.
-            ctx.add("relative-to", f"model '{model.get('name')}' is the file's top model: its "
-                    f"<pose relative_to=\"{pose.get('relative_to')}\"> must be left out",
-                    pose, model.get("name"))
+        _top_model_pose(model, ctx)
     return issues
+
+
+def _top_model_pose(model: etree._Element, ctx: _Context) -> None:
+    """Model.cc Load, every version: the file's top model has no frame around it to be
+    posed relative to ("Attribute //pose[@relative_to] of top level model must be left
+    empty")."""
+    pose = model.find("pose")
+    if pose is not None and pose.get("relative_to"):
+        ctx.add("relative-to", f"model '{model.get('name')}' is the file's top model: its "
+                f"<pose relative_to=\"{pose.get('relative_to')}\"> must be left out", pose,
+                model.get("name"))
 
 
 def _root_elements(root: etree._Element, ctx: _Context) -> None:
