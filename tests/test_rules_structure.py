@@ -66,6 +66,28 @@ CASES = [
     # link kept by preserveFixedJoint, a limited revolute joint; the car a mesh in metres.
     ("clean_arm.urdf", []),
     ("clean_car.urdf", []),
+    # libsdformat's structural refusals (S160-S168); tests/test_sdformat_outputs.py shows
+    # libsdformat refusing each bad fixture and loading each good one.
+    ("S160_bad_double_colon_1_9.sdf", ["S160"]),
+    ("S160_good_double_colon_1_6.sdf", []),
+    ("S161_bad_link_named_as_joint.sdf", ["S101", "S161", "S165", "S166"]),
+    ("S161_bad_duplicate_visual.sdf", ["S161"]),
+    ("S161_good_renamed_below_1_7.sdf", []),   # PX4 rover_differential's caster shape
+    ("S162_bad_link_named_world.sdf", ["S162", "S166"]),
+    ("S163_bad_canonical_link.sdf", ["S163"]),
+    ("S164_bad_attached_to_cycle.sdf", ["S164", "S164", "S165"]),
+    ("S165_bad_relative_to_own_joint.sdf", ["S101", "S165"]),
+    ("S165_good_frames_nested.sdf", []),
+    ("S166_bad_joint_child_is_parent.sdf", ["S109", "S166"]),
+    ("S167_bad_nested_without_link.sdf", ["S167"]),
+    ("S168_bad_no_version.sdf", ["S168"]),
+    # An absolute file:// mesh: machine-bound (S169), and missing here (S115).
+    ("S169_bad_absolute_mesh.urdf", ["S115", "S169"]),
+    ("S169_good_relative_mesh.urdf", []),
+    ("S170_bad_script_without_uri.sdf", ["S170"]),
+    ("S170_good_colour_material.sdf", []),
+    ("S171_bad_two_models.sdf", ["S171"]),
+    ("S171_good_models_in_world.sdf", []),
 ]
 
 
@@ -157,3 +179,36 @@ def test_dbl_max_joint_limits_mean_no_limit(tmp_path, as_sdf):
         path = tmp_path / f"m{suffix}"
         path.write_text(text)
         assert [f.code for f in run_checks(load_robot(path)) if f.code == "S102"] == expected
+
+
+def test_an_absolute_file_uri_works_here_only(tmp_path):
+    """S169: a mesh and an <include> named by absolute paths that exist on this machine
+    load (no S115, no include error) and are still reported, once each; the same files
+    named relative to the model are not."""
+    import shutil
+
+    models = tmp_path / "models"
+    (models / "camera").mkdir(parents=True)
+    (models / "camera" / "model.config").write_text(
+        '<?xml version="1.0"?><model><name>camera</name><sdf version="1.9">model.sdf</sdf>'
+        "</model>")
+    (models / "camera" / "model.sdf").write_text(
+        '<sdf version="1.9"><model name="camera"><link name="link"><inertial><mass>0.05'
+        "</mass><inertia><ixx>1e-5</ixx><iyy>1e-5</iyy><izz>1e-5</izz></inertia></inertial>"
+        "</link></model></sdf>")
+    shutil.copy(FIXTURES / "meshes" / "camera_m.stl", models / "body.stl")
+
+    def model(mesh_uri: str, include_uri: str) -> list[str]:
+        path = models / "quad.sdf"   # model://camera resolves beside it
+        path.write_text(
+            '<sdf version="1.9"><model name="quad"><link name="base_link"><inertial>'
+            "<mass>0.1</mass><inertia><ixx>1.5e-05</ixx><iyy>3.75e-05</iyy><izz>3.75e-05</izz>"
+            f"</inertia></inertial><visual name='v'><geometry><mesh><uri>{mesh_uri}</uri>"
+            f"</mesh></geometry></visual></link><include><uri>{include_uri}</uri></include>"
+            '<joint name="cam" type="fixed"><parent>base_link</parent><child>camera::link'
+            "</child></joint></model></sdf>")
+        return sorted(f.code for f in run_checks(load_robot(path)) if f.code.startswith("S"))
+
+    absolute = model(f"file://{models}/body.stl", f"file://{models}/camera")
+    assert absolute == ["S169", "S169"]
+    assert model("body.stl", "model://camera") == []

@@ -206,8 +206,10 @@ def prove(original, model_sdf: Path, port: GzPort, request: MigrateRequest, cont
     # A macro call writes many elements at one line: the macro line tells them apart.
     dropped = [(loc.file, loc.line, loc.macro) for row in port.rows
                if row.action in ("dropped", "unknown") for loc in (row.source, *row.covers)]
+    resolved = {"S169": "--copy-outside-files copied the file into it"} \
+        if port.copy_outside_files else {}
     compare_findings(run_checks(original, selection), run_checks(ported, selection), proof,
-                     dropped)
+                     dropped, resolved)
     return proof
 
 

@@ -338,14 +338,18 @@ def _fly(vehicle, config) -> dict:
 
 # ------------------------------------------------------------------ findings
 
-def compare_findings(original: list, port: list, proof: Proof, dropped=()) -> None:
+def compare_findings(original: list, port: list, proof: Proof, dropped=(),
+                     resolved: dict | None = None) -> None:
     """Error and warning counts per code of validate on each side.
 
     `dropped`: (file, line, macro) of source elements the port leaves out. A finding on one of
     them (R312: the MAVLink interface's rotor count) goes with its element: it is listed
-    in the notes, not counted as hidden.
+    in the notes, not counted as hidden. `resolved`: code -> why, for the original's
+    findings the port settles because the user asked it to (S169, a file named by its
+    absolute path, with --copy-outside-files): listed in the notes.
     """
     dropped = set(dropped)
+    resolved = resolved or {}
 
     def keys(findings, side):
         out: dict[tuple[str, str], list] = {}
@@ -356,6 +360,10 @@ def compare_findings(original: list, port: list, proof: Proof, dropped=()) -> No
                 proof.notes.append(f"{f.code} ({f.severity}) on the original is about an "
                                    f"element the port leaves out ({f.file}:{f.line}): "
                                    f"{f.message}")
+                continue
+            if side == "original" and f.code in resolved:
+                proof.notes.append(f"{f.code} ({f.severity}) on the original is settled by "
+                                   f"the port ({resolved[f.code]}): {f.message}")
                 continue
             out.setdefault((f.code, f.severity), []).append(f)
         return out

@@ -102,7 +102,9 @@ REFUSAL_GROUPS: dict[str, tuple[str, ...]] = {
     # The tree Gazebo and Pinocchio build: unreadable or non-finite numbers, links, joints,
     # limits, geometry sizes, links Gazebo drops. The mesh files (S115 unresolved, S130
     # format, S131 escaping URI) are the look and the collisions, not the dynamics.
-    "structure": ("S1", "-S115", "-S130", "-S131", "-S140"),
+    # libsdformat's refusals of names, frame references and materials (S160-S171) stop
+    # Gazebo, not the computation: reedtool read the tree (an unreadable frame is S101's).
+    "structure": ("S1", "-S115", "-S130", "-S131", "-S140", "-S16", "-S170", "-S171"),
     # The masses and inertias every number is computed from. I210 (a mesh in the wrong
     # unit) is a mesh's size, not a declared mass.
     "mass": ("I2", "-I210"),

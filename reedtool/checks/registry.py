@@ -34,6 +34,7 @@ EXTRA_RULE_MODULES: tuple[str, ...] = (
     "reedtool.checks.flightstack_rules",
     "reedtool.checks.lee_rules",
     "reedtool.checks.plausibility_rules",
+    "reedtool.checks.sdformat_rules",
 )
 
 # The severity policy (docs/validate.md, "Severity policy"): each rule names the clause that

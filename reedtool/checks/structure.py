@@ -30,6 +30,10 @@ _ROUTED_KINDS = frozenset({
     "xml-declaration-late",     # S124
     "sdf-short-pose",           # S125
     "package-duplicate",        # S150
+    *(f"sdf-refused-{kind}" for kind in (   # S160-S168: libsdformat's structural refusals
+        "double-colon", "name-collision", "reserved-name", "canonical-link", "attached-to",
+        "relative-to", "joint-frames", "model-without-link", "version", "script-uri", "root-elements")),
+    "absolute-uri",             # S169
 })
 # libsdformat's joint types (sdf/1.x/joint.sdf): what an SDF <joint type=> may be.
 SDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "ball", "screw",
@@ -132,13 +136,18 @@ def single_root(ctx: CheckContext) -> Iterator[Issue]:
 @rule("S105", "joint-link-missing", "error", "A joint's parent or child link does not exist.", clause="refused")
 def joint_link_missing(ctx: CheckContext) -> Iterator[Issue]:
     """Every joint's `<parent link=>` and `<child link=>` must name a link of the model.
-    A typo or a missing namespace prefix here makes urdfdom reject the file.
+    A typo or a missing namespace prefix here makes urdfdom reject the file. In SDF a
+    parent may also be `world` (the model welded to the world), and a parent or child a
+    frame, joint, nested model or `__model__`, each standing for the link it is on.
 
     Severity (error, refused): urdfdom rejects the joint and Gazebo cannot create it.
     """
     links = ctx.robot.link_map
+    sdf = ctx.robot.source_format == "sdf"
     for joint in ctx.robot.joints:
         for role, name in (("parent", joint.parent), ("child", joint.child)):
+            if sdf and role == "parent" and name == "world":
+                continue   # an SDF model welded to the world (a child 'world' is S166)
             if name is not None and name not in links:
                 yield Issue(f"joint '{joint.name}': {role} link '{name}' does not exist",
                             joint.loc, joint.name, hint=_closest_hint(name, links))

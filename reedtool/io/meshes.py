@@ -160,6 +160,17 @@ def uri_problem(uri: str, path: Path | None = None) -> str | None:
     return None
 
 
+def machine_path(uri: str) -> str | None:
+    """The absolute path an absolute `file://` URI or plain absolute path names, else None
+    (`package://`, `model://`, relative paths and URLs travel with the model)."""
+    from urllib.parse import unquote, urlparse
+
+    text = unquote(uri.strip())
+    if text.startswith("file://"):
+        text = urlparse(text).path
+    return text if text.startswith("/") else None
+
+
 def format_problem(uri: str, simulator: str) -> str | None:
     """Why Gazebo cannot load this mesh file format, or None.
 

@@ -67,8 +67,10 @@ from lxml import etree
 from reedtool.errors import ReedtoolError
 from reedtool.io.fileio import magnitude_problem
 from reedtool.frames import make_T, matrix_to_rpy, rpy_to_matrix
+from reedtool.io.meshes import machine_path
 from reedtool.io.resources import resolve_model_file_uri
 from reedtool.io.sdf_include import SourceFile, SourceMap, expand_includes
+from reedtool.io.sdf_refusals import document_refusals, parse_version
 from reedtool.io.tolerant_xml import (
     late_declaration_issues,
     local_tag,
@@ -149,7 +151,11 @@ def load_sdf_models(path: Path | str, *, resolver=None) -> list[Robot]:
     root, sources, resolver = _document(text, path, resolver)
     models = _candidate_models(root, path, sources)
     with_motors = [m for m in models if _has_motor_plugin(m)]
-    return [_read_model(m, path, resolver, sources) for m in (with_motors or models)]
+    read = with_motors or models
+    robots = [_read_model(m, path, resolver, sources) for m in read]
+    # What libsdformat refuses refuses the whole file: said once, with the first model.
+    robots[0].parse_issues += _refusals(root, sources, read)
+    return robots
 
 
 def parse_sdf(xml_text: str, file: Path | str, *, resolver=None,
@@ -157,7 +163,34 @@ def parse_sdf(xml_text: str, file: Path | str, *, resolver=None,
     file = Path(file)
     root, sources, resolver = _document(xml_text, file, resolver)
     model = _pick_model(root, file, sources, model_name)
-    return _read_model(model, file, resolver, sources)
+    robot = _read_model(model, file, resolver, sources)
+    robot.parse_issues += _refusals(root, sources, [model])
+    return robot
+
+
+def _refusals(root: etree._Element, sources: SourceMap, read) -> list[ParseIssue]:
+    """libsdformat's structural refusals of the expanded document (reedtool.io.sdf_refusals);
+    `read`: the models read into robots, whose own rules (S105) report a joint's missing
+    parent or child."""
+    versions: dict[Path, tuple[int, int]] = {}
+
+    def version_of(el: etree._Element) -> tuple[int, int]:
+        source = sources.file_of(el)
+        if source.path not in versions:
+            match = _SDF_VERSION.search("\n".join(source.lines[:200]))
+            versions[source.path] = parse_version(match.group(1) if match else None) or (1, 6)
+        return versions[source.path]
+
+    def loc(el: etree._Element) -> SourceLoc:
+        return SourceLoc(str(sources.file_of(el).path), sources.line_of(el))
+
+    issues = document_refusals(root, loc=loc, version_of=version_of, read_models=read)
+    for uri, file, line in sources.include_uris:
+        if machine_path(uri):
+            issues.append(ParseIssue("absolute-uri", f"<include> <uri>{uri}</uri> names a "
+                                     "file by its absolute path", SourceLoc(str(file), line),
+                                     uri))
+    return issues
 
 
 def _document(xml_text: str, file: Path, resolver):
@@ -432,11 +465,21 @@ class _ModelReader:
                 return self.canonical_link(nested_scope[:-2])
         return None
 
+    def _top_canonical(self) -> str | None:
+        """The top model's canonical link: its canonical_link=, else its first link."""
+        if self.canonical:
+            return self.canonical
+        return next((name for name, scope, _el in self.link_els if scope == ""), None)
+
     def body_of(self, name: str | None, _seen: tuple[str, ...] = ()) -> str | None:
         """A joint's parent/child as a link: a nested model -> its canonical link, a frame
         -> the link it is attached to; links and unknown names stay as written."""
         if name is None or name == "world" or name in _seen:
             return name
+        if name == MODEL_FRAME or name.endswith("::" + MODEL_FRAME):
+            # A joint naming its model's frame is attached to the model's canonical link.
+            scoped = name[:-len(MODEL_FRAME) - 2]
+            return (self.canonical_link(scoped) if scoped else self._top_canonical()) or name
         if name + "::" + MODEL_FRAME in self.frames:
             return self.canonical_link(name) or name
         if name in self.attached_to:
@@ -444,6 +487,17 @@ class _ModelReader:
         return name
 
     # ------------------------------------------------------------ collect
+    def _renamed(self, scope: str, name: str, el: etree._Element) -> str:
+        """The name libsdformat gives a joint or frame: below SDF 1.7 one that takes a
+        sibling's name is renamed NAME_joint / NAME_frame with a warning (Model.cc), and
+        references to NAME keep meaning the first (1.7 on refuses it: S161)."""
+        if scope + name not in self.frames or self._version(el) >= (1, 7):
+            return name
+        renamed, i = f"{name}_{el.tag}", 0
+        while scope + renamed in self.frames:
+            renamed, i = f"{name}_{el.tag}{i}", i + 1
+        return renamed
+
     def _collect(self, model: etree._Element, scope: str) -> None:
         """Register every frame of `model` (and its nested models) under scoped names."""
         for el in model:
@@ -455,12 +509,14 @@ class _ModelReader:
                 self.frames[scope + name] = _FrameEntry(self._scoped(scope, rel), T, el)
                 self.link_els.append((scope + name, scope, el))
             elif el.tag == "joint":
+                name = self._renamed(scope, name, el)
                 T, rel = self._pose(el.find("pose"), name)
                 child = (el.findtext("child") or "").strip()
                 self.frames[scope + name] = _FrameEntry(
                     self._scoped(scope, rel) if rel else self._scoped(scope, child), T, el)
                 self.joint_els.append((scope + name, scope, el))
             elif el.tag == "frame":
+                name = self._renamed(scope, name, el)
                 T, rel = self._pose(el.find("pose"), name)
                 placement = el.get("placement_frame")   # set on merged-include proxy frames
                 self.frames[scope + name] = _FrameEntry(
@@ -481,6 +537,7 @@ class _ModelReader:
     # ------------------------------------------------------------ elements
     def read(self, model: etree._Element) -> Robot:
         name = model.get("name", "")
+        self.canonical = model.get("canonical_link")
         self._collect(model, "")
         canonical = model.get("canonical_link")
         robot = Robot(name=name, loc=self.loc(model), source_file=self.file,

@@ -67,6 +67,8 @@ class SourceMap:
     lines: dict = field(default_factory=dict)
     tolerated: list[tuple[SourceFile, Tolerated]] = field(default_factory=list)
     unresolved: list[UnresolvedInclude] = field(default_factory=list)
+    # (uri, file, line) of every <include> read, for what a rule says about its URI.
+    include_uris: list[tuple[str, Path, int | None]] = field(default_factory=list)
 
     def file_of(self, el: etree._Element) -> SourceFile:
         node = el
@@ -223,6 +225,7 @@ def expand_includes(root: etree._Element, source: SourceFile, sources: SourceMap
         line = start_line("include", include.sourceline, source.lines)
         uri = (include.findtext("uri") or "").strip()
         in_world = parent is not None and parent.tag == "world"
+        sources.include_uris.append((uri, source.path, line))
         try:
             if not uri:
                 raise ReedtoolError("<include> has no <uri>")
