@@ -265,6 +265,56 @@ def geometry_mass_properties(geometry, T_link_geom, mass_kg: float) -> MassPrope
     return local.transformed(T_link_geom)
 
 
+def geometry_volume(geometry) -> tuple[float, bool]:
+    """(volume in m³, from_hull) of one URDF/SDF geometry as the simulator sizes it.
+
+    Primitives are exact. A mesh is read from its resolved path with its `scale`
+    applied; a closed mesh gives the volume it encloses, an open one its convex hull's
+    (from_hull True): a solid the open surface stands for lies inside that hull, so the
+    hull never under-states it. Raises ReedtoolError like geometry_mass_properties."""
+    if isinstance(geometry, Box):
+        return box_volume(geometry.size_m), False
+    if isinstance(geometry, Cylinder):
+        return cylinder_volume(geometry.radius_m, geometry.length_m), False
+    if isinstance(geometry, Sphere):
+        return sphere_volume(geometry.radius_m), False
+    props = geometry_mass_properties(geometry, np.eye(4), 1.0)
+    return float(props.volume_m3 or 0.0), props.from_hull
+
+
+@dataclass(frozen=True)
+class LinkVolume:
+    volume_m3: float
+    source: str          # "collision" or "visual": the group the volume is of
+    count: int           # geometries summed
+    from_hull: bool      # some mesh was open: its convex hull was measured
+
+
+def link_volume(link: Link) -> LinkVolume | None:
+    """The largest volume the link's geometry gives it: the sum over its collision
+    geometries or over its visual ones, whichever is larger; None when neither group
+    can be measured in full (an unresolved or unreadable mesh, no geometry at all).
+
+    Larger is the cautious side for a density bound: summing overlapping shapes counts
+    their overlap twice and only lowers mass / volume, never raises it."""
+    best: LinkVolume | None = None
+    for source, shapes in (("collision", link.collisions), ("visual", link.visuals)):
+        geometries = [shape.geometry for shape in shapes if shape.geometry is not None]
+        if not geometries:
+            continue
+        total, hull = 0.0, False
+        try:
+            for geometry in geometries:
+                volume, from_hull = geometry_volume(geometry)
+                total += volume
+                hull = hull or from_hull
+        except ReedtoolError:
+            continue
+        if math.isfinite(total) and total > 0 and (best is None or total > best.volume_m3):
+            best = LinkVolume(total, source, len(geometries), hull)
+    return best
+
+
 def declared_mass_properties(link: Link) -> MassProperties | None:
     """The link's <inertial> in the link frame (tensor rotated into link axes), or None."""
     inertial = link.inertial
