@@ -13,11 +13,13 @@ the last row held beyond them): one constant cannot follow CT's rise with speed,
 top of the range is where thrust-to-weight, the number the hover checks judge, is set.
 
 The full-throttle speed: a brushless motor turns at KV x (back-EMF), and the back-EMF is
-the supply voltage less the I R drop in winding, ESC and wiring, so
-omega_max = eta KV V with eta = back-EMF / V, the motor's copper efficiency at full
-throttle. Manufacturer tables of multirotor motors at 100 % throttle show 65-90 %
-(lower only for a motor driven past its rated current); LOADED_SPEED_FACTOR takes 0.80
-and the band is printed with it. V is the pack's nominal voltage, 3.7 V per LiPo cell
+the supply voltage less the I R drop in winding, ESC, wiring and the pack itself, so
+omega_max = eta KV V with eta = 1 - I R / V, the back-EMF share of the supply. At a
+2212-class motor's rated 20-28 A its 0.05-0.10 ohm winding alone drops 1-3 V of 11.1 V
+(eta 0.75-0.90); ESC, connectors and the pack's sag under four motors' current take it
+down to ~0.6 for a motor at or past its rating. LOADED_SPEED_FACTOR takes 0.80, and the
+band is printed with it (thrust goes with its square).
+V is the pack's nominal voltage, 3.7 V per LiPo cell
 (4.2 V full, ~3.5 V near empty under load).
 """
 
@@ -35,7 +37,7 @@ AIR_DENSITY_KG_M3 = 1.225
 INCH_M = 0.0254
 LIPO_NOMINAL_V_PER_CELL = 3.7
 LOADED_SPEED_FACTOR = 0.80
-LOADED_SPEED_BAND = (0.65, 0.90)
+LOADED_SPEED_BAND = (0.60, 0.90)
 RPM_TO_RAD_S = 2.0 * math.pi / 60.0
 # A propeller is "the same" as a tabulated one when its diameter is within this fraction
 # and its pitch-to-diameter ratio within PITCH_RATIO_TOL: the static coefficients of APC's
