@@ -4,7 +4,8 @@ Each of these models flies in Gazebo, but not like the vehicle it claims to be: 
 thrust-to-weight ratio no real multirotor has, a mass and inertia that belong to a
 frame ten times larger, a rotor joint spinning about another axis than the rotor
 pushes, or one arm longer than the others so that the rotors share the hover load
-unevenly. They are warnings with the numbers: each may be intended.
+unevenly. They are warnings with the numbers: each may be intended. One is not: a link
+denser than any matter (I221) has a mass in other units than its geometry, an error.
 """
 
 from __future__ import annotations

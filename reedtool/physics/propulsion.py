@@ -203,7 +203,8 @@ def derive(motor: MotorData, diameter_in: float, pitch_in: float, cells: int) ->
             f"{LOADED_SPEED_FACTOR:g} x KV {motor.kv_rpm_per_v:g} ({motor.source}) x "
             f"{voltage:.3g} V ({cells}S LiPo at {LIPO_NOMINAL_V_PER_CELL} V/cell) = "
             f"{rpm_max:.0f} rpm; {LOADED_SPEED_FACTOR:g} is the back-EMF share of the "
-            f"supply at full throttle (motor tables: {low:g}-{high:g}, so "
+            f"supply at full throttle ({low:g} for a motor past its rated current to "
+            f"{high:g} lightly loaded: "
             f"{low * motor.kv_rpm_per_v * voltage * RPM_TO_RAD_S:.0f}-"
             f"{high * motor.kv_rpm_per_v * voltage * RPM_TO_RAD_S:.0f} rad/s)"),
         "time_constant_up": Derived(FIREFLY["time_constant_up"], "s",

@@ -127,10 +127,9 @@ def final_line(status: str, passed: bool, requirement: str, message: str) -> str
     if kind == "accepted":
         return (f"ACCEPTED by --require {requirement}: the verdict is {status.upper()}, "
                 "not FLIES (exit 0, not a pass of the flight)")
-    if status in (Verdict.MARGINAL.value, Verdict.NOT_FLOWN.value) \
-            and requirement == "flies" and message:
-        return (f"FAILED: the verdict is {status.upper()}, not FLIES ({message}); "
-                "--require stable accepts it")
+    if status in (Verdict.MARGINAL.value, Verdict.NOT_FLOWN.value) and requirement == "flies":
+        return (f"FAILED: the verdict is {status.upper()}, not FLIES (above); --require "
+                "stable accepts a vehicle that hovers and can be stabilised")
     return f"FAILED: {message}"
 
 
