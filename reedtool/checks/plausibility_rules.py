@@ -292,7 +292,7 @@ def link_denser_than_matter(ctx: CheckContext) -> Iterator[Issue]:
     heavier than built does not hover on its rotors, and every inertia derived from the
     mass is as wrong.
     """
-    from reedtool.physics.inertia import link_volume
+    from reedtool.physics.inertia import link_volumes
 
     placeholders = ctx.placeholder_links
     for link in ctx.robot.links:
@@ -302,12 +302,16 @@ def link_denser_than_matter(ctx: CheckContext) -> Iterator[Issue]:
         mass = inertial.mass_kg
         if not (math.isfinite(mass) and mass > 0):
             continue
-        volume = link_volume(link)
-        if volume is None:
+        volume = None              # the largest group, each too dense for its mass
+        for group in link_volumes(link):
+            if mass / group.volume_m3 <= MAX_DENSITY_KG_M3:
+                volume = None      # one group gives the part room enough: plausible
+                break
+            if volume is None or group.volume_m3 > volume.volume_m3:
+                volume = group
+        if volume is None or _placeholder_geometry(ctx, link.name):
             continue
         density = mass / volume.volume_m3
-        if density <= MAX_DENSITY_KG_M3 or _placeholder_geometry(ctx, link.name):
-            continue
         shapes = (f"{volume.count} {volume.source} geometries" if volume.count > 1
                   else f"its {volume.source} geometry")
         hull = " (convex hull: the mesh is open)" if volume.from_hull else ""

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 from functools import lru_cache
-from typing import Iterable
+from typing import Iterable, Iterator
 
 import numpy as np
 
@@ -290,14 +290,14 @@ class LinkVolume:
     from_hull: bool      # some mesh was open: its convex hull was measured
 
 
-def link_volume(link: Link) -> LinkVolume | None:
-    """The largest volume the link's geometry gives it: the sum over its collision
-    geometries or over its visual ones, whichever is larger; None when neither group
-    can be measured in full (an unresolved or unreadable mesh, no geometry at all).
+def link_volumes(link: Link) -> Iterator[LinkVolume]:
+    """The volume the link's geometry gives it, per group: the sum over its collision
+    geometries, then over its visual ones, each group only when all of it can be measured
+    (an unresolved or unreadable mesh leaves its group out). Lazy: a caller bounding a
+    density stops at the first group that is plausible, and reads no more meshes.
 
-    Larger is the cautious side for a density bound: summing overlapping shapes counts
-    their overlap twice and only lowers mass / volume, never raises it."""
-    best: LinkVolume | None = None
+    Summing is the cautious side for a density bound: overlapping shapes count their
+    overlap twice, which only lowers mass / volume, never raises it."""
     for source, shapes in (("collision", link.collisions), ("visual", link.visuals)):
         geometries = [shape.geometry for shape in shapes if shape.geometry is not None]
         if not geometries:
@@ -310,9 +310,8 @@ def link_volume(link: Link) -> LinkVolume | None:
                 hull = hull or from_hull
         except ReedtoolError:
             continue
-        if math.isfinite(total) and total > 0 and (best is None or total > best.volume_m3):
-            best = LinkVolume(total, source, len(geometries), hull)
-    return best
+        if math.isfinite(total) and total > 0:
+            yield LinkVolume(total, source, len(geometries), hull)
 
 
 def declared_mass_properties(link: Link) -> MassProperties | None:
