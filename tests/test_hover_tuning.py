@@ -56,9 +56,17 @@ def vehicle(path: Path) -> VehicleParams:
     (FIXTURES / "omni" / "omni_reversible.sdf", "not-flown"),
 ])
 def test_real_model_shapes_get_the_verdict_of_the_vehicle(model, status):
+    # By default only the verdict "flies" passes; a weaker verdict fails (exit 1) unless
+    # --require stable accepts it, and then it is "accepted", never "passed" (issue 26).
     code, report = hover_json(model)
-    assert (code, report["status"], report["passed"]) == (0, status, True), report["message"]
+    flies = status == "flies"
+    assert (code, report["status"], report["passed"]) == (0 if flies else 1, status, flies), \
+        report["message"]
+    assert report["outcome"] == ("passed" if flies else "failed")
     assert report["verdict"]["status"] == status
+    code, report = hover_json(model, "--require", "stable")
+    assert (code, report["passed"]) == (0, True)
+    assert report["outcome"] == ("passed" if flies else "accepted")
     if report["sim"] is not None:
         assert report["sim"]["status"] != "crashed"
 
@@ -93,6 +101,27 @@ def test_marginal_vehicle_reports_what_it_recovers_from():
     assert f"{v['recoverable_tilt_deg']:.3g} deg" in report["message"]
     # the flight from the full start: settled only with the rotors long at their limits
     assert report["sim"]["longest_saturation_s"] >= 1.0
+
+
+def test_a_marginal_verdict_is_never_followed_by_passed():
+    """Issue 26: "MARGINAL ... did not settle" then "PASSED", exit 0. The last line is
+    PASSED only after the verdict FLIES; a marginal vehicle fails by default and is
+    ACCEPTED (exit 0, not PASSED) only when --require says a weaker verdict will do."""
+    code, out = run_cli("hover-test", str(TUNING / "crazyflie_like.urdf"))
+    lines = out.rstrip().splitlines()
+    verdict = next(i for i, line in enumerate(lines) if line.startswith("verdict: "))
+    assert lines[verdict].startswith("verdict: MARGINAL")
+    assert code == 1 and "PASSED" not in "\n".join(lines[verdict:])
+    assert lines[-1].startswith("FAILED: the verdict is MARGINAL, not FLIES")
+    for require in ("stable", "hover", "margin:3"):
+        code, out = run_cli("hover-test", str(TUNING / "crazyflie_like.urdf"),
+                            "--require", require)
+        last = out.rstrip().splitlines()[-1]
+        assert code == 0 and last.startswith(f"ACCEPTED by --require {require}: the "
+                                             "verdict is MARGINAL"), last
+        assert "PASSED" not in last
+    code, out = run_cli("hover-test", str(TUNING / "racing_tw10.urdf"))
+    assert code == 0 and out.rstrip().splitlines()[-1] == "PASSED"
 
 
 def test_require_picks_how_strict_ci_is():
@@ -296,14 +325,16 @@ def test_margin_from_a_level_start_flies_the_required_tilt():
 def test_a_tilt_rotor_frame_is_not_flown_and_says_why():
     # Two rotors on servos a plugin drives: the fixed-axis allocation has rank 2, but the
     # frame steers with the tilt. (validate's R305 still errors on it: --ignore-validation.)
-    code, report = hover_json(TUNING / "bicopter_servos.urdf", "--ignore-validation")
+    code, report = hover_json(TUNING / "bicopter_servos.urdf", "--ignore-validation",
+                              "--require", "stable")
     assert (code, report["status"], report["sim"]) == (0, "not-flown", None)
     assert report["message"].startswith("tilt-rotor frame (rotor_0 on servo_0_joint, "
                                          "rotor_1 on servo_1_joint")
     assert report["trim"]["cause"] == "rank-deficient"
     # rotors pointing forward at zero tilt: no thrust upward, but the servos tilt them up
     # (their 2 x 6.0 N at full speed exceed the 9.4 N weight)
-    code, report = hover_json(TUNING / "bicopter_sideways.urdf", "--ignore-validation")
+    code, report = hover_json(TUNING / "bicopter_sideways.urdf", "--ignore-validation",
+                              "--require", "stable")
     assert (code, report["status"], report["trim"]["cause"]) == (0, "not-flown",
                                                                   "insufficient-thrust")
     # the same frame with nothing driving the tilt cannot hover: still a failure

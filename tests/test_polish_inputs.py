@@ -89,8 +89,9 @@ def test_authority_refuses_an_omnidirectional_frame():
     """Its one-way 4-D ACAI called the omnicopter (which trims to hover, T/W 5 by the 6-DoF
     allocation) 'not controllable at any thrust-to-weight', with thrust-to-weight 1.6e-8."""
     model = FIXTURES / "omni" / "omni_reversible.sdf"
-    code, out = run_cli("hover-test", model, "--format", "json")
+    code, out = run_cli("hover-test", model, "--format", "json", "--require", "stable")
     assert code == 0, out                      # the 6-DoF trim holds: a frame that hovers
+    assert json.loads(out)["outcome"] == "accepted"     # not flown: never a pass (issue 26)
     code, out = run_cli("authority", model)
     assert code == 2
     last = out.strip().splitlines()[-1]

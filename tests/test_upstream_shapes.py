@@ -194,13 +194,20 @@ def test_quad_tailsitter_tilts_and_trim_by_hand():
 def test_hover_test_judges_an_omni_frame_by_its_6dof_trim_then_says_it_is_not_flown(capsys):
     """validate finds the reversible omni frame's 6-DoF trim; hover-test used to run the
     4-DoF one-way trim on it and report FAILED (yaw cannot cancel): a false alarm. Its
-    geometric controller does not apply to the frame: "not flown", exit 0 (issue 20)."""
+    geometric controller does not apply to the frame: "not flown" (issue 20), which is
+    not a pass (issue 26): exit 1 by default, "accepted" with --require stable."""
     omni = Path(__file__).parent / "fixtures" / "omni" / "omni_reversible.sdf"
     with pytest.raises(SystemExit) as info:
         main(["hover-test", str(omni), "--format", "json"])
     captured = capsys.readouterr()
+    assert info.value.code == 1 and "Traceback" not in captured.err
+    assert json.loads(captured.out)["outcome"] == "failed"
+    with pytest.raises(SystemExit) as info:
+        main(["hover-test", str(omni), "--format", "json", "--require", "stable"])
+    captured = capsys.readouterr()
     assert info.value.code == 0 and "Traceback" not in captured.err
     report = json.loads(captured.out)
+    assert report["outcome"] == "accepted"
     assert (report["status"], report["passed"], report["sim"]) == ("not-flown", True, None)
     assert "(6-DoF allocation)" in report["message"]
     assert report["message"].startswith("omnidirectional frame")

@@ -43,7 +43,7 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
     Keys: "model", "trim", "sim" (None when not flown), "batch" (None without samples),
     "verdict" (sim.verdict: what the vehicle can do, with its cause), "status" (the
     verdict's), "message", "passed" (the verdict against `requirement`, default
-    --require stable); plus "_run" (the HoverRun, for CSV/plot), "_omega_max" and
+    --require flies); plus "_run" (the HoverRun, for CSV/plot), "_omega_max" and
     "_envelope" (the batch's, with `envelope`). With `controller_files` (RotorS Lee
     gains and vehicle YAML) the flight is that controller's (assembly.lee_flight) and
     "controller" reports its checks; it passes only when it flies.

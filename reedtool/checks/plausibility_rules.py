@@ -4,7 +4,8 @@ Each of these models flies in Gazebo, but not like the vehicle it claims to be: 
 thrust-to-weight ratio no real multirotor has, a mass and inertia that belong to a
 frame ten times larger, a rotor joint spinning about another axis than the rotor
 pushes, or one arm longer than the others so that the rotors share the hover load
-unevenly. They are warnings with the numbers: each may be intended.
+unevenly. They are warnings with the numbers: each may be intended. One is not: a link
+denser than any matter (I221) has a mass in other units than its geometry, an error.
 """
 
 from __future__ import annotations
@@ -39,6 +40,63 @@ GYRATION_RATIO_MAX = 1.5
 # helicopter (the Sikorsky X2 shape), whose size the rotor positions do not tell.
 SINGLE_AXIS_SPAN_M = 0.01
 JOINT_AXIS_TOL_DEG = 5.0
+
+# ---- I221: no link is denser than matter.
+# The densest solid at room conditions is osmium, 22.59 g/cm³ (CRC Handbook of Chemistry
+# and Physics, 97th ed., "Density of the elements"; iridium 22.56). No assembly of real
+# material averages more than its densest part, so mass / volume above this is not a
+# part of any material. The bound needs a volume that does not under-state the part:
+#  - a closed mesh encloses the solid it bounds; when the part is a hollow shell drawn
+#    by its outer skin only, the enclosed volume exceeds the material's, so mass over it
+#    UNDER-states the material density: the bound still holds (it can only miss, never
+#    accuse wrongly);
+#  - an open mesh encloses nothing, so its convex hull is measured: any solid the open
+#    surface stands for lies inside its hull, again an over-statement of the volume;
+#  - several geometries are summed (overlaps count twice: more volume), and the larger
+#    of the collision and visual groups is used;
+#  - a stand-in geometry smaller than the part (a 5 mm box for a 0.3 kg servo) under-
+#    states it. When the declared inertia gives that away (more than 10x the geometry's
+#    at the same mass, I204's bound: no mass inside a shape turns it harder than that)
+#    the link is not judged. When the inertia was computed from the stand-in too, only a
+#    margin helps: PX4's sensors are drawn up to 1.5x too small (the 50 g aruco camera as
+#    a 5 x 30 x 10 mm box: 33,300 kg/m³; the 15 g GPS as a 0.63 cm³ puck: 23,900), so the
+#    error is at twice osmium. Grams written as kg multiply the density by 1000, so every
+#    part built denser than 45 kg/m³ (all but foam) is still caught;
+#  - a placeholder link (under 0.1 % of the robot's mass and inertia,
+#    physics.inertia.PLACEHOLDER_FRACTION) cannot change a flight and is not judged.
+OSMIUM_KG_M3 = 22_590.0
+STAND_IN_MARGIN = 2.0
+MAX_DENSITY_KG_M3 = STAND_IN_MARGIN * OSMIUM_KG_M3
+# Grams written as kg: the mass a thousand times too large. Named as the cause when a
+# thousandth of the mass gives the density of something drones are built of: 20 kg/m³
+# (expanded foam) to 8,960 kg/m³ (copper windings; steel 7,850).
+GRAMS_PER_KG = 1000.0
+BUILD_DENSITY_KG_M3 = (20.0, 8960.0)
+
+# ---- R343: mass against the rotor footprint, outside every real multirotor.
+# Footprint loading w = m g / (pi L²), L the farthest lift rotor's distance from the COM.
+# Published airframes (all-up or max take-off mass; L = half the motor-to-motor diagonal):
+#   Bitcraze Crazyflie 2.1   0.027 kg, 92 mm diagonal        ->   40 N/m²
+#   DJI F450                 1.2-1.6 kg, 450 mm             ->   74-99 N/m²
+#   Holybro X500 (PX4 x500)  2.0 kg, 500 mm                 ->  100 N/m²
+#   Tarot 680 Pro hexa       3-5 kg, 680 mm                 ->   81-135 N/m²
+#   5-inch racing quad       0.6-0.8 kg, 220 mm             ->  155-206 N/m²
+#   DJI Matrice 600          15.5 kg MTOW, 1133 mm          ->  151 N/m²
+#   EHang 216 (cargo/people) 600 kg MTOW, ~5.6 m diagonal   ~  240 N/m²
+#   AeroVelo Atlas (human-powered quad, Sikorsky prize 2013) ~128 kg with pilot, rotors of
+#                            20.2 m on a 47 m square, L ~ 19 m -> ~1.1 N/m² (the lightest)
+# Physics, heavy side: n coplanar rotors that do not overlap on a circle of radius L
+# have radius at most L sin(pi/n), so a total disc area at most 2.25 pi L² (n = 3; a
+# quad 2 pi L²): disc loading >= w / 2.25. The highest disc loading any rotorcraft
+# hovers with is ~1,300 N/m² (V-22 Osprey: 27.4 t on two 11.6 m rotors; CH-53E 860);
+# above it induced velocity sqrt(DL / 2 rho) passes 23 m/s and hover is a jet's. So
+# w > 2.25 x 1,500 = 3,400 N/m² is a footprint no rotor set fits, 17x the heaviest
+# multirotor above. Light side: below 0.3 N/m², a quarter of Atlas's (whose 47 m frame
+# of carbon spars is the lightest structure for its size ever flown), the vehicle is
+# lighter than any frame that spans its rotors.
+FOOTPRINT_LOADING_MAX_N_M2 = 3400.0
+FOOTPRINT_LOADING_MIN_N_M2 = 0.3
+G_M_S2 = 9.80665
 TRIM_SPREAD_MAX = 0.15
 PARALLEL_TOL_DEG = 1.0
 
@@ -196,3 +254,126 @@ def uneven_hover_trim(ctx: CheckContext) -> Iterator[Issue]:
                 f"({centroid[0]:.4g}, {centroid[1]:.4g}) m", rotors[high].loc, rotors[high].name,
                 hint=f"move the COM by ({shift[0]:+.4g}, {shift[1]:+.4g}) m in x, y, or the "
                      "rotors so their centroid is over it (an arm longer than the others?)")
+
+
+def _placeholder_geometry(ctx: CheckContext, link_name: str) -> bool:
+    """The declared inertia is more than PLAUSIBLE_TRACE_RATIO times the geometry's at the
+    same mass: the geometry stands for a larger part, so it does not bound its volume."""
+    from reedtool.physics.inertia import PLAUSIBLE_TRACE_RATIO
+
+    for comparison in ctx.link_comparisons:
+        if comparison.link == link_name:
+            ratio = comparison.trace_ratio
+            return ratio is not None and math.isfinite(ratio) and ratio > PLAUSIBLE_TRACE_RATIO
+    return False
+
+
+@rule("I221", "link-denser-than-matter", "error",
+      "A link's mass over its geometry's volume is over twice osmium's density (45 g/cm³).",
+      clause="cannot-fly")
+def link_denser_than_matter(ctx: CheckContext) -> Iterator[Issue]:
+    """No material is denser than osmium, 22.59 g/cm³ (CRC Handbook), so no part is: a
+    link whose declared mass over the volume of its collision (or visual) geometry
+    exceeds twice that (the factor allows a sensor drawn smaller than it is: PX4's 50 g
+    aruco camera in 1.5 cm³ is 33 g/cm³) has a mass in other units than its geometry. The usual cause is grams
+    written as kilograms (a CAD exporter set to mm-g-s: a 1.2 kg body declared 1200), and
+    the message says whether a thousandth of the mass gives the density of something
+    drones are built of (foam to copper, 20-8,960 kg/m³).
+
+    Volume: the sum over the link's collision geometries or its visual ones, whichever is
+    larger, with `<mesh scale>` applied. A closed mesh counts what it encloses (for a
+    hollow part drawn by its outer skin that is more than its material, which only lowers
+    the density computed: the bound still holds); an open mesh counts its convex hull.
+    Not judged: placeholder links (under 0.1 % of the robot's mass and inertia) and a
+    geometry that stands for a larger part (the declared inertia more than 10x the
+    geometry's: I204 speaks about that).
+
+    Severity (error): the mass is certainly not the part's; a vehicle a thousand times
+    heavier than built does not hover on its rotors, and every inertia derived from the
+    mass is as wrong.
+    """
+    from reedtool.physics.inertia import link_volumes
+
+    placeholders = ctx.placeholder_links
+    for link in ctx.robot.links:
+        inertial = link.inertial
+        if inertial is None or link.name in placeholders:
+            continue
+        mass = inertial.mass_kg
+        if not (math.isfinite(mass) and mass > 0):
+            continue
+        volume = None              # the largest group, each too dense for its mass
+        for group in link_volumes(link):
+            if mass / group.volume_m3 <= MAX_DENSITY_KG_M3:
+                volume = None      # one group gives the part room enough: plausible
+                break
+            if volume is None or group.volume_m3 > volume.volume_m3:
+                volume = group
+        if volume is None or _placeholder_geometry(ctx, link.name):
+            continue
+        density = mass / volume.volume_m3
+        shapes = (f"{volume.count} {volume.source} geometries" if volume.count > 1
+                  else f"its {volume.source} geometry")
+        hull = " (convex hull: the mesh is open)" if volume.from_hull else ""
+        grams = density / GRAMS_PER_KG
+        low, high = BUILD_DENSITY_KG_M3
+        if low <= grams <= high:
+            hint = (f"grams written as kg? {mass / GRAMS_PER_KG:.4g} kg gives "
+                    f"{grams:,.0f} kg/m³, a solid drones are built of; declare the mass in kg "
+                    "(and the inertia in kg·m²)")
+        else:
+            hint = (f"the mass is {density / OSMIUM_KG_M3:,.3g}x too large for the "
+                    "volume: check its unit, and the geometry's (a mesh in mm needs "
+                    "scale=\"0.001 0.001 0.001\", once)")
+        yield Issue(f"link '{link.name}': {mass:.4g} kg in {1e6 * volume.volume_m3:.4g} cm³ of "
+                    f"{shapes}{hull} is {density:,.0f} kg/m³, {density / OSMIUM_KG_M3:,.3g}x "
+                    f"the densest solid (osmium, {OSMIUM_KG_M3:,.0f} kg/m³)",
+                    inertial.mass_loc or inertial.loc, link.name, hint=hint)
+
+
+@rule("R343", "size-implausible-for-mass", "warning",
+      "The mass on the rotors' footprint is outside every real multirotor.", clause="suspicious")
+def size_implausible_for_mass(ctx: CheckContext) -> Iterator[Issue]:
+    """Footprint loading m g / (pi L²), with L the farthest lift rotor from the COM, is
+    40-240 N/m² across real multirotors from a 27 g Crazyflie to a 600 kg EHang 216;
+    the lightest ever flown, the 47 m human-powered AeroVelo Atlas, carries ~1.1 N/m².
+    Above 3,400 N/m² no set of rotors fits the footprint: n non-overlapping rotors on a
+    circle of radius L have at most 2.25 pi L² of disc, and no rotorcraft hovers above
+    ~1,500 N/m² of disc (the V-22 Osprey's 1,300). Below 0.3 N/m² the vehicle is lighter
+    than any frame that spans its rotors. Either is a mass or a length in other units:
+    1200 kg (grams) on a 0.38 m frame, a 36 m quad from an arm length of 18 meant as cm.
+    The derivation and the airframe table sit next to the rule's bounds in
+    reedtool/checks/plausibility_rules.py. A coaxial or single-rotor vehicle (every lift
+    rotor within 1 cm of the COM's vertical) has no footprint and is not judged; the
+    heavy side stays quiet when I220 reports the same mass on the same span.
+
+    Severity (warning, suspicious): the model loads and may hover in simulation; no real
+    vehicle has these proportions.
+    """
+    if not _physics_ready(ctx) or not _lift(ctx):
+        return
+    whole = ctx.whole_robot
+    arm_m = _span_m(ctx)
+    if arm_m < SINGLE_AXIS_SPAN_M:
+        return
+    loading = whole.mass_kg * G_M_S2 / (math.pi * arm_m ** 2)
+    farthest = max(_lift(ctx), key=lambda r: float(np.hypot(
+        *(r.position_m - np.asarray(whole.com_m, dtype=float))[:2])))
+    where = (f"{whole.mass_kg:.4g} kg with its farthest rotor {arm_m:.4g} m from the COM "
+             f"(a {2 * arm_m:.3g} m frame): {loading:.3g} N/m² of footprint")
+    typical_kg = 100.0 * math.pi * arm_m ** 2 / G_M_S2      # 100 N/m²: an F450, an x500
+    if loading > FOOTPRINT_LOADING_MAX_N_M2:
+        if whole.mass_kg / (2.0 * arm_m) ** 3 > SPAN_DENSITY_MAX_KG_M3:
+            return                                           # I220 says it
+        yield Issue(f"{where}, above the {FOOTPRINT_LOADING_MAX_N_M2:,.0f} N/m² no rotors on "
+                    "that frame can lift (real multirotors: 40-240)", ctx.robot.loc,
+                    ctx.robot.name,
+                    hint=f"a multirotor this size weighs about {typical_kg:.3g} kg; check the "
+                         "masses (grams written as kg?) or the arm length's unit")
+    elif loading < FOOTPRINT_LOADING_MIN_N_M2:
+        yield Issue(f"{where}, below the {FOOTPRINT_LOADING_MIN_N_M2:g} N/m² of any frame "
+                    "that spans its rotors (real multirotors: 40-240; a 47 m human-powered "
+                    "quad ~1)", farthest.loc, farthest.name,
+                    hint=f"a multirotor of {whole.mass_kg:.3g} kg has its rotors about "
+                         f"{math.sqrt(whole.mass_kg * G_M_S2 / (100.0 * math.pi)):.3g} m from "
+                         "its centre; check the arm length's unit (cm or mm read as m?)")

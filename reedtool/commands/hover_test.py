@@ -88,11 +88,12 @@ PROGRESS_AFTER_S = 2.0
                    "needs pip install 'reedtool[fast]').")
 @click.option("--min-pass-rate", type=FiniteFloatRange(0.0, 1.0), default=0.95,
               show_default=True, help="Batch pass rate needed to exit 0.")
-@click.option("--require", "require", default="stable", show_default=True,
-              metavar="hover|stable|margin:DEG",
-              help="What exit 0 needs: a hover trim (hover); and a vehicle some controller "
-                   "can stabilise (stable); and recovery from a start tilted DEG degrees "
-                   "(margin:DEG).")
+@click.option("--require", "require", default="flies", show_default=True,
+              metavar="flies|hover|stable|margin:DEG",
+              help="What exit 0 needs: the verdict flies (flies); or only a hover trim "
+                   "(hover); a vehicle some controller can stabilise (stable); recovery "
+                   "from a start tilted DEG degrees (margin:DEG). A verdict other than "
+                   "flies is then ACCEPTED, never PASSED.")
 @click.option("--controller", "controller_files", multiple=True,
               type=click.Path(path_type=Path, dir_okay=False), metavar="FILE.yaml",
               help="Fly RotorS' Lee position controller with these files instead of "
@@ -113,7 +114,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
             max_memory_mb: int, seed: int,
             mass_spread: float, com_spread_m: float, inertia_spread: float,
             motor_spread: float, engine: str, min_pass_rate: float,
-            require: str = "stable", controller_files: tuple[Path, ...] = (),
+            require: str = "flies", controller_files: tuple[Path, ...] = (),
             controller_rate_hz: float = 100.0,
             ignore: tuple[str, ...] = (), ignore_validation: bool = False) -> int:
     """Trim MODEL for hover and fly it.
@@ -249,6 +250,9 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
             report["message"] = (f"only {100 * batch['pass_rate']:.1f}% of the perturbed "
                                  f"vehicles hover, {100 * min_pass_rate:.0f}% required")
 
+    from reedtool.sim.verdict import outcome
+
+    report["outcome"] = outcome(report.get("status", ""), report["passed"])
     run, omega_max = report.pop("_run", None), report.pop("_omega_max")
     envelope = report.pop("_envelope", None)
     if run is not None and csv_path is not None:
@@ -414,7 +418,10 @@ def render_text(report: dict) -> str:
     verdict = report.get("verdict")
     if verdict is not None:
         lines.append(f"verdict: {verdict['status'].upper()}: {verdict['message']}")
-    lines.append("PASSED" if report["passed"] else f"FAILED: {report.get('message', '')}")
+    from reedtool.sim.verdict import final_line
+
+    lines.append(final_line(report.get("status", ""), report["passed"],
+                            report.get("require", "flies"), report.get("message", "")))
     return "\n".join(lines)
 
 

@@ -109,6 +109,9 @@ def _summary(result: NewPackageResult, spec) -> list[str]:
         for r in ctx["rotors"]:
             lines.append(f"  motor {r['motor_number']}  {r['suffix']:<20} "
                          f"({', '.join(r['position_m'])}) m  {r['direction']}")
+        from reedtool.scaffold.package_spec import propulsion_lines
+
+        lines.extend(propulsion_lines(spec))
     else:
         lines.append(f"mass {ctx['p']['mass']} kg body, {ctx['total_mass_kg']} kg total; "
                      f"{len(ctx['wheels'])} wheels, {ctx['drive'].replace('_', '-')} on cmd_vel")
@@ -159,6 +162,13 @@ def _summary(result: NewPackageResult, spec) -> list[str]:
                    "(FLU): the CAD origin (default with --arm-length), the body's COM, the "
                    "motor mounts' centre, or x,y,z with a unit ('15.2,0,0 mm'). Without "
                    "--center and --arm-length the rotors go on the mesh's motor mounts.")
+@click.option("--motor", metavar="KV|NAME",
+              help="Motor KV (rpm/V), e.g. 920, or a named motor (docs/new-package.md); with "
+                   "--prop and --battery it derives the motor constants.")
+@click.option("--prop", metavar="DxP",
+              help="Propeller diameter x pitch in inches, e.g. 10x4.7 (UIUC-measured "
+                   "static coefficients).")
+@click.option("--battery", metavar="NS", help="LiPo cells in series, e.g. 4S.")
 @click.option("-o", "--output-dir", type=click.Path(path_type=Path, file_okay=False),
               default=Path("."), show_default=True,
               help="Directory to create the package directory NAME in.")
@@ -168,7 +178,8 @@ def _summary(result: NewPackageResult, spec) -> list[str]:
               help="Also write the autopilot's rotor table for this model: a PX4 gz airframe "
                    "(px4/) or an ArduPilot .parm (ardupilot/).")
 def command(name, frame, ros, sim, spec_file, mass, arm_length, mesh, mesh_units, mesh_frame,
-            output_dir, force, autopilot=None, center=None) -> int:
+            output_dir, force, autopilot=None, center=None, motor=None, prop=None,
+            battery=None) -> int:
     """Create the ROS package NAME for a multirotor or ground robot.
 
     Masses and inertias are computed from the geometry; a multirotor (gz-sim
@@ -178,7 +189,8 @@ def command(name, frame, ros, sim, spec_file, mass, arm_length, mesh, mesh_units
     from reedtool.scaffold.package_spec import build_spec
 
     spec = build_spec(name, frame=frame, ros=int(ros) if ros else None, spec_file=spec_file,
-                      flags={"mass": mass, "arm_length": arm_length}, mesh=mesh, sim=sim)
+                      flags={"mass": mass, "arm_length": arm_length}, mesh=mesh, sim=sim,
+                      drive={"motor": motor, "prop": prop, "battery": battery})
     result = new_package(spec, output_dir, force=force, mesh_units=mesh_units,
                          mesh_frame=mesh_frame, autopilot=autopilot, center=center)
     for line in _summary(result, spec):

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 from functools import lru_cache
-from typing import Iterable
+from typing import Iterable, Iterator
 
 import numpy as np
 
@@ -263,6 +263,55 @@ def geometry_mass_properties(geometry, T_link_geom, mass_kg: float) -> MassPrope
     else:
         raise ReedtoolError(f"unsupported geometry type {type(geometry).__name__}")
     return local.transformed(T_link_geom)
+
+
+def geometry_volume(geometry) -> tuple[float, bool]:
+    """(volume in m³, from_hull) of one URDF/SDF geometry as the simulator sizes it.
+
+    Primitives are exact. A mesh is read from its resolved path with its `scale`
+    applied; a closed mesh gives the volume it encloses, an open one its convex hull's
+    (from_hull True): a solid the open surface stands for lies inside that hull, so the
+    hull never under-states it. Raises ReedtoolError like geometry_mass_properties."""
+    if isinstance(geometry, Box):
+        return box_volume(geometry.size_m), False
+    if isinstance(geometry, Cylinder):
+        return cylinder_volume(geometry.radius_m, geometry.length_m), False
+    if isinstance(geometry, Sphere):
+        return sphere_volume(geometry.radius_m), False
+    props = geometry_mass_properties(geometry, np.eye(4), 1.0)
+    return float(props.volume_m3 or 0.0), props.from_hull
+
+
+@dataclass(frozen=True)
+class LinkVolume:
+    volume_m3: float
+    source: str          # "collision" or "visual": the group the volume is of
+    count: int           # geometries summed
+    from_hull: bool      # some mesh was open: its convex hull was measured
+
+
+def link_volumes(link: Link) -> Iterator[LinkVolume]:
+    """The volume the link's geometry gives it, per group: the sum over its collision
+    geometries, then over its visual ones, each group only when all of it can be measured
+    (an unresolved or unreadable mesh leaves its group out). Lazy: a caller bounding a
+    density stops at the first group that is plausible, and reads no more meshes.
+
+    Summing is the cautious side for a density bound: overlapping shapes count their
+    overlap twice, which only lowers mass / volume, never raises it."""
+    for source, shapes in (("collision", link.collisions), ("visual", link.visuals)):
+        geometries = [shape.geometry for shape in shapes if shape.geometry is not None]
+        if not geometries:
+            continue
+        total, hull = 0.0, False
+        try:
+            for geometry in geometries:
+                volume, from_hull = geometry_volume(geometry)
+                total += volume
+                hull = hull or from_hull
+        except ReedtoolError:
+            continue
+        if math.isfinite(total) and total > 0:
+            yield LinkVolume(total, source, len(geometries), hull)
 
 
 def declared_mass_properties(link: Link) -> MassProperties | None:

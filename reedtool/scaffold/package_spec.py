@@ -119,7 +119,10 @@ PARAM_MAP = {p.key: p for p in PARAMS}
 
 # Non-numeric spec keys.
 TEXT_KEYS = ("name", "frame", "ros", "sim", "mesh", "description", "maintainer",
-             "maintainer_email", "license", "version")
+             "maintainer_email", "license", "version", "motor", "prop", "battery")
+# What --motor, --prop and --battery (spec keys motor, prop, battery) derive together
+# (reedtool.physics.propulsion); given with them, these would contradict them.
+PROPULSION_KEYS = ("motor_constant", "moment_constant", "max_rot_velocity", "radius_rotor")
 
 
 @dataclass
@@ -148,6 +151,9 @@ class PackageSpec:
     origin: dict[str, str] = field(default_factory=dict)  # key -> "default"|"spec"|"--flag"
     sim: str = "classic"                       # a SIMULATORS entry
     cad: CadPlacement | None = None            # a CAD body's frame, COM and mounts
+    # reedtool.physics.propulsion.Propulsion when --motor/--prop/--battery derived the
+    # motor constants; None: the constants are the defaults (RotorS firefly) or given.
+    propulsion: object | None = None
 
     @property
     def kind(self) -> str:
@@ -258,8 +264,12 @@ def read_spec_file(path: Path) -> dict:
 
 def build_spec(name: str, *, frame: str | None = None, ros: int | None = None,
                spec_file: Path | None = None, flags: Mapping[str, object] | None = None,
-               mesh: Path | None = None, sim: str | None = None) -> PackageSpec:
-    """Merge defaults < spec file < flags, convert to SI and check the result."""
+               mesh: Path | None = None, sim: str | None = None,
+               drive: Mapping[str, str | None] | None = None) -> PackageSpec:
+    """Merge defaults < spec file < flags, convert to SI and check the result.
+
+    `drive`: the --motor, --prop and --battery texts (None where not given); with the
+    spec file's `motor`, `prop` and `battery` they derive the motor constants."""
     data = read_spec_file(spec_file) if spec_file else {}
     src = str(spec_file) if spec_file else "<spec>"
     unknown = [k for k in data if k not in PARAM_MAP and k not in TEXT_KEYS]
@@ -331,8 +341,53 @@ def build_spec(name: str, *, frame: str | None = None, ros: int | None = None,
         version=str(data.get("version", PackageSpec.version)),
         origin=origin, sim=sim_value,
     )
+    spec.propulsion = _derive_propulsion(spec, data, drive or {}, spec_file)
     check_geometry(spec)
     return spec
+
+
+def _derive_propulsion(spec: PackageSpec, data: Mapping[str, object],
+                       drive: Mapping[str, str | None], spec_file: Path | None):
+    """Motor constants from --motor/--prop/--battery (flags over the spec's keys): all
+    three or none, and not beside the constants they derive."""
+    given = {key: (f"--{key}", drive[key]) if drive.get(key) is not None else
+             (f"{key} in the spec", data[key]) for key in ("motor", "prop", "battery")
+             if drive.get(key) is not None or data.get(key) is not None}
+    if not given:
+        return None
+    if spec.kind != "multirotor":
+        raise ReedtoolError(f"{next(iter(given.values()))[0]} applies to multirotor frames "
+                            f"only, not '{spec.frame.name}'")
+    missing = [f"--{key}" for key in ("motor", "prop", "battery") if key not in given]
+    if missing:
+        raise ReedtoolError(f"{', '.join(label for label, _ in given.values())} needs "
+                            f"{' and '.join(missing)} too: the maximum rotor speed is KV x "
+                            "battery voltage, and the thrust at it is the propeller's",
+                            hint="e.g. --motor 920 --prop 10x4.7 --battery 3S")
+    clash = [key for key in PROPULSION_KEYS if spec.origin.get(key) not in (None, "default")]
+    if clash:
+        raise ReedtoolError(f"{clash[0]} ({spec.origin[clash[0]]}) and --motor/--prop/--battery "
+                            "both set it", file=spec_file,
+                            hint="give either the constants or the motor, propeller and "
+                                 "battery they are derived from")
+    from reedtool.physics.propulsion import derive, parse_battery, parse_motor, parse_propeller
+
+    try:
+        motor = parse_motor(given["motor"][1])
+        diameter_in, pitch_in = parse_propeller(given["prop"][1])
+        cells = parse_battery(given["battery"][1])
+    except ReedtoolError as exc:
+        from_spec = any(label.endswith("spec") for label, _ in given.values())
+        raise ReedtoolError(exc.message, file=spec_file if from_spec else None,
+                            hint=exc.hint) from None
+    result = derive(motor, diameter_in, pitch_in, cells)
+    label = (f"{given['motor'][0]} {given['motor'][1]}, {given['prop'][0]} "
+             f"{given['prop'][1]}, {given['battery'][0]} {given['battery'][1]}")
+    for key, derived in result.constants.items():
+        if key in PROPULSION_KEYS or spec.origin.get(key) == "default":
+            spec.values[key], spec.origin[key] = float(derived.value), label
+    spec.values["radius_rotor"], spec.origin["radius_rotor"] = result.radius_m, given["prop"][0]
+    return result
 
 
 # catkin and ament both require a version of three dot-separated integers (REP 149).
@@ -718,3 +773,43 @@ def _ground_context(spec: PackageSpec, body_props) -> dict:
         "total_mass_kg": fmt_number(total_mass_estimate_kg(spec)),
     }
     return ctx
+
+
+# RotorS xacro/SDF names of the motor constants, as the summary prints them.
+_ROTORS_NAMES = {"motor_constant": "motorConstant", "moment_constant": "momentConstant",
+                 "max_rot_velocity": "maxRotVelocity", "time_constant_up": "timeConstantUp",
+                 "time_constant_down": "timeConstantDown"}
+_UNITS = {"motor_constant": "N/(rad/s)^2", "moment_constant": "m", "max_rot_velocity": "rad/s",
+          "time_constant_up": "s", "time_constant_down": "s"}
+
+
+def propulsion_lines(spec: PackageSpec) -> list[str]:
+    """What new-package says about the motor constants: each derived one with its source,
+    or that they are RotorS firefly's defaults and what thrust-to-weight they give."""
+    if spec.kind != "multirotor":
+        return []
+    n = spec.frame.rotor_count
+    per_rotor_N = spec["motor_constant"] * spec["max_rot_velocity"] ** 2
+    thrust = (f"{n} x {per_rotor_N:.4g} N = {n * per_rotor_N:.4g} N at full speed, "
+              f"thrust-to-weight {thrust_to_weight(spec):.2f} for the "
+              f"{total_mass_estimate_kg(spec):.3g} kg vehicle")
+    result = spec.propulsion
+    if result is not None:
+        lines = [f"motor constants from {result.motor.name}, {result.diameter_in:g}x"
+                 f"{result.pitch_in:g} propeller, {result.cells}S LiPo ({result.voltage_V:.3g} V):"]
+        for key, derived in result.constants.items():
+            value = spec[key]
+            source = derived.source if spec.origin.get(key, "").startswith(("--motor", "motor")) \
+                else f"as given ({spec.origin[key]})"
+            lines.append(f"  {_ROTORS_NAMES[key]} {value:.6g} {derived.unit}: {source}")
+        lines.append(f"  propeller data: {result.propeller.name}, {result.match}")
+        lines.append(f"  {thrust}")
+        return lines
+    keys = list(_ROTORS_NAMES)
+    given = [k for k in keys if spec.origin.get(k) != "default"]
+    values = ", ".join(f"{_ROTORS_NAMES[k]} {spec[k]:g} {_UNITS[k]}" for k in keys)
+    if not given:
+        return [f"motor constants: RotorS firefly defaults ({values}), not your motor's: "
+                f"{thrust}; --motor, --prop and --battery derive them"]
+    return [f"motor constants: {values} ({', '.join(_ROTORS_NAMES[k] for k in given)} as "
+            f"given, the rest RotorS firefly defaults): {thrust}"]

@@ -16,7 +16,11 @@ vehicle; the verdict separates what the vehicle cannot do from what a start aske
 "Recovers" means: the flight passes (settles within the tolerances and holds) and the
 rotors were never out of range for `config.saturation_limit_s` in a row: a recovery that
 rides the rotors' limits for a second is luck of the start, not margin. Only the first
-two fail by default; `Requirement` decides what else a CI run demands.
+two fail whatever is asked; `Requirement` decides what else a run demands, and its
+default, `flies`, demands the verdict `flies`. `final_line` is the one place that words
+the conclusion: PASSED only after the verdict `flies`; a weaker verdict that an explicit
+`--require` accepts is ACCEPTED, never PASSED (a "MARGINAL" then "PASSED" is a green
+check that is false).
 """
 
 from __future__ import annotations
@@ -48,16 +52,17 @@ class Verdict(enum.Enum):
 
 @dataclass(frozen=True)
 class Requirement:
-    """`--require`: hover (a trim exists), stable (default: and it can be stabilised), or
-    margin:DEG (and it recovers from a start tilted by DEG degrees)."""
+    """`--require`: flies (default: the verdict is `flies`), hover (a trim exists), stable
+    (and it can be stabilised), or margin:DEG (and it recovers from a start tilted by DEG
+    degrees)."""
 
-    level: str = "stable"
+    level: str = "flies"
     margin_deg: float = 0.0
 
     @classmethod
     def parse(cls, text: str) -> "Requirement":
         text = text.strip().lower()
-        if text in ("hover", "stable"):
+        if text in ("flies", "hover", "stable"):
             return cls(text)
         head, sep, value = text.partition(":")
         if head == "margin" and sep:
@@ -67,7 +72,7 @@ class Requirement:
                 deg = math.nan
             if math.isfinite(deg) and 0.0 < deg < 90.0:
                 return cls("margin", deg)
-        raise ValueError(f"--require '{text}': expected hover, stable or margin:DEG "
+        raise ValueError(f"--require '{text}': expected flies, hover, stable or margin:DEG "
                          "with 0 < DEG < 90")
 
     def __str__(self) -> str:
@@ -89,6 +94,8 @@ class HoverVerdict:
             return False
         if self.verdict is Verdict.CANNOT_STABILISE:
             return requirement.level == "hover"
+        if requirement.level == "flies":
+            return self.verdict is Verdict.FLIES
         if requirement.level != "margin" or self.verdict is Verdict.NOT_FLOWN:
             return True
         return (self.recoverable_tilt_deg or 0.0) >= requirement.margin_deg - 1e-9
@@ -99,6 +106,31 @@ class HoverVerdict:
                 "recoverable_offset_m": self.recoverable_offset_m,
                 "start_tilt_deg": self.start_tilt_deg, "start_offset_m": self.start_offset_m,
                 "flights": self.flights}
+
+
+def outcome(status: str, passed: bool) -> str:
+    """"passed" (exit 0 after the verdict `flies`), "accepted" (exit 0 because an explicit
+    --require accepts a weaker verdict: not a pass of the flight) or "failed" (exit 1)."""
+    if not passed:
+        return "failed"
+    return "passed" if status == Verdict.FLIES.value else "accepted"
+
+
+def final_line(status: str, passed: bool, requirement: str, message: str) -> str:
+    """hover-test's last line: PASSED only when the verdict is `flies`.
+
+    `status` is the verdict's value, `passed` the verdict (and batch) against
+    `requirement` (its text), `message` why it failed."""
+    kind = outcome(status, passed)
+    if kind == "passed":
+        return "PASSED"
+    if kind == "accepted":
+        return (f"ACCEPTED by --require {requirement}: the verdict is {status.upper()}, "
+                "not FLIES (exit 0, not a pass of the flight)")
+    if status in (Verdict.MARGINAL.value, Verdict.NOT_FLOWN.value) and requirement == "flies":
+        return (f"FAILED: the verdict is {status.upper()}, not FLIES (above); --require "
+                "stable accepts a vehicle that hovers and can be stabilised")
+    return f"FAILED: {message}"
 
 
 def tilt_deg(config: HoverConfig) -> float:
