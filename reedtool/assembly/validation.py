@@ -174,6 +174,17 @@ def judge(model: Path, robot, request: ModelRequest, command: str) -> Verdict:
     return verdict
 
 
+def refusal_table() -> list[tuple[str, str, str]]:
+    """(command, groups, rule codes) rows for the docs and --help."""
+    from reedtool.checks.registry import all_rules
+
+    rows = []
+    for command, needs in COMMAND_NEEDS.items():
+        codes = [r.code for r in all_rules() if r.severity == "error" and refuses(r.code, needs)]
+        rows.append((command, ", ".join(needs), " ".join(codes)))
+    return rows
+
+
 # ------------------------------------------------------------------ inertia's link verdicts
 #
 # `reedtool inertia` shows physics.inertia.compare_links' verdict per link, the same verdict
@@ -227,14 +238,3 @@ def judge_links(model: Path, robot, request: ModelRequest, comparisons: list) ->
               and not any(code.startswith(s) for s in ignores_for(c.loc.file)))
         judged.append(replace(c, severity=selection.severity_of(rule) if on else None))
     return judged
-
-
-def refusal_table() -> list[tuple[str, str, str]]:
-    """(command, groups, rule codes) rows for the docs and --help."""
-    from reedtool.checks.registry import all_rules
-
-    rows = []
-    for command, needs in COMMAND_NEEDS.items():
-        codes = [r.code for r in all_rules() if r.severity == "error" and refuses(r.code, needs)]
-        rows.append((command, ", ".join(needs), " ".join(codes)))
-    return rows
