@@ -71,22 +71,108 @@ def test_real_model_shapes_get_the_verdict_of_the_vehicle(model, status):
         assert report["sim"]["status"] != "crashed"
 
 
+def _by_hand(path: Path) -> dict:
+    """The fixture's mass properties and hover trim worked out here from its text, without
+    reedtool: every rpy is 0 (checked), so link frames are joint origins added up, tensors
+    stay diagonal in base axes, and each rotor pushes along +z at its link origin.
+
+    Mass, COM, Ixx about the COM (parallel axis); the allocation A (thrust; roll = y T,
+    pitch = -x T about the COM; yaw = c_m T with the spin's sign), the minimum-norm trim
+    T = A+ [m g, 0, 0, 0], omega = sqrt(T / k), and the roll authority as trim.py words it:
+    along A+'s roll column in both signs until a rotor reaches 0 or k omega_max^2.
+    """
+    import xml.etree.ElementTree as ET
+
+    root = ET.parse(path).getroot()
+    assert {e.get("rpy") for e in root.iter("origin")} == {"0 0 0"}
+
+    def xyz(element) -> np.ndarray:
+        return np.array([float(v) for v in element.get("xyz", "0 0 0").split()])
+
+    origin_of = {j.find("child").get("link"): (j.find("parent").get("link"), xyz(j.find("origin")))
+                 for j in root.iter("joint")}
+
+    def position(link: str) -> np.ndarray:
+        p = np.zeros(3)
+        while link in origin_of:
+            link, offset = origin_of[link]
+            p = p + offset
+        return p
+
+    masses, coms, ixx = [], [], []
+    for link in root.iter("link"):
+        inertial = link.find("inertial")
+        masses.append(float(inertial.find("mass").get("value")))
+        coms.append(position(link.get("name")) + xyz(inertial.find("origin")))
+        ixx.append(float(inertial.find("inertia").get("ixx")))
+    m, coms = np.array(masses), np.array(coms)
+    mass = m.sum()
+    com = (m[:, None] * coms).sum(axis=0) / mass
+    d = coms - com
+    Ixx = float(np.sum(ixx) + np.sum(m * (d[:, 1] ** 2 + d[:, 2] ** 2)))
+
+    columns, k, omega_max = [], [], []
+    for plugin in root.iter("plugin"):
+        r = position(plugin.find("linkName").text) - com
+        sign = 1.0 if plugin.find("turningDirection").text == "ccw" else -1.0
+        columns.append([1.0, r[1], -r[0], sign * float(plugin.find("momentConstant").text)])
+        k.append(float(plugin.find("motorConstant").text))
+        omega_max.append(float(plugin.find("maxRotVelocity").text))
+    A, k, omega_max = np.array(columns).T, np.array(k), np.array(omega_max)
+    A_pinv = np.linalg.pinv(A)
+    thrust = A_pinv @ np.array([mass * G, 0.0, 0.0, 0.0])
+    thrust_max = k * omega_max ** 2
+    roll = A_pinv[:, 1]
+    reach = [min(np.min(np.where(s * roll > 0, (thrust_max - thrust) / (s * roll), np.inf)),
+                 np.min(np.where(s * roll < 0, -thrust / (s * roll), np.inf)))
+             for s in (1.0, -1.0)]
+    omega = np.sqrt(thrust / k)
+    return {"mass_kg": mass, "Ixx": Ixx, "omega": omega, "roll_authority": min(reach),
+            "thrust_to_weight": thrust_max.sum() / (mass * G),
+            "hover_throttle_max": float(np.max(omega / omega_max))}
+
+
 def test_the_shapes_are_the_ones_the_issue_describes():
+    """Each figure is worked out from the fixture's text (_by_hand), then held against the
+    issue's description the generator was written to (tests/fixtures/hover_tuning/generate.py).
+
+    Tolerances: reedtool and _by_hand sum the same decimals (rel 1e-12); the trim is a
+    4 x n least-squares solve in both, cond < 1e3: rel 1e-9. The generator writes 10
+    significant digits, so a target it sets exactly (T/W 10, 85 %) holds to rel 1e-9."""
     code, hexa = hover_json(TUNING / "hexa_manipulator.urdf")
-    assert hexa["model"]["mass_kg"] == pytest.approx(7.3, rel=1e-3)
-    assert hexa["model"]["inertia_kg_m2"][0][0] == pytest.approx(1.85, rel=0.02)
-    assert hexa["trim"]["torque_authority_N_m"]["roll"] == pytest.approx(14.0, rel=0.02)
+    hand = _by_hand(TUNING / "hexa_manipulator.urdf")
+    assert hexa["model"]["mass_kg"] == pytest.approx(hand["mass_kg"], rel=1e-12)
+    assert hexa["model"]["inertia_kg_m2"][0][0] == pytest.approx(hand["Ixx"], rel=1e-9)
+    roll = hexa["trim"]["torque_authority_N_m"]["roll"]
+    assert roll == pytest.approx(hand["roll_authority"], rel=1e-9)
+    # the issue's vehicle: 7.3 kg (4.985 + 6 x 0.05 + 2 x 0.5 + 1.0 + 0.015), Ixx about
+    # 1.85 kg*m^2 (the pendulum's 1 kg a metre below), about 14 N*m of roll authority
+    assert hand["mass_kg"] == pytest.approx(4.985 + 6 * 0.05 + 2 * 0.5 + 1.0 + 0.015,
+                                            rel=1e-12)
+    assert 1.8 < hand["Ixx"] < 1.9 and 13 < hand["roll_authority"] < 15
     # The fixed 12 rad/s loop would ask J w^2 0.2 = 1.84 * 144 * 0.2 = 53 N*m of it.
+    assert hand["Ixx"] * 12.0 ** 2 * 0.2 > hand["roll_authority"]
     assert hexa["sim"]["gains"]["limited_by"] == "torque authority"
     _, racing = hover_json(TUNING / "racing_tw10.urdf")
-    assert racing["trim"]["thrust_to_weight"] == pytest.approx(10.0, rel=1e-9)
+    hand = _by_hand(TUNING / "racing_tw10.urdf")
+    assert racing["trim"]["thrust_to_weight"] == pytest.approx(hand["thrust_to_weight"],
+                                                               rel=1e-12)
+    assert hand["thrust_to_weight"] == pytest.approx(10.0, rel=1e-9)
     _, slow = hover_json(TUNING / "racing_slow_motors.urdf")
-    assert slow["trim"]["thrust_to_weight"] == pytest.approx(5.0, abs=0.1)
+    hand = _by_hand(TUNING / "racing_slow_motors.urdf")
+    assert slow["trim"]["thrust_to_weight"] == pytest.approx(hand["thrust_to_weight"],
+                                                             rel=1e-12)
     speeds = [r["omega_rad_s"] for r in slow["trim"]["rotors"]]
-    assert min(speeds) == pytest.approx(485, abs=2) and max(speeds) == pytest.approx(529, abs=2)
+    assert speeds == pytest.approx(list(hand["omega"]), rel=1e-9)
+    # the front pair nearer the COM than the rear: two trims, ~485 and ~529 rad/s
+    assert 480 < min(speeds) < 490 and 524 < max(speeds) < 534
     _, cf = hover_json(TUNING / "crazyflie_like.urdf")
-    assert cf["model"]["mass_kg"] == pytest.approx(0.027, rel=1e-9)
-    assert cf["trim"]["hover_throttle_max"] == pytest.approx(0.85, rel=1e-9)
+    hand = _by_hand(TUNING / "crazyflie_like.urdf")
+    assert cf["model"]["mass_kg"] == pytest.approx(hand["mass_kg"], rel=1e-12)
+    assert cf["trim"]["hover_throttle_max"] == pytest.approx(hand["hover_throttle_max"],
+                                                             rel=1e-9)
+    assert (hand["mass_kg"], hand["hover_throttle_max"]) == pytest.approx((0.027, 0.85),
+                                                                          rel=1e-9)
 
 
 def test_marginal_vehicle_reports_what_it_recovers_from():

@@ -121,3 +121,100 @@ def test_a_negligible_whole_robot_change_is_said_in_percent():
     (judged,) = [c for c in judge_in_robot(robot, [way_off]) if c.link == rotor.link]
     assert judged.verdict == "implausible"
     assert "%" in judged.message and " 1x" not in judged.message
+
+
+# A 1 kg box body and a 0.1 kg wheel (cylinder r 0.05 m, 2 cm wide) on a continuous joint:
+# no rotor, so validate's only finding is the wheel's inertia. The wheel's solid-cylinder
+# tensor is m(3r^2 + l^2)/12 = 6.5833e-5 about x and y, m r^2/2 = 1.25e-4 about z.
+WHEEL_SOLID = np.diag(cylinder_inertia(0.1, 0.05, 0.02))
+
+
+def cart_model(wheel_diag, mass="0.1", joint="continuous") -> str:
+    ixx, iyy, izz = np.diag(box_inertia(1.0, (0.3, 0.3, 0.1)))
+    wxx, wyy, wzz = wheel_diag
+    return f"""<?xml version="1.0"?>
+<robot name="cart">
+  <link name="base_link"><inertial><mass value="1"/>
+    <inertia ixx="{ixx}" ixy="0" ixz="0" iyy="{iyy}" iyz="0" izz="{izz}"/></inertial>
+    <collision><geometry><box size="0.3 0.3 0.1"/></geometry></collision></link>
+  <joint name="wheel_joint" type="{joint}"><parent link="base_link"/><child link="wheel"/>
+    <origin xyz="0.2 0 0"/><axis xyz="0 1 0"/></joint>
+  <link name="wheel"><inertial><mass value="{mass}"/>
+    <inertia ixx="{wxx}" ixy="0" ixz="0" iyy="{wyy}" iyz="0" izz="{wzz}"/></inertial>
+    <collision><geometry><cylinder length="0.02" radius="0.05"/></geometry></collision></link>
+</robot>
+"""
+
+
+def _exit_and_json(argv, capsys) -> tuple[int, dict]:
+    from reedtool.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main([*map(str, argv), "--format", "json"])
+    return exc.value.code, json.loads(capsys.readouterr().out)
+
+
+# (wheel tensor, the user's pyproject.toml [tool.reedtool] lines, the wheel's severity and
+# the exit code both commands must give). 1.0 everywhere is ~1.2e4x the wheel's trace and
+# decides the cart's inertia (I209, error by default); 20x the solid cylinder is past the
+# 10x plausible bound but the cart flies alike (I204, warning by default).
+@pytest.mark.parametrize("wheel, config, severity, code", [
+    (np.ones(3), "", "error", 1),
+    (np.ones(3), '[tool.reedtool.severity]\nI209 = "warning"\n', "warning", 0),
+    (np.ones(3), '[tool.reedtool.severity]\nI2 = "info"\n', "info", 0),     # a prefix
+    (np.ones(3), '[tool.reedtool]\nignore = ["I209"]\n', None, 0),
+    (WHEEL_SOLID * 20, "", "warning", 0),
+    (WHEEL_SOLID * 20, '[tool.reedtool.severity]\nI204 = "error"\n', "error", 1),
+])
+def test_a_severity_override_means_the_same_in_validate_and_inertia(
+        tmp_path, capsys, wheel, config, severity, code):
+    """The user's configuration decides a verdict's severity in `inertia` exactly as in
+    `validate` (issue 29: inertia kept its own table and exited 1 on an I209 the user
+    had made a warning, printing "(error, as in validate)")."""
+    model = tmp_path / "cart.urdf"
+    model.write_text(cart_model(wheel))
+    if config:
+        (tmp_path / "pyproject.toml").write_text(config)
+    validate_code, validate_doc = _exit_and_json(["validate", model], capsys)
+    inertia_code, inertia_doc = _exit_and_json(["inertia", model], capsys)
+    by_link = {f["subject"]: f["severity"] for f in validate_doc["findings"]}
+    (wheel_link,) = [link for link in inertia_doc["links"] if link["link"] == "wheel"]
+    assert (validate_code, inertia_code) == (code, code)
+    assert by_link.get("wheel") == wheel_link["severity"] == severity
+    assert inertia_doc["failing"] == code
+    # The text report says the same word.
+    from cli_helpers import run_cli
+
+    text_code, text = run_cli("inertia", model)
+    assert text_code == code
+    if severity in ("error", "warning"):
+        assert f"({severity}, as in validate): wheel" in text
+    else:
+        assert "as in validate" not in text
+
+
+@pytest.mark.parametrize("wheel, mass, joint, verdict", [
+    (WHEEL_SOLID, "-0.1", "continuous", "negative-mass"),
+    (np.zeros(3), "0", "continuous", "massless-moving"),
+    (WHEEL_SOLID, "0", "continuous", "massless-inertia"),   # moving: I201 says it
+    (WHEEL_SOLID, "0", "fixed", "massless-inertia"),        # fixed: I208 says it
+    ((1e-4, 1e-4, 5e-4), "0.1", "continuous", "invalid"),   # 1e-4 + 1e-4 < 5e-4
+    ((-1e-4, 1e-4, 1e-4), "0.1", "continuous", "invalid"),  # a negative moment
+    (np.ones(3), "0.1", "continuous", "way-off"),
+    (WHEEL_SOLID * 20, "0.1", "continuous", "implausible"),
+])
+def test_each_failing_verdict_maps_to_the_rule_validate_reports_it_with(
+        tmp_path, wheel, mass, joint, verdict):
+    """inertia takes a verdict's severity from one rule (assembly.validation.verdict_code);
+    that must be the rule validate actually reports the link with, found by running
+    validate's rules, not by reading the map back."""
+    from reedtool.assembly.validation import verdict_code
+    from reedtool.physics.inertia import moving_links
+
+    model = tmp_path / "cart.urdf"
+    model.write_text(cart_model(wheel, mass, joint))
+    robot = load_robot(model)
+    (c,) = [c for c in compare_links(robot) if c.link == "wheel"]
+    assert c.verdict == verdict
+    reported = {f.code for f in run_checks(robot) if f.subject == "wheel"}
+    assert verdict_code(c, "wheel" in moving_links(robot)) in reported, reported

@@ -86,11 +86,24 @@ def test_every_import_points_down_the_pipeline():
     assert wrong == []
 
 
+def _stage_edges(graph: dict[str, set[str]]) -> set[tuple[str, str]]:
+    """(importing stage, imported stage) for every import across stages."""
+    return {(_stage(module), _stage(target)) for module, imported in graph.items()
+            for target in imported if _stage(module) != _stage(target)}
+
+
 def test_stages_run_in_pipeline_order():
-    """The assembly sits between the output stage and the commands; checks and sim below it."""
-    order = sorted(RANK, key=RANK.get)
-    assert order.index("assembly") > max(order.index(s) for s in ("checks", "sim", "report"))
-    assert order.index("assembly") < order.index("commands") < order.index("cli")
+    """The assembly sits between the output stage and the commands, checks and sim below
+    it: read from the package's imports, not from RANK. The assembly builds on checks, sim
+    and report, the commands on the assembly, and no stage below reaches up to them."""
+    edges = _stage_edges(_graph())
+    assert {("assembly", "checks"), ("assembly", "sim"), ("assembly", "report"),
+            ("commands", "assembly")} <= edges
+    below = {"", "io", "physics", "flightstack", "checks", "sim", "scaffold", "report",
+             "config"}
+    upward = sorted(f"{low} -> {high}" for low, high in edges
+                    if low in below and high in ("assembly", "commands", "cli"))
+    assert upward == []
 
 
 def _command_to_command(graph: dict[str, set[str]]) -> list[str]:

@@ -343,19 +343,74 @@ def test_scoped_ardupilot_names_resolve(tmp_path):
     assert [f.code for f in run_checks(robot) if f.severity != "info"] == []
 
 
-@pytest.mark.parametrize("old,new", [
-    ("<reversible>true</reversible>", "<reversible>maybe</reversible>"),
-    ("<actuator_number>3</actuator_number>", "<actuator_number>three</actuator_number>"),
-    ("<motorType>velocity</motorType>", "<motorType>POSITION</motorType>"),
-])
-def test_odd_gz_input_never_raises(tmp_path, old, new):
-    for fixture in ("omni/omni_reversible.sdf", "vtol/vtol_pusher.sdf"):
-        text = (FIXTURES / fixture).read_text()
-        path = tmp_path / "odd.sdf"
-        path.write_text(text.replace(old, new))
-        robot = load_robot(path)
-        discover_rotors(robot)
-        run_checks(robot)
+GZ_FIXTURES = ("omni/omni_reversible.sdf", "vtol/vtol_pusher.sdf")
+
+
+def _edited(tmp_path, fixture, old=None, new=None, name="odd.sdf"):
+    """The fixture with every `old` replaced by `new` (None: as it is): (robot, rotors,
+    findings). The edit must change the text: a mutation of an absent string tests nothing."""
+    text = (FIXTURES / fixture).read_text()
+    if old is not None:
+        assert old in text and old != new, f"{fixture}: replacing {old} changes nothing"
+        text = text.replace(old, new)
+    path = tmp_path / name
+    path.write_text(text)
+    robot = load_robot(path)
+    findings = run_checks(robot)
+    crashed = [f"{f.code}: {f.message}" for f in findings
+               if f.message.startswith("internal error in this rule")]
+    assert not crashed
+    return robot, discover_rotors(robot), findings
+
+
+def _said(findings) -> list[tuple[str, str, str]]:
+    return sorted((f.code, f.severity, f.message) for f in findings)
+
+
+def test_an_odd_reversible_word_reads_as_sdformat_reads_it(tmp_path):
+    """gz-sim reads `<reversible>` with Element::Get<bool>(): sdformat accepts true/false/
+    1/0 in any case and gives bool() = false for any other word (Param.cc "Invalid boolean
+    value"). So "maybe" is "false": the omnicopter's eight motors spin one way only, and
+    every finding is the one the model with "false" written gets."""
+    old = "<reversible>true</reversible>"
+    _, rotors, findings = _edited(tmp_path, "omni/omni_reversible.sdf", old,
+                                  "<reversible>maybe</reversible>")
+    _, rotors_false, findings_false = _edited(tmp_path, "omni/omni_reversible.sdf", old,
+                                              "<reversible>false</reversible>", "false.sdf")
+    assert len(rotors) == 8 and not any(r.reversible for r in rotors)
+    assert _said(findings) == _said(findings_false)
+    assert any("(0 reversible)" in f.message for f in findings if f.code == "R319")
+    _, rotors_upper, _ = _edited(tmp_path, "omni/omni_reversible.sdf", old,
+                                 "<reversible>TRUE</reversible>", "upper.sdf")
+    assert all(r.reversible for r in rotors_upper)
+
+
+@pytest.mark.parametrize("fixture", GZ_FIXTURES)
+def test_a_word_for_an_actuator_number_is_an_error_naming_it(tmp_path, fixture):
+    # gz-sim's Get<int>() gives int() = 0 for "three": the motor would listen to output 0.
+    _, original, _ = _edited(tmp_path, fixture, name="original.sdf")
+    _, rotors, findings = _edited(tmp_path, fixture, "<actuator_number>3</actuator_number>",
+                                  "<actuator_number>three</actuator_number>")
+    assert [r.joint for r in rotors] == [r.joint for r in original]
+    named = [f for f in findings if "'three'" in f.message]
+    assert [(f.code, f.severity, f.subject) for f in named] == [("R302", "error", "rotor_3")]
+
+
+@pytest.mark.parametrize("fixture", GZ_FIXTURES)
+def test_motor_type_is_compared_exactly_as_the_motor_plugins_do(tmp_path, fixture):
+    """gz-sim's MulticopterMotorModel (and RotorS' gazebo_motor_model) compare the word
+    exactly: "position" makes a servo, "POSITION" is not one of their words and leaves the
+    default, a velocity motor (an error in Gazebo's log, nothing else changes)."""
+    old = "<motorType>velocity</motorType>"
+    _, original, findings_original = _edited(tmp_path, fixture, name="original.sdf")
+    _, rotors, findings = _edited(tmp_path, fixture, old, "<motorType>POSITION</motorType>")
+    assert [(r.joint, r.motor_number) for r in rotors] == \
+        [(r.joint, r.motor_number) for r in original]
+    assert len(rotors) == (FIXTURES / fixture).read_text().count(old) > 0
+    assert _said(findings) == _said(findings_original)
+    _, servos, _ = _edited(tmp_path, fixture, old, "<motorType>position</motorType>",
+                           "servo.sdf")
+    assert servos == []
 
 
 def test_hover_test_derives_ardupilot_time_constant_from_the_pid(capsys):

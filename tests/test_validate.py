@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import io
 import json
 import shutil
+import sys
 from pathlib import Path
 
 import pytest
@@ -116,11 +118,32 @@ def test_text_has_no_colour_unless_a_terminal(capsys):
     assert "\x1b[" in coloured
 
 
-def test_no_color_env(monkeypatch):
-    from reedtool.commands.validate import _use_color
+class _Terminal(io.StringIO):
+    """A stdout that says it is a terminal, where validate colours its text."""
 
-    monkeypatch.setenv("NO_COLOR", "1")
-    assert _use_color(False) is False
+    def isatty(self) -> bool:
+        return True
+
+
+# no-color.org: NO_COLOR "present and not an empty string" turns colour off, whatever
+# its value; an empty NO_COLOR is as if it were not set.
+@pytest.mark.parametrize("no_color, coloured", [(None, True), ("1", False), ("0", False),
+                                                ("", True)])
+def test_no_color_env(monkeypatch, no_color, coloured):
+    """On a terminal validate colours its text (the control case), and NO_COLOR wins."""
+    from reedtool.cli import main
+
+    monkeypatch.delenv("NO_COLOR", raising=False)
+    if no_color is not None:
+        monkeypatch.setenv("NO_COLOR", no_color)
+    terminal = _Terminal()
+    monkeypatch.setattr(sys, "stdout", terminal)
+    with pytest.raises(SystemExit) as exc:
+        main(["validate", str(TWO_ERRORS)])
+    assert exc.value.code == 1
+    out = terminal.getvalue()
+    assert "S105" in out
+    assert ("\x1b[" in out) is coloured
 
 
 # ------------------------------------------------------------------- selection

@@ -145,6 +145,7 @@ class Verdict:
 
     refusing: list = field(default_factory=list)   # the result would be meaningless
     reported: list = field(default_factory=list)   # shown beside the result
+    findings: list = field(default_factory=list)   # every kept finding, any severity
 
     @property
     def errors(self) -> list:
@@ -168,7 +169,7 @@ def judge(model: Path, robot, request: ModelRequest, command: str) -> Verdict:
     --ignore), split into those `command` refuses on and those it reports."""
     kept = validation_findings(model, robot, request)
     needs = COMMAND_NEEDS[command]
-    verdict = Verdict()
+    verdict = Verdict(findings=kept)
     for f in kept:
         if f.severity == "error":
             (verdict.refusing if refuses(f.code, needs) else verdict.reported).append(f)
@@ -184,3 +185,58 @@ def refusal_table() -> list[tuple[str, str, str]]:
         codes = [r.code for r in all_rules() if r.severity == "error" and refuses(r.code, needs)]
         rows.append((command, ", ".join(needs), " ".join(codes)))
     return rows
+
+
+# ------------------------------------------------------------------ inertia's link verdicts
+#
+# `reedtool inertia` shows physics.inertia.compare_links' verdict per link, the same verdict
+# the I2xx rules word as findings. Its severity is the reporting rule's, with the model's
+# configuration and the command line applied exactly as for validate: the registry holds
+# the default, `[tool.reedtool] severity` may change it, `ignore` may switch it off.
+
+# Verdicts reported by one rule whatever the link; the others are decided in verdict_code.
+VERDICT_RULES: dict[str, str] = {
+    "negative-mass": "I201",       # mass-not-positive
+    "massless-moving": "I201",
+    "implausible": "I204",         # inertia-implausible-for-geometry
+    "way-off": "I209",
+}
+# An impossible tensor, by physics.inertia.tensor_problem: NaN/inf is a non-finite number.
+INVALID_TENSOR_RULES: dict[str, str] = {"non-finite": "S102", "not-positive-definite": "I202",
+                                        "triangle": "I203"}
+
+
+def verdict_code(comparison, moving: bool) -> str | None:
+    """The code of the rule that reports a link's inertia verdict; None when none does
+    (ok, differs, slowdown-scaled, placeholder, ...: nothing to judge)."""
+    if comparison.verdict == "invalid":
+        return INVALID_TENSOR_RULES.get(comparison.tensor_problem, "I202")
+    if comparison.verdict == "massless-inertia":
+        # On a link that moves, the zero mass itself is I201 (I208 stays quiet there).
+        return "I201" if moving else "I208"
+    return VERDICT_RULES.get(comparison.verdict)
+
+
+def judge_links(model: Path, robot, request: ModelRequest, comparisons: list) -> list:
+    """`comparisons` (physics.inertia.compare_links) with each link's severity: that of the
+    rule reporting its verdict, under the model's configuration and --select/--ignore; None
+    where no rule reports it or the rule is switched off (also for the link's file by
+    per-file-ignores)."""
+    from dataclasses import replace
+
+    from reedtool.checks.registry import get_rule
+    from reedtool.config import load_config
+    from reedtool.physics.inertia import moving_links
+
+    config = load_config(model)
+    selection = selection_for(config, request.select, request.ignore)
+    ignores_for = _ignores_for(config, model)
+    moving = moving_links(robot)
+    judged = []
+    for c in comparisons:
+        code = verdict_code(c, c.link in moving)
+        rule = get_rule(code) if code else None
+        on = (rule is not None and selection.enabled(code)
+              and not any(code.startswith(s) for s in ignores_for(c.loc.file)))
+        judged.append(replace(c, severity=selection.severity_of(rule) if on else None))
+    return judged

@@ -49,11 +49,9 @@ def _finite_or_none(value):
 SHARED_CODES = ("S130", "S131", "I207", "I210")
 
 
-def shared_findings(robot, ignore=()) -> list:
-    from reedtool.checks.runner import Selection, parse_selectors, run_checks
-
-    return run_checks(robot, Selection(select=SHARED_CODES,
-                                       ignore=parse_selectors(ignore, origin="--ignore")))
+def shared_findings(verdict) -> list:
+    """validate's findings of SHARED_CODES (its configuration's severities and ignores)."""
+    return [f for f in verdict.findings if f.code in SHARED_CODES]
 
 
 def format_text(model: Path, robot, comparisons, whole, own, findings=()) -> str:
@@ -317,7 +315,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
     model, request = one_model_request("inertia", inputs, package_paths, model_name,
                                        launch_file, ignore)
     from reedtool.assembly.assemble import load_robot_for
-    from reedtool.assembly.validation import judge
+    from reedtool.assembly.validation import judge, judge_links
     from reedtool.checks.preflight import require_sound_model
     from reedtool.physics.inertia import compare_links, whole_robot
     from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
@@ -347,12 +345,13 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
                                    "findings": [f.to_dict() for f in verdict.errors]},
                                   indent=2))
         return 1
-    comparisons = compare_links(robot)
+    # Each verdict's severity is its rule's, as the configuration sets it for validate.
+    comparisons = judge_links(model, robot, request, compare_links(robot))
     own = whole_robot(robot)
     whole = whole_robot_pinocchio(robot)
 
     # The shared model-level findings (any severity), then validate's other errors.
-    findings = shared_findings(robot, request.ignore)
+    findings = shared_findings(verdict)
     shown = {(f.code, f.subject, f.message) for f in findings}
     findings += [f for f in verdict.errors if (f.code, f.subject, f.message) not in shown]
     render = format_json if fmt == "json" else format_text

@@ -498,12 +498,6 @@ ORDERS_OFF_TRACE_RATIO = 100.0
 # this many radii of gyration, it is probably outside it.
 COM_OFF_GYRATION_RADII = 1.0
 
-VERDICT_SEVERITY = {
-    "invalid": "error", "way-off": "error", "massless-inertia": "error",
-    "negative-mass": "error", "massless-moving": "error",
-    "implausible": "warning",
-}
-FAILING_VERDICTS = tuple(v for v, sev in VERDICT_SEVERITY.items() if sev == "error")
 FIXABLE_VERDICTS = ("invalid", "way-off", "implausible", "differs", "com-off")
 
 
@@ -517,15 +511,15 @@ class LinkComparison:
     inertia_rel_diff: float | None
     trace_ratio: float | None          # trace(declared) / trace(derived)
     com_offset_m: float | None
-    verdict: str                       # see VERDICT_SEVERITY; also ok | differs | com-off |
-    #   slowdown-scaled | massless | no-geometry | no-inertial | geometry-error
+    verdict: str                       # invalid | way-off | implausible | negative-mass |
+    #   massless-moving | massless-inertia | placeholder | point-mass | ok | differs |
+    #   com-off | slowdown-scaled | massless | no-geometry | no-inertial | geometry-error
     message: str
     slowdown: float | None = None      # rotorVelocitySlowdownSim of the rotor on this link
     tensor_problem: str | None = None  # see tensor_problem()
-
-    @property
-    def severity(self) -> str | None:
-        return VERDICT_SEVERITY.get(self.verdict)
+    # How much the verdict matters is policy, not physics: the rule registry decides, with
+    # the user's configuration (assembly.validation.judge_links fills this in).
+    severity: str | None = None
 
     @property
     def failing(self) -> bool:

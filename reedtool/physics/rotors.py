@@ -3,8 +3,8 @@
 Four families are read:
 
 - RotorS and PX4 gazebo-classic motor models (`gazebo_motor_model`): jointName, linkName,
-  turningDirection, motorConstant, ... A `<motorType>` other than `velocity` (the
-  plugins' default) is a position or force servo (RotorS omav's tilt arms), not a rotor.
+  turningDirection, motorConstant, ... A `<motorType>` of `position` or `force` (exactly;
+  `velocity` is the default) is a servo (RotorS omav's tilt arms), not a rotor.
 - gz-sim's MulticopterMotorModel: the same elements, numbered by `<actuator_number>`
   (`<motorNumber>` is its deprecated alias, read when the new one is absent), and
   `<reversible>` motors that may spin both ways (PX4's omnicopter).
@@ -240,9 +240,13 @@ def discover_rotors(robot: Robot) -> list[Rotor]:
 
 
 def _motor_model_rotor(robot: Robot, plugin: Plugin, kind: str, poses, index: int):
-    motor_type = (plugin.param("motorType") or "velocity").strip().lower()
-    if motor_type != "velocity":
-        return None  # a position/force servo (a tilt arm), not a propeller
+    # RotorS' gazebo_motor_model and gz-sim's MulticopterMotorModel compare the trimmed
+    # word exactly: "position" or "force" is a servo (a tilt arm), not a propeller; any
+    # other word ("POSITION") leaves their default, a velocity motor, with an error in
+    # Gazebo's log. PX4 classic's gazebo_motor_model does not read <motorType> at all.
+    motor_type = (plugin.param("motorType") or "velocity").strip()
+    if kind != "px4" and motor_type in ("position", "force"):
+        return None
     link = plugin.param("linkName")
     joint = plugin.param("jointName")
     if link is None and joint in robot.joint_map:
