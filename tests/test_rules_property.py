@@ -358,7 +358,10 @@ def damaged_model(draw) -> tuple[str, bool]:
     return text, as_sdf
 
 
-READER_CODES = {"S101", "S102", "R316"}    # the readers' findings quote the raw text
+# the readers' findings quote the raw text: S101/S102 a number, R316 a plugin value, R302 a
+# <motorNumber> that is no integer, S168 the <sdf version> (libsdformat reads the
+# document's version before anything else)
+READER_CODES = {"S101", "S102", "R302", "R316", "S168"}
 UNKNOWN_NUMBER = re.compile(r"(?<!['\"=])\b(nan|inf)\b", re.IGNORECASE)
 
 
