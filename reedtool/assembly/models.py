@@ -205,9 +205,13 @@ def one_model(paths: Sequence[str], request: ModelRequest, command: str) -> Path
         if Path(word).exists() or _GLOB_CHARS.search(word):
             continue
         if n == 0 and "=" not in word:
+            from reedtool.io.model_inputs import suggest_path
+
+            nearby = suggest_path(word)
             raise ReedtoolError("model file not found", file=word,
-                                hint="pass a model file (.urdf, .xacro, .sdf, .gazebo, "
-                                     ".world), a directory or a ROS package")
+                                hint=f"did you mean '{nearby}'?" if nearby else
+                                "pass a model file (.urdf, .xacro, .sdf, .gazebo, "
+                                ".world), a directory or a ROS package")
         # A word after the model that names nothing is a mistyped argument.
         from reedtool.io.mappings import suggest_mapping
 

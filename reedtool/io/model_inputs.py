@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import fnmatch
 import glob as globmod
+import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -278,7 +279,11 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
 
     for raw in targets:
         path = Path(raw)
-        if path.is_file() and path.name in CONFIG_NAMES:
+        if path.is_file() and path.name == "package.xml":
+            # The manifest names the package; its models are in the directory beside it.
+            out.append(Target(display(path), None, error=PACKAGE_XML_MESSAGE.format(
+                directory=display(path.parent) if str(path.parent) != "." else ".")))
+        elif path.is_file() and path.name in CONFIG_NAMES:
             if configures_models(path):
                 add_directory(path.parent, raw)
             else:
@@ -303,15 +308,56 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
     return out
 
 
+PACKAGE_XML_MESSAGE = ("package.xml is the package's manifest, not a model; pass the package "
+                       "directory: reedtool validate {directory}")
+
+
 def not_found_message(word: str) -> str:
-    """"file not found", or what the word looks like it meant (an argument without `:=`)."""
+    """"file not found", and what the word looks like it meant: an argument without `:=`,
+    or a file or directory whose name is close to it."""
     from reedtool.io.mappings import suggest_mapping
 
     suggestion = suggest_mapping(word)
     if suggestion is not None:
         return (f"file not found; xacro arguments are written name:=value: did you mean "
                 f"'{suggestion}'?")
+    nearby = suggest_path(word)
+    if nearby is not None:
+        return f"file not found; did you mean '{nearby}'?"
     return "file not found"
+
+
+def suggest_path(word: str) -> str | None:
+    """The existing path nearest a mistyped one, component by component from the deepest
+    directory that exists (`urdf/mav_generic_odometry_sensr.gazebo` ->
+    `urdf/mav_generic_odometry_sensor.gazebo`), or None when no name is close."""
+    from difflib import get_close_matches
+
+    path = Path(word)
+    parts = path.parts
+    if not parts:
+        return None
+    # The longest prefix that exists; every component after it gets its nearest name.
+    start = 0
+    base = Path(parts[0]) if path.is_absolute() else Path(".")
+    if path.is_absolute():
+        start = 1
+    while start < len(parts) and (base / parts[start]).exists():
+        base, start = base / parts[start], start + 1
+    if start == len(parts):
+        return None        # it exists (a race, or a dangling link): nothing to suggest
+    for part in parts[start:]:
+        try:
+            names = sorted(entry.name for entry in base.iterdir()
+                           if not entry.name.startswith("."))
+        except OSError:
+            return None
+        # 0.8: one or two slips in a file name (`sensr`, `hexacoptr`), not another file.
+        close = get_close_matches(part, names, n=1, cutoff=0.8)
+        if not close:
+            return None
+        base = base / close[0]
+    return str(base) if path.is_absolute() else os.path.normpath(str(base))
 
 
 def include_tree_of(mappings_for: Callable[[Path], Mapping[str, str]],
