@@ -29,6 +29,10 @@ class ModelRequest:
     launch_file: Path | None = None
     select: tuple[str, ...] = ()
     ignore: tuple[str, ...] = ()
+    # One argument variant of the configuration's per-file-args (validate runs each
+    # separately); None: the model's first variant, if it has any.
+    variant: dict | None = None
+    force_exclude: bool = False           # --force-exclude: `exclude` named files too
     # Models loaded while deciding what a named file means (io.model_inputs), kept so the
     # check does not expand them twice: resolved path -> load_models pairs.
     preloaded: dict = field(default_factory=dict)
@@ -64,6 +68,14 @@ def model_arguments(model: Path, config, request: ModelRequest):
         origins[name] = f"config {relative_to_cwd(config.path)}"
         if name not in config.args:   # per-file-args name this model on purpose
             checked.add(name)
+    variants = config.variants_for(model)
+    variant = request.variant if request.variant is not None else \
+        (variants[0] if variants else {})
+    for name, value in variant.items():
+        mappings[name] = value
+        given[name] = SourceLoc(relative_to_cwd(config.path), _config_line(config.path, name))
+        origins[name] = f"config {relative_to_cwd(config.path)} (variant)"
+        checked.add(name)
     launch = request.launch
     if launch is not None:
         for name, value in launch.mappings.items():
@@ -105,6 +117,11 @@ def argument_use(model: Path, mappings, given, origins, checked, config,
                        complete=complete)
 
 
+def variant_label(variant: dict[str, str]) -> str:
+    """How a model's argument variant is named in reports: ` [mav_name:=firefly]`."""
+    return " [" + ", ".join(f"{name}:={value}" for name, value in variant.items()) + "]"
+
+
 def load_models(model: Path, mappings, package_paths, model_name):
     """(display suffix, Robot) pairs of one model path: one, or each model of a world."""
     from reedtool.io.loader import load_robots
@@ -137,7 +154,8 @@ def targets_of(paths: Sequence[str], request: ModelRequest):
             config = load_config(path)
         except ReedtoolError:
             return False
-        return set(config.args_for(path)[0].items()) != set(config.args.items())
+        return (set(config.args_for(path)[0].items()) != set(config.args.items())
+                or bool(config.variants_for(path)))
 
     def stands_alone(path: Path) -> bool:
         """Loads alone into a robot with links; the robots are kept for the check."""
@@ -158,11 +176,33 @@ def targets_of(paths: Sequence[str], request: ModelRequest):
         found = find_config(path)
         return found is not None and found[0] == path.resolve()
 
+    def excluded(path: Path, walked: Path | None) -> str | None:
+        """Why the configuration leaves `path` out: always when found by a directory walk,
+        when named only with `force-exclude` (ruff's rule: a file passed is checked)."""
+        try:
+            config = load_config(path)
+        except ReedtoolError:
+            return None       # the check of the file reports the configuration's error
+        if walked is None and not (config.force_exclude or request.force_exclude):
+            return None
+        pattern = config.exclusion(path, walked)
+        if pattern is None:
+            return None
+        from reedtool.config import relative_to_cwd
+
+        if pattern in config.extend_exclude:
+            where = f"extend-exclude in {relative_to_cwd(config.path)}"
+        elif config.exclude is not None:
+            where = f"exclude in {relative_to_cwd(config.path)}"
+        else:
+            where = "reedtool's default exclude"
+        return f"excluded by '{pattern}' ({where})"
+
     return expand_targets(paths, include_tree_of(mappings_for, request.package_paths),
                           display=lambda p: display_path(str(p)) or str(p),
                           include_globs=include_globs_of(mappings_for, request.package_paths),
                           has_arguments=has_arguments, stands_alone=stands_alone,
-                          configures_models=configures_models)
+                          configures_models=configures_models, excluded=excluded)
 
 
 def request_from_words(words: Sequence[str], *, package_paths: Sequence[Path] = (),

@@ -59,14 +59,41 @@ class RunOptions:
     notes: list[str] = field(default_factory=list)   # one line per clean cross-check
 
 
-def check_target(target, options: RunOptions) -> tuple[list, list[str]]:
-    """check_model for a Target, and the notes it made (what --jobs hands each worker:
+@dataclass(frozen=True)
+class Job:
+    """One check of the run: a model path, with one argument variant of its config."""
+
+    target: object                  # io.model_inputs.Target
+    variant: dict | None = None     # per-file-args variant; None: the model's arguments
+
+    @property
+    def name(self) -> str:
+        from reedtool.assembly.models import variant_label
+
+        return self.target.name + (variant_label(self.variant) if self.variant else "")
+
+
+def jobs_of(target) -> list[Job]:
+    """The checks of one target: one per argument variant its configuration gives it."""
+    from reedtool.config import load_config
+
+    variants = load_config(target.path).variants_for(target.path)
+    return [Job(target, v) for v in variants] if variants else [Job(target)]
+
+
+def check_target(job: Job, options: RunOptions) -> tuple[list, list[str]]:
+    """check_model for a Job, and the notes it made (what --jobs hands each worker:
     a worker's changes to `options` do not come back, its return value does)."""
-    notes, options.notes = options.notes, []
+    from dataclasses import replace
+
+    notes, request, options.notes = options.notes, options.request, []
+    if job.variant is not None:
+        # Each variant is its own robot: nothing loaded for another variant is reused.
+        options.request = replace(request, variant=job.variant, preloaded={})
     try:
-        return check_model(target.name, target.path, options), options.notes
+        return check_model(job.name, job.target.path, options), options.notes
     finally:
-        options.notes = notes
+        options.notes, options.request = notes, request
 
 
 def check_model(name: str, model: Path, options: RunOptions) -> list:
@@ -175,6 +202,65 @@ def print_settings(targets, options: RunOptions) -> int:
     return 0
 
 
+def _write_baseline(results, path: Path, force: bool) -> int:
+    """--write-baseline: every finding of the run recorded; exit 0 (2 when a model could
+    not be read: a baseline without its findings would not be the run's)."""
+    from reedtool.assembly.baseline import baseline_text
+    from reedtool.io.fileio import atomic_write_text
+    from reedtool.report import render
+
+    unread = [r for r in results if r.error is not None]
+    if unread:
+        click.echo(render(unread, "text"), nl=False)
+        raise ReedtoolError(f"{len(unread)} model(s) could not be read; baseline not written",
+                            file=path, hint="fix or exclude them, then write the baseline")
+    text, count = baseline_text(results, path)
+    atomic_write_text(path, text, force=force)
+    checked = sum(1 for r in results if r.skipped is None)
+    click.echo(f"reedtool: wrote {count} finding(s) of {checked} model(s) to {path}")
+    return 0
+
+
+def _apply_baselines(results, targets, baseline_file: Path | None) -> list:
+    """Drop the findings each model's baseline (--baseline, else its config's `baseline`)
+    accepts; the baselines used."""
+    from reedtool.assembly.baseline import apply_baselines, read_baseline
+    from reedtool.config import load_config, relative_to_cwd
+
+    loaded: dict[Path, object] = {}
+
+    def load(path: Path):
+        key = path.resolve()
+        if key not in loaded:
+            loaded[key] = read_baseline(path)
+        return loaded[key]
+
+    if baseline_file is not None:
+        baseline = load(baseline_file)
+        return apply_baselines(results, lambda result: baseline)
+    by_name = {}
+    for target in targets:
+        if target.path is not None:
+            config = load_config(target.path)
+            if config.baseline is not None:
+                by_name[target.name] = config.baseline
+    if not by_name:
+        return []
+
+    def baseline_for(result):
+        path = next((p for name, p in by_name.items()
+                     if result.name == name or result.name.startswith(name + " [")), None)
+        if path is None:
+            return None
+        if not path.is_file():
+            raise ReedtoolError("the configuration's baseline file does not exist",
+                                file=path, hint="write it with `reedtool validate "
+                                                f"--write-baseline {relative_to_cwd(path)}`")
+        return load(path)
+
+    return apply_baselines(results, baseline_for)
+
+
 # ------------------------------------------------------------------ the command
 
 @click.command(name="validate")
@@ -212,6 +298,16 @@ def print_settings(targets, options: RunOptions) -> int:
               help="ArduPilot .parm file to cross-check (FRAME_CLASS/TYPE, SERVOn_FUNCTION).")
 @click.option("--diagram", type=click.Path(path_type=Path, dir_okay=False), default=None,
               help="Also draw the rotor layout (.svg/.png), rotors named by findings in red.")
+@click.option("--force-exclude", is_flag=True,
+              help="Apply the configuration's exclude to files named on the command line too "
+                   "(as pre-commit passes them; the config's `force-exclude`).")
+@click.option("--baseline", "baseline_file", type=click.Path(path_type=Path, dir_okay=False),
+              help="Report only findings not recorded in this baseline file (default: the "
+                   "config's `baseline`).")
+@click.option("--write-baseline", "write_baseline", metavar="FILE",
+              type=click.Path(path_type=Path, dir_okay=False),
+              help="Record every finding of this run in FILE as accepted and exit 0 "
+                   "(--force to replace it).")
 @click.option("--jobs", "-j", type=click.IntRange(min=0), default=1, show_default=True,
               metavar="N", help="Check the models in N processes (0: one per available "
                                 "CPU); the report keeps the models' order.")
@@ -221,7 +317,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
             strict: bool | None, exit_zero: bool, show_statistics: bool, show_settings: bool,
             no_color: bool, controller_files: tuple[Path, ...] = (),
             airframe_files: tuple[Path, ...] = (), autopilot_files: tuple[Path, ...] = (),
-            diagram: Path | None = None, jobs: int = 1) -> int:
+            diagram: Path | None = None, jobs: int = 1, force_exclude: bool = False,
+            baseline_file: Path | None = None, write_baseline: Path | None = None) -> int:
     """Check models (.urdf, .xacro (.urdf.xacro), .gazebo, .sdf or .world files,
     directories, globs, ROS packages, or a changed pyproject.toml/reedtool.toml: the
     models it configures) for mistakes; NAME:=VALUE words are xacro arguments for every
@@ -243,6 +340,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
     paths, request = request_from_words(inputs, package_paths=package_paths,
                                         model_name=model_name, launch_file=launch_file,
                                         select=select, ignore=ignore)
+    request.force_exclude = force_exclude
     from reedtool.io.mappings import suggest_mapping
 
     for word in paths:
@@ -280,12 +378,14 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
     from reedtool.config import load_config
     from reedtool.report import ModelResult, render
 
-    checkable = [t for t in targets if t.skipped is None and t.path is not None]
-    checked = dict(zip((id(t) for t in checkable),
-                       map_models(functools.partial(check_target, options=options), checkable,
-                                  jobs)))
+    checkable = [job for t in targets if t.skipped is None and t.path is not None
+                 for job in jobs_of(t)]
+    outcomes = map_models(functools.partial(check_target, options=options), checkable, jobs)
+    checked: dict[int, list] = {}
+    for job, outcome in zip(checkable, outcomes):
+        checked.setdefault(id(job.target), []).append(outcome)
     results = []
-    failed = False       # a finding at its model's failing severity
+    failing_of = []      # (result, the severities that fail its model)
     strict_any = False
     for target in targets:
         if target.skipped is not None:
@@ -296,8 +396,10 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
                 raise ReedtoolError(target.error, file=target.name)
             results.append(ModelResult(target.name, error=target.error, error_file=target.name))
             continue
-        model_results, notes = checked[id(target)]
-        options.notes += notes
+        model_results = []
+        for one_results, notes in checked[id(target)]:
+            model_results += one_results
+            options.notes += notes
         if target.checked_for is not None:
             for result in model_results:
                 if result.error is not None:
@@ -313,8 +415,19 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
         model_strict = load_config(target.path).strict if strict is None else strict
         strict_any = strict_any or model_strict
         model_failing = {"error", "warning"} if model_strict else {"error"}
-        failed = failed or any(f.severity in model_failing
-                               for r in model_results for f in r.findings)
+        failing_of += [(r, model_failing) for r in model_results]
+    if write_baseline is not None:
+        return _write_baseline(results, write_baseline, force)
+    baselines = _apply_baselines(results, targets, baseline_file)
+    failed = any(f.severity in model_failing for r, model_failing in failing_of
+                 for f in r.findings)
+    for baseline in baselines:
+        from reedtool.config import relative_to_cwd
+
+        if baseline.stale():
+            options.notes.append(f"reedtool: {relative_to_cwd(baseline.path)}: "
+                                 f"{baseline.stale()} accepted finding(s) no longer occur in "
+                                 "this run; `--write-baseline` records the findings of now")
     failing = frozenset({"error", "warning"} if strict_any else {"error"})   # junit
     color = _use_color(no_color) and output_file is None
     text = render(results, fmt, color=color, show_statistics=show_statistics, failing=failing)

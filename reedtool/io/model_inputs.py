@@ -196,12 +196,18 @@ def _never(_path: Path) -> bool:
     return False
 
 
+def _not_excluded(_path: Path, _walked: Path | None) -> str | None:
+    return None
+
+
 def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequence[Path]],
                    display: Callable[[Path], str] = str, *,
                    include_globs: Callable[[Path], Sequence[str]] | None = None,
                    has_arguments: Callable[[Path], bool] = _never,
                    stands_alone: Callable[[Path], bool] = _never,
-                   configures_models: Callable[[Path], bool] = _never) -> list[Target]:
+                   configures_models: Callable[[Path], bool] = _never,
+                   excluded: Callable[[Path, Path | None], str | None] = _not_excluded
+                   ) -> list[Target]:
     """Every model the targets name, in order, each once.
 
     `include_tree(path)` lists the files a xacro model reads (itself first); it decides
@@ -211,6 +217,8 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
     per-file table of the config). `stands_alone(path)`: the file loads alone into a robot
     with links (the caller may keep what it loaded). `configures_models(path)`: the file is
     a reedtool configuration (its directory's models are checked when it changes).
+    `excluded(path, walked)`: why a file found walking directory `walked` (None: a file
+    named on the command line) is left out, or None (the configuration's `exclude`).
     """
     include_tree = _memo(include_tree)
     include_globs = _memo(include_globs) if include_globs is not None else None
@@ -230,6 +238,7 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
                                            suffixes=PACKAGE_SUFFIXES)]
         else:
             files = _model_files(path, recursive=True)
+        files = [f for f in files if excluded(f, path) is None]
         models = _top_level(files, include_tree, include_globs)
         if not models:
             out.append(Target(raw, None, "no model file (" + ", ".join(MODEL_SUFFIXES)
@@ -238,6 +247,10 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
             add(model)
 
     def add_file(path: Path) -> None:
+        why = excluded(path, None)
+        if why is not None:
+            out.append(Target(display(path), None, skipped=why))
+            return
         xacro = path.is_file() and path.suffix.lower() in XACRO_SUFFIXES
         includers = _includers(path, include_tree, include_globs) if xacro else []
         root, children = _root_and_children(path) if xacro else (None, [])
@@ -302,7 +315,11 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
             if not files:
                 out.append(Target(raw, None, "no file matches this pattern"))
             for match in files:
-                add(match)
+                why = excluded(match, None)
+                if why is not None:
+                    out.append(Target(display(match), None, skipped=why))
+                else:
+                    add(match)
         else:
             out.append(Target(raw, None, not_found_message(raw)))
     return out
