@@ -108,18 +108,33 @@ def rule(code: str, slug: str, severity: str, summary: str, *, clause: str
     return register
 
 
+_families_loaded = False
+# The sorted catalogue, kept while the registered rules stay the same ones: every model of
+# a run asks for it several times (selection, runner, severities).
+_sorted: tuple[tuple, list[Rule]] = ((), [])
+
+
 def _load_families() -> None:
+    global _families_loaded
+    if _families_loaded:
+        return
     for module_name, _title in FAMILIES.values():
         importlib.import_module(module_name)
     for module_name in EXTRA_RULE_MODULES:
         importlib.import_module(module_name)
+    _families_loaded = True
 
 
 def all_rules() -> list[Rule]:
     """Every registered rule, by family (S, I, R) and then by code."""
+    global _sorted
     _load_families()
-    order = list(FAMILIES)
-    return sorted(_RULES.values(), key=lambda r: (order.index(r.code[0]), r.code))
+    key = tuple(map(id, _RULES.values()))
+    if _sorted[0] != key:
+        order = list(FAMILIES)
+        _sorted = (key, sorted(_RULES.values(),
+                                       key=lambda r: (order.index(r.code[0]), r.code)))
+    return list(_sorted[1])
 
 
 def get_rule(code_or_slug: str) -> Rule | None:

@@ -34,10 +34,63 @@ class MeshFile:
         return self.triangles * self.metres_per_unit if self.metres_per_unit != 1.0 \
             else self.triangles
 
+    def bounds_m(self) -> np.ndarray | None:
+        """(2, 3) min/max corners in metres (the file's unit applied); None when empty.
+        Computed once: a shared mesh is measured by every model that uses it."""
+        if not hasattr(self, "_bounds_m"):
+            vertices = self.triangles.reshape(-1, 3)
+            bounds = (np.vstack([vertices.min(axis=0), vertices.max(axis=0)])
+                      * self.metres_per_unit if len(vertices) else None)
+            if bounds is not None:
+                bounds.flags.writeable = False
+            self._bounds_m = bounds
+        return self._bounds_m
+
+
+# Every mesh file is read once per process: a repository's models share a few propeller
+# and sensor meshes, and one model's checks ask for a mesh more than once (its extent, its
+# units, its mass properties). Keyed by the file's identity (path, device, inode, size,
+# mtime), so an edited file is read again; files above SHARED_MESH_MAX_BYTES are not kept.
+SHARED_MESHES_MAX = 64
+SHARED_MESH_MAX_BYTES = 8 * 1024 * 1024
+_read_meshes: dict[tuple, "MeshFile | ReedtoolError"] = {}
+
+
+def _identity(path: Path) -> tuple | None:
+    import os
+
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    if st.st_size > SHARED_MESH_MAX_BYTES:
+        return None
+    return (os.path.abspath(path), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+
 
 def read_mesh(path: str | Path) -> MeshFile:
-    """A mesh file as Gazebo reads it, without the `<mesh scale>`; unreadable -> ReedtoolError."""
+    """A mesh file as Gazebo reads it, without the `<mesh scale>`; unreadable -> ReedtoolError.
+
+    Read once per process (see `_read_meshes`): the triangles are shared, so read-only."""
     path = Path(path)
+    key = _identity(path)
+    found = _read_meshes.get(key) if key is not None else None
+    if found is None:
+        try:
+            found = _read_mesh(path)
+            found.triangles.flags.writeable = False
+        except ReedtoolError as exc:
+            found = exc
+        if key is not None:
+            if len(_read_meshes) >= SHARED_MESHES_MAX:
+                _read_meshes.pop(next(iter(_read_meshes)))      # the oldest first
+            _read_meshes[key] = found
+    if isinstance(found, ReedtoolError):
+        raise ReedtoolError(found.message, file=found.file, line=found.line, hint=found.hint)
+    return found
+
+
+def _read_mesh(path: Path) -> MeshFile:
     suffix = path.suffix.lower()
     if suffix == ".stl":
         stl = read_stl(path)
