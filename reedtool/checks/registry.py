@@ -30,6 +30,7 @@ FAMILIES: dict[str, tuple[str, str]] = {
 # Further rule modules of the families above (a family may span modules).
 EXTRA_RULE_MODULES: tuple[str, ...] = (
     "reedtool.checks.argument_rules",
+    "reedtool.checks.suppression_rules",
     "reedtool.checks.fault_rules",
     "reedtool.checks.flightstack_rules",
     "reedtool.checks.plausibility_rules",
@@ -63,6 +64,9 @@ class Rule:
     summary: str           # one line
     check: CheckFn
     clause: str = ""       # POLICY_CLAUSES key: why the default severity is what it is
+    # Judged over a whole run, not one robot (S143: a suppression no model needed); the
+    # runner skips it and `check` takes what the run gathered instead of a CheckContext.
+    run_level: bool = False
 
     @property
     def policy(self) -> str:
@@ -81,8 +85,8 @@ class Rule:
 _RULES: dict[str, Rule] = {}
 
 
-def rule(code: str, slug: str, severity: str, summary: str, *, clause: str
-         ) -> Callable[[CheckFn], CheckFn]:
+def rule(code: str, slug: str, severity: str, summary: str, *, clause: str,
+         run_level: bool = False) -> Callable[[CheckFn], CheckFn]:
     """Register a check function under a stable code; `clause` names the severity
     policy's clause (POLICY_CLAUSES) that gives `severity`."""
 
@@ -102,7 +106,7 @@ def rule(code: str, slug: str, severity: str, summary: str, *, clause: str
             raise ValueError(f"rule code {code} registered twice")
         if any(r.slug == slug and r.code != code for r in _RULES.values()):
             raise ValueError(f"rule slug {slug!r} registered twice")
-        _RULES[code] = Rule(code, slug, severity, summary, fn, clause)
+        _RULES[code] = Rule(code, slug, severity, summary, fn, clause, run_level)
         return fn
 
     return register

@@ -57,6 +57,8 @@ class RunOptions:
     diagram_per_model: bool = False       # several models: NAME.svg -> NAME-MODEL.svg
     force: bool = False
     notes: list[str] = field(default_factory=list)   # one line per clean cross-check
+    # (model name, SuppressionUse, S143 severity) per robot checked: the run's S143
+    suppression_uses: list = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -81,19 +83,22 @@ def jobs_of(target) -> list[Job]:
     return [Job(target, v) for v in variants] if variants else [Job(target)]
 
 
-def check_target(job: Job, options: RunOptions) -> tuple[list, list[str]]:
-    """check_model for a Job, and the notes it made (what --jobs hands each worker:
-    a worker's changes to `options` do not come back, its return value does)."""
+def check_target(job: Job, options: RunOptions) -> tuple[list, list[str], list]:
+    """check_model for a Job, the notes it made and its suppression uses (what --jobs
+    hands each worker: a worker's changes to `options` do not come back, its return value
+    does)."""
     from dataclasses import replace
 
-    notes, request, options.notes = options.notes, options.request, []
+    notes, uses, request = options.notes, options.suppression_uses, options.request
+    options.notes, options.suppression_uses = [], []
     if job.variant is not None:
         # Each variant is its own robot: nothing loaded for another variant is reused.
         options.request = replace(request, variant=job.variant, preloaded={})
     try:
-        return check_model(job.name, job.target.path, options), options.notes
+        results = check_model(job.name, job.target.path, options)
+        return results, options.notes, options.suppression_uses
     finally:
-        options.notes, options.request = notes, request
+        options.notes, options.suppression_uses, options.request = notes, uses, request
 
 
 def check_model(name: str, model: Path, options: RunOptions) -> list:
@@ -108,9 +113,17 @@ def check_model(name: str, model: Path, options: RunOptions) -> list:
         exc = checked.error
         return [ModelResult(name, error=exc.one_line(), error_file=exc.file,
                             error_line=exc.line)]
+    from reedtool.assembly.suppression_audit import suppression_use
+    from reedtool.config import load_config
+
+    selection = selection_for(load_config(model), options.request.select,
+                              options.request.ignore)
     results = []
     for one in checked.models:
-        results.append(ModelResult(name + one.suffix, one.findings, suppressed=one.suppressed))
+        results.append(ModelResult(name + one.suffix, one.findings,
+                                   suppressed=len(one.suppressed)))
+        options.suppression_uses.append((name + one.suffix,
+                                         *suppression_use(one.robot, one.suppressed, selection)))
         if not one.suppressed:     # a silenced flight-stack finding is no agreement
             options.notes += _agreement_lines(model, one.robot, one.findings, options,
                                               name + one.suffix)
@@ -386,6 +399,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
         checked.setdefault(id(job.target), []).append(outcome)
     results = []
     failing_of = []      # (result, the severities that fail its model)
+    suppression_uses: list = []
     strict_any = False
     for target in targets:
         if target.skipped is not None:
@@ -397,9 +411,10 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
             results.append(ModelResult(target.name, error=target.error, error_file=target.name))
             continue
         model_results = []
-        for one_results, notes in checked[id(target)]:
+        for one_results, notes, uses in checked[id(target)]:
             model_results += one_results
             options.notes += notes
+            suppression_uses += uses
         if target.checked_for is not None:
             for result in model_results:
                 if result.error is not None:
@@ -416,6 +431,16 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
         strict_any = strict_any or model_strict
         model_failing = {"error", "warning"} if model_strict else {"error"}
         failing_of += [(r, model_failing) for r in model_results]
+    from reedtool.assembly.suppression_audit import unused_suppressions
+
+    # S143 over the whole run: a comment in a shared file is unused only if no model needed it.
+    unused = unused_suppressions(suppression_uses)
+    for result in results:
+        if unused.get(result.name):
+            from reedtool.checks.finding import Finding
+
+            result.findings = sorted(result.findings + unused.pop(result.name),
+                                     key=Finding.sort_key)
     if write_baseline is not None:
         return _write_baseline(results, write_baseline, force)
     baselines = _apply_baselines(results, targets, baseline_file)
