@@ -215,6 +215,18 @@ def print_settings(targets, options: RunOptions) -> int:
     return 0
 
 
+def _prepare_workers() -> None:
+    """What every model's check imports, loaded once before --jobs forks its workers."""
+    import reedtool.assembly.suppression_audit  # noqa: F401
+    import reedtool.io.dae  # noqa: F401
+    import reedtool.io.loader  # noqa: F401
+    import reedtool.io.xacro_expand  # noqa: F401
+    import reedtool.physics.inertia  # noqa: F401
+    from reedtool.checks.registry import all_rules
+
+    all_rules()
+
+
 def _write_baseline(results, path: Path, force: bool) -> int:
     """--write-baseline: every finding of the run recorded; exit 0 (2 when a model could
     not be read: a baseline without its findings would not be the run's)."""
@@ -393,7 +405,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
 
     checkable = [job for t in targets if t.skipped is None and t.path is not None
                  for job in jobs_of(t)]
-    outcomes = map_models(functools.partial(check_target, options=options), checkable, jobs)
+    outcomes = map_models(functools.partial(check_target, options=options), checkable, jobs,
+                          prepare=_prepare_workers)
     checked: dict[int, list] = {}
     for job, outcome in zip(checkable, outcomes):
         checked.setdefault(id(job.target), []).append(outcome)
