@@ -150,7 +150,7 @@ def apply_baselines(results, baseline_for) -> list[Baseline]:
     used: dict[int, Baseline] = {}
     for result in results:
         baseline = baseline_for(result)
-        if baseline is None or not result.findings:
+        if baseline is None:
             continue
         used[id(baseline)] = baseline
         kept = [f for f in result.findings if not baseline.accepts(result.name, f)]

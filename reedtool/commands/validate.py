@@ -75,11 +75,18 @@ class Job:
         return self.target.name + (variant_label(self.variant) if self.variant else "")
 
 
-def jobs_of(target) -> list[Job]:
-    """The checks of one target: one per argument variant its configuration gives it."""
+def jobs_of(target, request: ModelRequest) -> list[Job]:
+    """The checks of one target: one per argument variant its configuration gives it. An
+    argument typed or read from --launch wins over a variant's, as over every configured
+    one; variants that then differ in nothing are checked once."""
     from reedtool.config import load_config
 
-    variants = load_config(target.path).variants_for(target.path)
+    given = set(request.mappings) | (set(request.launch.mappings) if request.launch else set())
+    variants: list[dict] = []
+    for variant in load_config(target.path).variants_for(target.path):
+        left = {name: value for name, value in variant.items() if name not in given}
+        if left and left not in variants:
+            variants.append(left)
     return [Job(target, v) for v in variants] if variants else [Job(target)]
 
 
@@ -246,7 +253,7 @@ def _write_baseline(results, path: Path, force: bool) -> int:
     return 0
 
 
-def _apply_baselines(results, targets, baseline_file: Path | None) -> list:
+def _apply_baselines(results, targets, baseline_file: Path | None, notes: list[str]) -> list:
     """Drop the findings each model's baseline (--baseline, else its config's `baseline`)
     accepts; the baselines used."""
     from reedtool.assembly.baseline import apply_baselines, read_baseline
@@ -271,6 +278,7 @@ def _apply_baselines(results, targets, baseline_file: Path | None) -> list:
                 by_name[target.name] = config.baseline
     if not by_name:
         return []
+    missing: list[Path] = []
 
     def baseline_for(result):
         path = next((p for name, p in by_name.items()
@@ -278,12 +286,18 @@ def _apply_baselines(results, targets, baseline_file: Path | None) -> list:
         if path is None:
             return None
         if not path.is_file():
-            raise ReedtoolError("the configuration's baseline file does not exist",
-                                file=path, hint="write it with `reedtool validate "
-                                                f"--write-baseline {relative_to_cwd(path)}`")
+            # Nothing accepted yet: every finding is reported (the safe side), and said why.
+            if path not in missing:
+                missing.append(path)
+            return None
         return load(path)
 
-    return apply_baselines(results, baseline_for)
+    used = apply_baselines(results, baseline_for)
+    for path in missing:
+        notes.append(f"reedtool: the configuration's baseline {relative_to_cwd(path)} does not "
+                     "exist yet, so every finding is reported; write it with `reedtool "
+                     f"validate --write-baseline {relative_to_cwd(path)}`")
+    return used
 
 
 # ------------------------------------------------------------------ the command
@@ -404,7 +418,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
     from reedtool.report import ModelResult, render
 
     checkable = [job for t in targets if t.skipped is None and t.path is not None
-                 for job in jobs_of(t)]
+                 for job in jobs_of(t, request)]
     outcomes = map_models(functools.partial(check_target, options=options), checkable, jobs,
                           prepare=_prepare_workers)
     checked: dict[int, list] = {}
@@ -456,7 +470,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
                                      key=Finding.sort_key)
     if write_baseline is not None:
         return _write_baseline(results, write_baseline, force)
-    baselines = _apply_baselines(results, targets, baseline_file)
+    baselines = _apply_baselines(results, targets, baseline_file, options.notes)
     failed = any(f.severity in model_failing for r, model_failing in failing_of
                  for f in r.findings)
     for baseline in baselines:

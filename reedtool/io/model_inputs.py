@@ -369,8 +369,9 @@ def suggest_path(word: str) -> str | None:
                            if not entry.name.startswith("."))
         except OSError:
             return None
-        # 0.8: one or two slips in a file name (`sensr`, `hexacoptr`), not another file.
-        close = get_close_matches(part, names, n=1, cutoff=0.8)
+        # 0.75: a slip or two in a name (`sensr`, `urfd`), not another file of the same
+        # pattern (`missing.urdf` is 0.52 from `broken.urdf`).
+        close = get_close_matches(part, names, n=1, cutoff=0.75)
         if not close:
             return None
         base = base / close[0]
