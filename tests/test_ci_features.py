@@ -354,3 +354,24 @@ def _fail_from_3(n: int) -> int:
     if n >= 3:
         raise ReedtoolError(f"item {n}")
     return n
+
+
+# ------------------------------------------------------------------ installation, as documented
+
+def test_no_doc_installs_reedtool_from_a_package_index():
+    """reedtool is installed from its repository or a wheel: an instruction to install it
+    by name (`pip install reedtool`, `pip install 'reedtool[fast]'`) sends users to an
+    index that does not have it. Docs, README and the product's own messages."""
+    import re
+
+    root = Path(__file__).resolve().parents[1]
+    by_name = re.compile(r"pip install\s+['\"]?reedtool(\[[^\]]*\])?(?![\w@ ]*@)['\"]?(?=[\s`)]|$)")
+    texts = {p: p.read_text(encoding="utf-8") for p in
+             [root / "README.md", *(root / "docs").glob("*.md"),
+              *(root / "reedtool").rglob("*.py")]}
+    offenders = [f"{p.relative_to(root)}: {m.group(0)}" for p, text in texts.items()
+                 for m in by_name.finditer(text)]
+    assert offenders == []
+    ci = texts[root / "docs" / "ci.md"]
+    assert 'pip install "reedtool @ git+https://github.com/reedtool/reedtool@v' in ci
+    assert "pip install dist/reedtool-" in ci
