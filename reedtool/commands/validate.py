@@ -219,6 +219,18 @@ def print_settings(targets, options: RunOptions) -> int:
         ignores = config.ignores_for(target.path)
         if ignores:
             click.echo(f"  per-file-ignores: {', '.join(ignores)}")
+        from reedtool.assembly.models import variant_label
+
+        for job in jobs_of(target, options.request):
+            if job.variant is not None:
+                click.echo(f"  variant:{variant_label(job.variant)}")
+        from reedtool.config import DEFAULT_EXCLUDE
+
+        exclude = DEFAULT_EXCLUDE if config.exclude is None else config.exclude
+        click.echo(f"  exclude: {', '.join((*exclude, *config.extend_exclude)) or '-'}"
+                   + (" (forced)" if config.force_exclude else ""))
+        if config.baseline is not None:
+            click.echo(f"  baseline: {relative_to_cwd(config.baseline)}")
     return 0
 
 
