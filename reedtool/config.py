@@ -149,7 +149,28 @@ class Config:
         return tuple(found)
 
 
+# Every model of a run asks for its configuration (selection, arguments, exclude, strict):
+# a file is parsed once per version of it (path, size, mtime).
+_parsed: dict[tuple, dict] = {}
+
+
 def _load_toml(path: Path) -> dict:
+    try:
+        st = os.stat(path)
+        key = (os.path.abspath(path), st.st_size, st.st_mtime_ns)
+    except OSError:
+        key = None
+    if key is not None and key in _parsed:
+        return _parsed[key]
+    table = _read_toml(path)
+    if key is not None:
+        if len(_parsed) >= 64:
+            _parsed.pop(next(iter(_parsed)))
+        _parsed[key] = table
+    return table
+
+
+def _read_toml(path: Path) -> dict:
     if sys.version_info >= (3, 11):
         import tomllib
     else:  # pragma: no cover - exercised on 3.10 only

@@ -79,7 +79,11 @@ def is_suppressed(code: str, slug: str, file: str | None, line: int | None) -> b
 
 def source_files(robot) -> dict[str, str]:
     """Every file an element of `robot` was read from (where its suppressions can be):
-    resolved path -> the path as the elements name it (what the findings show)."""
+    resolved path -> the path as the elements name it (what the findings show). Kept on
+    the robot: S142 and the run's S143 both ask."""
+    cached = getattr(robot, "_suppression_source_files", None)
+    if cached is not None:
+        return cached
     from reedtool.model import SourceLoc
 
     files: set[str] = set()
@@ -93,16 +97,27 @@ def source_files(robot) -> dict[str, str]:
             return
         if isinstance(value, (list, tuple)):
             for item in value:
-                visit(item, depth + 1)
+                if isinstance(item, (SourceLoc, list, tuple)) or is_dataclass(item):
+                    visit(item, depth + 1)
         elif is_dataclass(value) and not isinstance(value, type):
             seen.add(id(value))
-            for f in fields(value):
-                item = getattr(value, f.name, None)
+            for name in _dataclass_fields(type(value)):
+                item = getattr(value, name, None)
                 if isinstance(item, (SourceLoc, list, tuple)) or is_dataclass(item):
                     visit(item, depth + 1)
 
     visit(robot, 0)
-    return {str(Path(f).resolve()): f for f in sorted(files) if f and Path(f).is_file()}
+    out = {str(Path(f).resolve()): f for f in sorted(files) if f and Path(f).is_file()}
+    try:
+        robot._suppression_source_files = out
+    except AttributeError:        # a frozen or slotted stand-in: computed again next time
+        pass
+    return out
+
+
+@lru_cache(maxsize=128)
+def _dataclass_fields(kind: type) -> tuple[str, ...]:
+    return tuple(f.name for f in fields(kind))
 
 
 def unknown_names(path: str) -> Iterator[tuple[int, str]]:
