@@ -268,18 +268,21 @@ def _write_baseline(results, path: Path, force: bool) -> int:
 def _apply_baselines(results, targets, baseline_file: Path | None, notes: list[str]) -> list:
     """Drop the findings each model's baseline (--baseline, else its config's `baseline`)
     accepts; the baselines used."""
-    from reedtool.assembly.baseline import apply_baselines, read_baseline
     from reedtool.config import load_config, relative_to_cwd
 
     loaded: dict[Path, object] = {}
 
     def load(path: Path):
+        from reedtool.assembly.baseline import read_baseline
+
         key = path.resolve()
         if key not in loaded:
             loaded[key] = read_baseline(path)
         return loaded[key]
 
     if baseline_file is not None:
+        from reedtool.assembly.baseline import apply_baselines
+
         baseline = load(baseline_file)
         return apply_baselines(results, lambda result: baseline)
     by_name = {}
@@ -289,7 +292,9 @@ def _apply_baselines(results, targets, baseline_file: Path | None, notes: list[s
             if config.baseline is not None:
                 by_name[target.name] = config.baseline
     if not by_name:
-        return []
+        return []       # no baseline anywhere: its module is not even imported
+    from reedtool.assembly.baseline import apply_baselines
+
     missing: list[Path] = []
 
     def baseline_for(result):
