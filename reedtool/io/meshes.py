@@ -38,9 +38,8 @@ class MeshFile:
         """(2, 3) min/max corners in metres (the file's unit applied); None when empty.
         Computed once: a shared mesh is measured by every model that uses it."""
         if not hasattr(self, "_bounds_m"):
-            vertices = self.triangles.reshape(-1, 3)
-            bounds = (np.vstack([vertices.min(axis=0), vertices.max(axis=0)])
-                      * self.metres_per_unit if len(vertices) else None)
+            bounds = (corner_bounds(self.triangles) * self.metres_per_unit
+                      if len(self.triangles) else None)
             if bounds is not None:
                 bounds.flags.writeable = False
             self._bounds_m = bounds
@@ -139,6 +138,14 @@ class MeshCheck:
     extent: np.ndarray               # bounding box size, file units
 
 
+def corner_bounds(triangles: np.ndarray) -> np.ndarray:
+    """(2, 3) min and max corner of (n, 3, 3) triangles (or (n, 3) points). Reduced per
+    coordinate over a contiguous row: numpy's reduction along axis 0 of an (n, 3) array
+    is ten times slower on the 10^5 corners of an exported mesh."""
+    columns = np.ascontiguousarray(np.asarray(triangles).reshape(-1, 3).T)
+    return np.vstack([columns.min(axis=1), columns.max(axis=1)])
+
+
 def triangle_areas(triangles: np.ndarray) -> np.ndarray:
     return 0.5 * np.linalg.norm(np.cross(triangles[:, 1] - triangles[:, 0],
                                          triangles[:, 2] - triangles[:, 0]), axis=1)
@@ -160,8 +167,8 @@ def check_triangles(triangles: np.ndarray, source: str | Path) -> MeshCheck:
     check_mesh_coordinates(triangles, source)
     areas = triangle_areas(triangles)
     total_area = float(areas.sum())
-    vertices = triangles.reshape(-1, 3)
-    extent = vertices.max(axis=0) - vertices.min(axis=0)
+    low, high = corner_bounds(triangles)
+    extent = high - low
     if total_area == 0.0:
         raise ReedtoolError(f"all {len(triangles)} triangles have zero area", file=source,
                             hint="the mesh is degenerate; export the part again")
