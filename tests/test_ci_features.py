@@ -75,6 +75,25 @@ def test_extend_exclude_and_the_default_exclude_of_build_trees(tmp_path, monkeyp
                                           "pyproject.toml)", "urdf/a.urdf": None}
 
 
+def test_the_pre_commit_hook_honours_exclude_for_files_it_names(tmp_path, monkeypatch,
+                                                                capsys):
+    """The hook's own entry (.pre-commit-hooks.yaml), given the changed files by name."""
+    import shlex
+
+    import yaml
+
+    hooks = yaml.safe_load((Path(__file__).parents[1] / ".pre-commit-hooks.yaml").read_text())
+    entry = shlex.split(hooks[0]["entry"])
+    assert entry[:2] == ["reedtool", "validate"]
+    root = project(tmp_path, monkeypatch, 'extend-exclude = ["urdf/old"]\n')
+    for where in ("urdf/a.urdf", "urdf/old/b.urdf"):
+        (root / where).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy(TRIANGLE, root / where)
+    code, out, _ = run_validate([*entry[2:], "urdf/old/b.urdf", "urdf/a.urdf"], capsys)
+    assert "urdf/old/b.urdf: skipped: excluded by 'urdf/old'" in out
+    assert "urdf/a.urdf: 1 error" in out and code == 1
+
+
 def test_exclude_replaces_the_default_and_force_exclude_is_a_setting(tmp_path, monkeypatch,
                                                                      capsys):
     root = project(tmp_path, monkeypatch, 'exclude = ["legacy_*"]\nforce-exclude = true\n')
