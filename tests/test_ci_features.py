@@ -295,6 +295,29 @@ def test_a_suppression_in_a_shared_part_is_used_if_any_variant_needs_it(tmp_path
     assert doc["findings"] == []
 
 
+def test_variants_of_a_top_file_that_picks_its_vehicle_by_argument(tmp_path, monkeypatch,
+                                                                    capsys):
+    """RotorS's shape: the .gazebo top file includes `$(arg mav_name)_base.xacro`. With
+    variants for mav_name, every *_base.xacro is still a part of the top file (found in a
+    directory), and each variant reads its own."""
+    root = project(tmp_path, monkeypatch, "[tool.reedtool.per-file-args]\n"
+                   '"urdf/*.gazebo" = [{mav_name = "light"}, {mav_name = "heavy"}]\n')
+    (root / "urdf").mkdir()
+    (root / "urdf" / "mav.gazebo").write_text(
+        '<?xml version="1.0"?>\n<robot name="$(arg mav_name)" '
+        'xmlns:xacro="http://ros.org/wiki/xacro">\n  <xacro:arg name="mav_name" '
+        'default="light"/>\n' + BASE_LINK
+        + '  <xacro:include filename="$(arg mav_name)_base.xacro"/>\n</robot>\n')
+    for name, arm in (("light", ""), ("heavy", BAD_LINK)):
+        (root / "urdf" / f"{name}_base.xacro").write_text(
+            '<?xml version="1.0"?>\n<robot xmlns:xacro="http://ros.org/wiki/xacro">\n'
+            + arm + "</robot>\n")
+    code, doc, _ = run_json(["urdf"], capsys)
+    assert codes_by_model(doc) == {"urdf/mav.gazebo [mav_name:=light]": [],
+                                   "urdf/mav.gazebo [mav_name:=heavy]": ["I203"]}
+    assert code == 1
+
+
 def test_an_empty_variant_list_is_one_line_exit_2(tmp_path, monkeypatch, capsys):
     _variant_project(tmp_path, monkeypatch, "[]")
     code, _, err = run_validate(["urdf/mav.gazebo"], capsys)

@@ -144,6 +144,20 @@ def targets_of(paths: Sequence[str], request: ModelRequest):
             return dict(request.mappings)
         return model_arguments(path, config, request)[0]
 
+    def glob_mappings_for(path: Path) -> dict[str, str]:
+        """mappings_for without the names argument variants set (unless typed): a top file
+        checked as firefly and as hummingbird includes `$(arg mav_name)_base.xacro` for
+        each, so every file that name matches is a part of it, not a model."""
+        mappings = mappings_for(path)
+        try:
+            variants = load_config(path).variants_for(path)
+        except ReedtoolError:
+            return mappings
+        for name in {name for variant in variants for name in variant}:
+            if name not in request.mappings:
+                mappings.pop(name, None)
+        return mappings
+
     def has_arguments(path: Path) -> bool:
         """Arguments meant for this file: typed, from --launch, or a per-file table.
         (The config's `args` reach every model of a repository, so they do not say the
@@ -200,7 +214,8 @@ def targets_of(paths: Sequence[str], request: ModelRequest):
 
     return expand_targets(paths, include_tree_of(mappings_for, request.package_paths),
                           display=lambda p: display_path(str(p)) or str(p),
-                          include_globs=include_globs_of(mappings_for, request.package_paths),
+                          include_globs=include_globs_of(glob_mappings_for,
+                                                         request.package_paths),
                           has_arguments=has_arguments, stands_alone=stands_alone,
                           configures_models=configures_models, excluded=excluded)
 
