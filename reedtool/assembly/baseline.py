@@ -22,7 +22,6 @@ format (docs/ci.md):
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import re
@@ -39,6 +38,8 @@ _LINE_REFERENCE = re.compile(r"(\bline\s+|:)\d+\b")
 
 def fingerprint(code: str, subject: str | None, message: str) -> str:
     """16 hex digits of the finding's code, subject and message, line numbers taken out."""
+    import hashlib
+
     text = _LINE_REFERENCE.sub(r"\1#", " ".join(message.split()))
     return hashlib.sha256(f"{code}\0{subject or ''}\0{text}".encode()).hexdigest()[:16]
 
@@ -157,3 +158,41 @@ def apply_baselines(results, baseline_for) -> list[Baseline]:
         result.baselined += len(result.findings) - len(kept)
         result.findings = kept
     return list(used.values())
+
+
+def apply_run_baselines(results, models, baseline_file: Path | None
+                        ) -> tuple[list[Baseline], list[Path]]:
+    """A run's baselines applied: `--baseline FILE` for every model, else each model's
+    configuration's `baseline` (`models`: (display name, path) of the run's targets; a
+    result belongs to its target by name, variants and world models included). Returns
+    the baselines used and the configured ones that do not exist yet (nothing accepted:
+    every finding is reported, the safe side)."""
+    from reedtool.config import load_config
+
+    loaded: dict[Path, Baseline] = {}
+
+    def load(path: Path) -> Baseline:
+        key = Path(os.path.abspath(path))
+        if key not in loaded:
+            loaded[key] = read_baseline(path)
+        return loaded[key]
+
+    if baseline_file is not None:
+        baseline = load(baseline_file)
+        return apply_baselines(results, lambda result: baseline), []
+    configured = {name: load_config(path).baseline for name, path in models}
+    configured = {name: path for name, path in configured.items() if path is not None}
+    missing: list[Path] = []
+
+    def baseline_for(result) -> Baseline | None:
+        path = next((p for name, p in configured.items()
+                     if result.name == name or result.name.startswith(name + " [")), None)
+        if path is None:
+            return None
+        if not path.is_file():
+            if path not in missing:
+                missing.append(path)
+            return None
+        return load(path)
+
+    return (apply_baselines(results, baseline_for) if configured else []), missing

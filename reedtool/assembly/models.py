@@ -117,6 +117,22 @@ def argument_use(model: Path, mappings, given, origins, checked, config,
                        complete=complete)
 
 
+def variants_of(model: Path, request: ModelRequest) -> list[dict[str, str]]:
+    """The argument variants `model` is validated with: its configuration's lists of
+    `per-file-args` tables. An argument typed or read from --launch wins over a variant's,
+    as over every configured one; variants that then differ in nothing are checked once
+    ([] when the model is checked once, with its arguments)."""
+    from reedtool.config import load_config
+
+    given = set(request.mappings) | (set(request.launch.mappings) if request.launch else set())
+    variants: list[dict[str, str]] = []
+    for variant in load_config(model).variants_for(model):
+        left = {name: value for name, value in variant.items() if name not in given}
+        if left and left not in variants:
+            variants.append(left)
+    return variants
+
+
 def variant_label(variant: dict[str, str]) -> str:
     """How a model's argument variant is named in reports: ` [mav_name:=firefly]`."""
     return " [" + ", ".join(f"{name}:={value}" for name, value in variant.items()) + "]"

@@ -76,17 +76,10 @@ class Job:
 
 
 def jobs_of(target, request: ModelRequest) -> list[Job]:
-    """The checks of one target: one per argument variant its configuration gives it. An
-    argument typed or read from --launch wins over a variant's, as over every configured
-    one; variants that then differ in nothing are checked once."""
-    from reedtool.config import load_config
+    """The checks of one target: one per argument variant it has (assembly.models)."""
+    from reedtool.assembly.models import variants_of
 
-    given = set(request.mappings) | (set(request.launch.mappings) if request.launch else set())
-    variants: list[dict] = []
-    for variant in load_config(target.path).variants_for(target.path):
-        left = {name: value for name, value in variant.items() if name not in given}
-        if left and left not in variants:
-            variants.append(left)
+    variants = variants_of(target.path, request)
     return [Job(target, v) for v in variants] if variants else [Job(target)]
 
 
@@ -265,58 +258,6 @@ def _write_baseline(results, path: Path, force: bool) -> int:
     return 0
 
 
-def _apply_baselines(results, targets, baseline_file: Path | None, notes: list[str]) -> list:
-    """Drop the findings each model's baseline (--baseline, else its config's `baseline`)
-    accepts; the baselines used."""
-    from reedtool.config import load_config, relative_to_cwd
-
-    loaded: dict[Path, object] = {}
-
-    def load(path: Path):
-        from reedtool.assembly.baseline import read_baseline
-
-        key = path.resolve()
-        if key not in loaded:
-            loaded[key] = read_baseline(path)
-        return loaded[key]
-
-    if baseline_file is not None:
-        from reedtool.assembly.baseline import apply_baselines
-
-        baseline = load(baseline_file)
-        return apply_baselines(results, lambda result: baseline)
-    by_name = {}
-    for target in targets:
-        if target.path is not None:
-            config = load_config(target.path)
-            if config.baseline is not None:
-                by_name[target.name] = config.baseline
-    if not by_name:
-        return []       # no baseline anywhere: its module is not even imported
-    from reedtool.assembly.baseline import apply_baselines
-
-    missing: list[Path] = []
-
-    def baseline_for(result):
-        path = next((p for name, p in by_name.items()
-                     if result.name == name or result.name.startswith(name + " [")), None)
-        if path is None:
-            return None
-        if not path.is_file():
-            # Nothing accepted yet: every finding is reported (the safe side), and said why.
-            if path not in missing:
-                missing.append(path)
-            return None
-        return load(path)
-
-    used = apply_baselines(results, baseline_for)
-    for path in missing:
-        notes.append(f"reedtool: the configuration's baseline {relative_to_cwd(path)} does not "
-                     "exist yet, so every finding is reported; write it with `reedtool "
-                     f"validate --write-baseline {relative_to_cwd(path)}`")
-    return used
-
-
 # ------------------------------------------------------------------ the command
 
 @click.command(name="validate")
@@ -487,12 +428,18 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
                                      key=Finding.sort_key)
     if write_baseline is not None:
         return _write_baseline(results, write_baseline, force)
-    baselines = _apply_baselines(results, targets, baseline_file, options.notes)
+    from reedtool.assembly.baseline import apply_run_baselines
+    from reedtool.config import relative_to_cwd
+
+    baselines, missing = apply_run_baselines(
+        results, [(t.name, t.path) for t in targets if t.path is not None], baseline_file)
     failed = any(f.severity in model_failing for r, model_failing in failing_of
                  for f in r.findings)
+    for path in missing:
+        options.notes.append(f"reedtool: the configuration's baseline {relative_to_cwd(path)} "
+                             "does not exist yet, so every finding is reported; write it with "
+                             f"`reedtool validate --write-baseline {relative_to_cwd(path)}`")
     for baseline in baselines:
-        from reedtool.config import relative_to_cwd
-
         if baseline.stale():
             options.notes.append(f"reedtool: {relative_to_cwd(baseline.path)}: "
                                  f"{baseline.stale()} accepted finding(s) no longer occur in "
