@@ -25,7 +25,7 @@ from reedtool.sim.run import simulate_hover
 
 pytestmark = pytest.mark.skipif(
     not compiled.available(),
-    reason="numba is not installed (pip install 'reedtool[fast]'): no compiled engine to test")
+    reason="numba is not installed (pip install '.[fast]'): no compiled engine to test")
 
 RTOL = ENGINE_RTOL   # see test_sim.test_engine_tolerance_stands_far_above_the_ulp_floor
 FIELDS = ("status_code", "reason", "reason_value", "end_time_s", "settle_time_s",

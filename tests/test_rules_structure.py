@@ -28,6 +28,8 @@ CASES = [
     ("S108_bad_two_parents.urdf", ["S108"]),
     ("S109_bad_cycle.urdf", ["S109"]),
     ("S110_bad_joint_type.urdf", ["S110"]),
+    ("S142_bad_code_typo.urdf", ["S142"]),
+    ("S142_good_known_names.urdf", []),
     ("S111_bad_no_limit.urdf", ["S111"]),
     ("S111_bad_no_effort.urdf", ["S111"]),
     ("S112_bad_inverted_limit.urdf", ["S112"]),

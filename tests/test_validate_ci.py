@@ -244,14 +244,20 @@ def test_inline_comment_on_the_line_with_names_and_several_codes(capsys, tmp_pat
     model = tmp_path / "m.urdf"
     model.write_text("\n".join(lines) + "\n")
     code, doc = run_json([model], capsys)
-    assert doc["findings"] == [] and doc["models"][0]["suppressed"] == 2 and code == 0
+    assert doc["models"][0]["suppressed"] == 2 and code == 0
+    # S104 (single-root) is reported on line 13, so the name on line 9 silenced nothing:
+    # the one finding left is S143 saying so, at the comment (info: exit 0).
+    assert [(f["code"], f["line"], f["subject"]) for f in doc["findings"]] == \
+        [("S143", 9, "single-root")]
 
 
 def test_inline_comment_for_another_rule_or_line_does_not_suppress(capsys, tmp_path):
     model = _with_line_inserted(TWO_ERRORS, tmp_path / "m.urdf", 3,
                                 "  <!-- reedtool: ignore[S105] -->")   # above base_link
     code, doc = run_json([model], capsys)
-    assert sorted(f["code"] for f in doc["findings"]) == ["S104", "S105"]
+    # Both findings stay; the misplaced comment itself is reported unused (S143, line 3).
+    assert sorted((f["code"], f["line"]) for f in doc["findings"]) == \
+        [("S104", 14), ("S105", 10), ("S143", 3)]
 
 
 def test_inline_comment_in_the_xacro_the_user_wrote(capsys, tmp_path):

@@ -29,6 +29,10 @@ class ModelRequest:
     launch_file: Path | None = None
     select: tuple[str, ...] = ()
     ignore: tuple[str, ...] = ()
+    # One argument variant of the configuration's per-file-args (validate runs each
+    # separately); None: the model's first variant, if it has any.
+    variant: dict | None = None
+    force_exclude: bool = False           # --force-exclude: `exclude` named files too
     # Models loaded while deciding what a named file means (io.model_inputs), kept so the
     # check does not expand them twice: resolved path -> load_models pairs.
     preloaded: dict = field(default_factory=dict)
@@ -64,6 +68,14 @@ def model_arguments(model: Path, config, request: ModelRequest):
         origins[name] = f"config {relative_to_cwd(config.path)}"
         if name not in config.args:   # per-file-args name this model on purpose
             checked.add(name)
+    variants = config.variants_for(model)
+    variant = request.variant if request.variant is not None else \
+        (variants[0] if variants else {})
+    for name, value in variant.items():
+        mappings[name] = value
+        given[name] = SourceLoc(relative_to_cwd(config.path), _config_line(config.path, name))
+        origins[name] = f"config {relative_to_cwd(config.path)} (variant)"
+        checked.add(name)
     launch = request.launch
     if launch is not None:
         for name, value in launch.mappings.items():
@@ -105,6 +117,27 @@ def argument_use(model: Path, mappings, given, origins, checked, config,
                        complete=complete)
 
 
+def variants_of(model: Path, request: ModelRequest) -> list[dict[str, str]]:
+    """The argument variants `model` is validated with: its configuration's lists of
+    `per-file-args` tables. An argument typed or read from --launch wins over a variant's,
+    as over every configured one; variants that then differ in nothing are checked once
+    ([] when the model is checked once, with its arguments)."""
+    from reedtool.config import load_config
+
+    given = set(request.mappings) | (set(request.launch.mappings) if request.launch else set())
+    variants: list[dict[str, str]] = []
+    for variant in load_config(model).variants_for(model):
+        left = {name: value for name, value in variant.items() if name not in given}
+        if left and left not in variants:
+            variants.append(left)
+    return variants
+
+
+def variant_label(variant: dict[str, str]) -> str:
+    """How a model's argument variant is named in reports: ` [mav_name:=firefly]`."""
+    return " [" + ", ".join(f"{name}:={value}" for name, value in variant.items()) + "]"
+
+
 def load_models(model: Path, mappings, package_paths, model_name):
     """(display suffix, Robot) pairs of one model path: one, or each model of a world."""
     from reedtool.io.loader import load_robots
@@ -127,6 +160,20 @@ def targets_of(paths: Sequence[str], request: ModelRequest):
             return dict(request.mappings)
         return model_arguments(path, config, request)[0]
 
+    def glob_mappings_for(path: Path) -> dict[str, str]:
+        """mappings_for without the names argument variants set (unless typed): a top file
+        checked as firefly and as hummingbird includes `$(arg mav_name)_base.xacro` for
+        each, so every file that name matches is a part of it, not a model."""
+        mappings = mappings_for(path)
+        try:
+            variants = load_config(path).variants_for(path)
+        except ReedtoolError:
+            return mappings
+        for name in {name for variant in variants for name in variant}:
+            if name not in request.mappings:
+                mappings.pop(name, None)
+        return mappings
+
     def has_arguments(path: Path) -> bool:
         """Arguments meant for this file: typed, from --launch, or a per-file table.
         (The config's `args` reach every model of a repository, so they do not say the
@@ -137,7 +184,8 @@ def targets_of(paths: Sequence[str], request: ModelRequest):
             config = load_config(path)
         except ReedtoolError:
             return False
-        return set(config.args_for(path)[0].items()) != set(config.args.items())
+        return (set(config.args_for(path)[0].items()) != set(config.args.items())
+                or bool(config.variants_for(path)))
 
     def stands_alone(path: Path) -> bool:
         """Loads alone into a robot with links; the robots are kept for the check."""
@@ -158,11 +206,34 @@ def targets_of(paths: Sequence[str], request: ModelRequest):
         found = find_config(path)
         return found is not None and found[0] == path.resolve()
 
+    def excluded(path: Path, walked: Path | None) -> str | None:
+        """Why the configuration leaves `path` out: always when found by a directory walk,
+        when named only with `force-exclude` (ruff's rule: a file passed is checked)."""
+        try:
+            config = load_config(path)
+        except ReedtoolError:
+            return None       # the check of the file reports the configuration's error
+        if walked is None and not (config.force_exclude or request.force_exclude):
+            return None
+        pattern = config.exclusion(path, walked)
+        if pattern is None:
+            return None
+        from reedtool.config import relative_to_cwd
+
+        if pattern in config.extend_exclude:
+            where = f"extend-exclude in {relative_to_cwd(config.path)}"
+        elif config.exclude is not None:
+            where = f"exclude in {relative_to_cwd(config.path)}"
+        else:
+            where = "reedtool's default exclude"
+        return f"excluded by '{pattern}' ({where})"
+
     return expand_targets(paths, include_tree_of(mappings_for, request.package_paths),
                           display=lambda p: display_path(str(p)) or str(p),
-                          include_globs=include_globs_of(mappings_for, request.package_paths),
+                          include_globs=include_globs_of(glob_mappings_for,
+                                                         request.package_paths),
                           has_arguments=has_arguments, stands_alone=stands_alone,
-                          configures_models=configures_models)
+                          configures_models=configures_models, excluded=excluded)
 
 
 def request_from_words(words: Sequence[str], *, package_paths: Sequence[Path] = (),
@@ -205,9 +276,13 @@ def one_model(paths: Sequence[str], request: ModelRequest, command: str) -> Path
         if Path(word).exists() or _GLOB_CHARS.search(word):
             continue
         if n == 0 and "=" not in word:
+            from reedtool.io.model_inputs import suggest_path
+
+            nearby = suggest_path(word)
             raise ReedtoolError("model file not found", file=word,
-                                hint="pass a model file (.urdf, .xacro, .sdf, .gazebo, "
-                                     ".world), a directory or a ROS package")
+                                hint=f"did you mean '{nearby}'?" if nearby else
+                                "pass a model file (.urdf, .xacro, .sdf, .gazebo, "
+                                ".world), a directory or a ROS package")
         # A word after the model that names nothing is a mistyped argument.
         from reedtool.io.mappings import suggest_mapping
 

@@ -382,9 +382,7 @@ class CheckContext:
             if read is None:        # a format only trimesh reads: not measured in validate
                 bounds = None
             else:
-                vertices = read.triangles_m.reshape(-1, 3)
-                bounds = np.vstack([vertices.min(axis=0), vertices.max(axis=0)]) \
-                    if len(vertices) else None
+                bounds = read.bounds_m()
             self._mesh_bounds[key] = bounds
         bounds = self._mesh_bounds[key]
         if bounds is None:

@@ -30,6 +30,7 @@ FAMILIES: dict[str, tuple[str, str]] = {
 # Further rule modules of the families above (a family may span modules).
 EXTRA_RULE_MODULES: tuple[str, ...] = (
     "reedtool.checks.argument_rules",
+    "reedtool.checks.suppression_rules",
     "reedtool.checks.fault_rules",
     "reedtool.checks.flightstack_rules",
     "reedtool.checks.lee_rules",
@@ -65,6 +66,9 @@ class Rule:
     summary: str           # one line
     check: CheckFn
     clause: str = ""       # POLICY_CLAUSES key: why the default severity is what it is
+    # Judged over a whole run, not one robot (S143: a suppression no model needed); the
+    # runner skips it and `check` takes what the run gathered instead of a CheckContext.
+    run_level: bool = False
 
     @property
     def policy(self) -> str:
@@ -83,8 +87,8 @@ class Rule:
 _RULES: dict[str, Rule] = {}
 
 
-def rule(code: str, slug: str, severity: str, summary: str, *, clause: str
-         ) -> Callable[[CheckFn], CheckFn]:
+def rule(code: str, slug: str, severity: str, summary: str, *, clause: str,
+         run_level: bool = False) -> Callable[[CheckFn], CheckFn]:
     """Register a check function under a stable code; `clause` names the severity
     policy's clause (POLICY_CLAUSES) that gives `severity`."""
 
@@ -104,24 +108,39 @@ def rule(code: str, slug: str, severity: str, summary: str, *, clause: str
             raise ValueError(f"rule code {code} registered twice")
         if any(r.slug == slug and r.code != code for r in _RULES.values()):
             raise ValueError(f"rule slug {slug!r} registered twice")
-        _RULES[code] = Rule(code, slug, severity, summary, fn, clause)
+        _RULES[code] = Rule(code, slug, severity, summary, fn, clause, run_level)
         return fn
 
     return register
 
 
+_families_loaded = False
+# The sorted catalogue, kept while the registered rules stay the same ones: every model of
+# a run asks for it several times (selection, runner, severities).
+_sorted: tuple[tuple, list[Rule]] = ((), [])
+
+
 def _load_families() -> None:
+    global _families_loaded
+    if _families_loaded:
+        return
     for module_name, _title in FAMILIES.values():
         importlib.import_module(module_name)
     for module_name in EXTRA_RULE_MODULES:
         importlib.import_module(module_name)
+    _families_loaded = True
 
 
 def all_rules() -> list[Rule]:
     """Every registered rule, by family (S, I, R) and then by code."""
+    global _sorted
     _load_families()
-    order = list(FAMILIES)
-    return sorted(_RULES.values(), key=lambda r: (order.index(r.code[0]), r.code))
+    key = tuple(map(id, _RULES.values()))
+    if _sorted[0] != key:
+        order = list(FAMILIES)
+        _sorted = (key, sorted(_RULES.values(),
+                                       key=lambda r: (order.index(r.code[0]), r.code)))
+    return list(_sorted[1])
 
 
 def get_rule(code_or_slug: str) -> Rule | None:

@@ -127,8 +127,8 @@ def run_checks(robot: Robot, selection: Selection | None = None, *,
     ctx = CheckContext(robot, controllers, flight_params, arguments)
     findings: set[Finding] = set()
     for rule in all_rules():
-        if not selection.enabled(rule.code):
-            continue
+        if rule.run_level or not selection.enabled(rule.code):
+            continue      # a run-level rule is judged over the whole run (validate)
         severity = selection.severity_of(rule)
         issues, crashed = _issues_of(rule, ctx)
         for issue in issues:
@@ -148,8 +148,9 @@ def run_checks(robot: Robot, selection: Selection | None = None, *,
 
 
 def apply_suppressions(findings: Sequence[Finding], ignores_for=None
-                       ) -> tuple[list[Finding], int]:
-    """Findings left after inline comments and per-file ignores; and how many were dropped.
+                       ) -> tuple[list[Finding], list[Finding]]:
+    """Findings left after inline comments and per-file ignores; and those dropped (what
+    the unused-suppression check S143 learns which comments silenced something from).
 
     `ignores_for(file) -> selectors` gives the per-file ignore selectors (already parsed
     by `parse_selectors`) that apply to a file; None: no per-file ignores.
@@ -168,4 +169,5 @@ def apply_suppressions(findings: Sequence[Finding], ignores_for=None
             if any(finding.code.startswith(s) for s in selectors):
                 continue
         kept.append(finding)
-    return kept, len(findings) - len(kept)
+    kept_ids = {id(f) for f in kept}
+    return kept, [f for f in findings if id(f) not in kept_ids]

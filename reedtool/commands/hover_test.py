@@ -85,7 +85,7 @@ PROGRESS_AFTER_S = 2.0
 @click.option("--engine", type=click.Choice(["numpy", "numba"]), default="numpy",
               show_default=True,
               help="Simulator engine: numpy (the reference) or numba (compiled, all cores; "
-                   "needs pip install 'reedtool[fast]').")
+                   "needs numba: pip install numba).")
 @click.option("--min-pass-rate", type=FiniteFloatRange(0.0, 1.0), default=0.95,
               show_default=True, help="Batch pass rate needed to exit 0.")
 @click.option("--require", "require", default="flies", show_default=True,

@@ -25,8 +25,17 @@ def select_rules(selectors: tuple[str, ...], family: str | None, severity: str |
         letters = {letter for letter, (_module, title) in FAMILIES.items()
                    if wanted in (letter.lower(), title.lower())}
         if not letters:
+            from difflib import get_close_matches
+
             names = ", ".join(f"{letter} ({title})" for letter, (_m, title) in FAMILIES.items())
-            raise ReedtoolError(f"unknown rule family '{family}'", hint=f"families: {names}")
+            titles = {title.lower(): title for _m, title in FAMILIES.values()}
+            # The family titles and their first words (`rotor` -> Rotors, `controler` ->
+            # Controller cross-check), as the selectors' did-you-mean does for codes.
+            words = {**titles, **{t.split()[0]: full for t, full in titles.items()}}
+            close = get_close_matches(wanted, list(words), n=1, cutoff=0.6)
+            guess = f"did you mean '{words[close[0]].lower()}'? " if close else ""
+            raise ReedtoolError(f"unknown rule family '{family}'",
+                                hint=f"{guess}families: {names}")
         rules = [r for r in rules if r.code[0] in letters]
     if severity:
         rules = [r for r in rules if r.severity == severity]

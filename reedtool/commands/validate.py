@@ -57,16 +57,48 @@ class RunOptions:
     diagram_per_model: bool = False       # several models: NAME.svg -> NAME-MODEL.svg
     force: bool = False
     notes: list[str] = field(default_factory=list)   # one line per clean cross-check
+    # (model name, SuppressionUse, S143 severity) per robot checked: the run's S143
+    suppression_uses: list = field(default_factory=list)
 
 
-def check_target(target, options: RunOptions) -> tuple[list, list[str]]:
-    """check_model for a Target, and the notes it made (what --jobs hands each worker:
-    a worker's changes to `options` do not come back, its return value does)."""
-    notes, options.notes = options.notes, []
+@dataclass(frozen=True)
+class Job:
+    """One check of the run: a model path, with one argument variant of its config."""
+
+    target: object                  # io.model_inputs.Target
+    variant: dict | None = None     # per-file-args variant; None: the model's arguments
+
+    @property
+    def name(self) -> str:
+        from reedtool.assembly.models import variant_label
+
+        return self.target.name + (variant_label(self.variant) if self.variant else "")
+
+
+def jobs_of(target, request: ModelRequest) -> list[Job]:
+    """The checks of one target: one per argument variant it has (assembly.models)."""
+    from reedtool.assembly.models import variants_of
+
+    variants = variants_of(target.path, request)
+    return [Job(target, v) for v in variants] if variants else [Job(target)]
+
+
+def check_target(job: Job, options: RunOptions) -> tuple[list, list[str], list]:
+    """check_model for a Job, the notes it made and its suppression uses (what --jobs
+    hands each worker: a worker's changes to `options` do not come back, its return value
+    does)."""
+    from dataclasses import replace
+
+    notes, uses, request = options.notes, options.suppression_uses, options.request
+    options.notes, options.suppression_uses = [], []
+    if job.variant is not None:
+        # Each variant is its own robot: nothing loaded for another variant is reused.
+        options.request = replace(request, variant=job.variant, preloaded={})
     try:
-        return check_model(target.name, target.path, options), options.notes
+        results = check_model(job.name, job.target.path, options)
+        return results, options.notes, options.suppression_uses
     finally:
-        options.notes = notes
+        options.notes, options.suppression_uses, options.request = notes, uses, request
 
 
 def check_model(name: str, model: Path, options: RunOptions) -> list:
@@ -81,9 +113,17 @@ def check_model(name: str, model: Path, options: RunOptions) -> list:
         exc = checked.error
         return [ModelResult(name, error=exc.one_line(), error_file=exc.file,
                             error_line=exc.line)]
+    from reedtool.assembly.suppression_audit import suppression_use
+    from reedtool.config import load_config
+
+    selection = selection_for(load_config(model), options.request.select,
+                              options.request.ignore)
     results = []
     for one in checked.models:
-        results.append(ModelResult(name + one.suffix, one.findings, suppressed=one.suppressed))
+        results.append(ModelResult(name + one.suffix, one.findings,
+                                   suppressed=len(one.suppressed)))
+        options.suppression_uses.append((name + one.suffix,
+                                         *suppression_use(one.robot, one.suppressed, selection)))
         if not one.suppressed:     # a silenced flight-stack finding is no agreement
             options.notes += _agreement_lines(model, one.robot, one.findings, options,
                                               name + one.suffix)
@@ -172,6 +212,49 @@ def print_settings(targets, options: RunOptions) -> int:
         ignores = config.ignores_for(target.path)
         if ignores:
             click.echo(f"  per-file-ignores: {', '.join(ignores)}")
+        from reedtool.assembly.models import variant_label
+
+        for job in jobs_of(target, options.request):
+            if job.variant is not None:
+                click.echo(f"  variant:{variant_label(job.variant)}")
+        from reedtool.config import DEFAULT_EXCLUDE
+
+        exclude = DEFAULT_EXCLUDE if config.exclude is None else config.exclude
+        click.echo(f"  exclude: {', '.join((*exclude, *config.extend_exclude)) or '-'}"
+                   + (" (forced)" if config.force_exclude else ""))
+        if config.baseline is not None:
+            click.echo(f"  baseline: {relative_to_cwd(config.baseline)}")
+    return 0
+
+
+def _prepare_workers() -> None:
+    """What every model's check imports, loaded once before --jobs forks its workers."""
+    import reedtool.assembly.suppression_audit  # noqa: F401
+    import reedtool.io.dae  # noqa: F401
+    import reedtool.io.loader  # noqa: F401
+    import reedtool.io.xacro_expand  # noqa: F401
+    import reedtool.physics.inertia  # noqa: F401
+    from reedtool.checks.registry import all_rules
+
+    all_rules()
+
+
+def _write_baseline(results, path: Path, force: bool) -> int:
+    """--write-baseline: every finding of the run recorded; exit 0 (2 when a model could
+    not be read: a baseline without its findings would not be the run's)."""
+    from reedtool.assembly.baseline import baseline_text
+    from reedtool.io.fileio import atomic_write_text
+    from reedtool.report import render
+
+    unread = [r for r in results if r.error is not None]
+    if unread:
+        click.echo(render(unread, "text"), nl=False)
+        raise ReedtoolError(f"{len(unread)} model(s) could not be read; baseline not written",
+                            file=path, hint="fix or exclude them, then write the baseline")
+    text, count = baseline_text(results, path)
+    atomic_write_text(path, text, force=force)
+    checked = sum(1 for r in results if r.skipped is None)
+    click.echo(f"reedtool: wrote {count} finding(s) of {checked} model(s) to {path}")
     return 0
 
 
@@ -213,6 +296,16 @@ def print_settings(targets, options: RunOptions) -> int:
               help="ArduPilot .parm file to cross-check (FRAME_CLASS/TYPE, SERVOn_FUNCTION).")
 @click.option("--diagram", type=click.Path(path_type=Path, dir_okay=False), default=None,
               help="Also draw the rotor layout (.svg/.png), rotors named by findings in red.")
+@click.option("--force-exclude", is_flag=True,
+              help="Apply the configuration's exclude to files named on the command line too "
+                   "(as pre-commit passes them; the config's `force-exclude`).")
+@click.option("--baseline", "baseline_file", type=click.Path(path_type=Path, dir_okay=False),
+              help="Report only findings not recorded in this baseline file (default: the "
+                   "config's `baseline`).")
+@click.option("--write-baseline", "write_baseline", metavar="FILE",
+              type=click.Path(path_type=Path, dir_okay=False),
+              help="Record every finding of this run in FILE as accepted and exit 0 "
+                   "(--force to replace it).")
 @click.option("--jobs", "-j", type=click.IntRange(min=0), default=1, show_default=True,
               metavar="N", help="Check the models in N processes (0: one per available "
                                 "CPU); the report keeps the models' order.")
@@ -222,7 +315,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
             strict: bool | None, exit_zero: bool, show_statistics: bool, show_settings: bool,
             no_color: bool, controller_files: tuple[Path, ...] = (),
             airframe_files: tuple[Path, ...] = (), autopilot_files: tuple[Path, ...] = (),
-            diagram: Path | None = None, jobs: int = 1) -> int:
+            diagram: Path | None = None, jobs: int = 1, force_exclude: bool = False,
+            baseline_file: Path | None = None, write_baseline: Path | None = None) -> int:
     """Check models (.urdf, .xacro (.urdf.xacro), .gazebo, .sdf or .world files,
     directories, globs, ROS packages, or a changed pyproject.toml/reedtool.toml: the
     models it configures) for mistakes; NAME:=VALUE words are xacro arguments for every
@@ -244,6 +338,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
     paths, request = request_from_words(inputs, package_paths=package_paths,
                                         model_name=model_name, launch_file=launch_file,
                                         select=select, ignore=ignore)
+    request.force_exclude = force_exclude
     from reedtool.io.mappings import suggest_mapping
 
     for word in paths:
@@ -281,12 +376,16 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
     from reedtool.config import load_config
     from reedtool.report import ModelResult, render
 
-    checkable = [t for t in targets if t.skipped is None and t.path is not None]
-    checked = dict(zip((id(t) for t in checkable),
-                       map_models(functools.partial(check_target, options=options), checkable,
-                                  jobs)))
+    checkable = [job for t in targets if t.skipped is None and t.path is not None
+                 for job in jobs_of(t, request)]
+    outcomes = map_models(functools.partial(check_target, options=options), checkable, jobs,
+                          prepare=_prepare_workers)
+    checked: dict[int, list] = {}
+    for job, outcome in zip(checkable, outcomes):
+        checked.setdefault(id(job.target), []).append(outcome)
     results = []
-    failed = False       # a finding at its model's failing severity
+    failing_of = []      # (result, the severities that fail its model)
+    suppression_uses: list = []
     strict_any = False
     for target in targets:
         if target.skipped is not None:
@@ -297,8 +396,11 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
                 raise ReedtoolError(target.error, file=target.name)
             results.append(ModelResult(target.name, error=target.error, error_file=target.name))
             continue
-        model_results, notes = checked[id(target)]
-        options.notes += notes
+        model_results = []
+        for one_results, notes, uses in checked[id(target)]:
+            model_results += one_results
+            options.notes += notes
+            suppression_uses += uses
         if target.checked_for is not None:
             for result in model_results:
                 if result.error is not None:
@@ -314,8 +416,35 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
         model_strict = load_config(target.path).strict if strict is None else strict
         strict_any = strict_any or model_strict
         model_failing = {"error", "warning"} if model_strict else {"error"}
-        failed = failed or any(f.severity in model_failing
-                               for r in model_results for f in r.findings)
+        failing_of += [(r, model_failing) for r in model_results]
+    from reedtool.assembly.suppression_audit import unused_suppressions
+
+    # S143 over the whole run: a comment in a shared file is unused only if no model needed it.
+    unused = unused_suppressions(suppression_uses)
+    for result in results:
+        if unused.get(result.name):
+            from reedtool.checks.finding import Finding
+
+            result.findings = sorted(result.findings + unused.pop(result.name),
+                                     key=Finding.sort_key)
+    if write_baseline is not None:
+        return _write_baseline(results, write_baseline, force)
+    from reedtool.assembly.baseline import apply_run_baselines
+    from reedtool.config import relative_to_cwd
+
+    baselines, missing = apply_run_baselines(
+        results, [(t.name, t.path) for t in targets if t.path is not None], baseline_file)
+    failed = any(f.severity in model_failing for r, model_failing in failing_of
+                 for f in r.findings)
+    for path in missing:
+        options.notes.append(f"reedtool: the configuration's baseline {relative_to_cwd(path)} "
+                             "does not exist yet, so every finding is reported; write it with "
+                             f"`reedtool validate --write-baseline {relative_to_cwd(path)}`")
+    for baseline in baselines:
+        if baseline.stale():
+            options.notes.append(f"reedtool: {relative_to_cwd(baseline.path)}: "
+                                 f"{baseline.stale()} accepted finding(s) no longer occur in "
+                                 "this run; `--write-baseline` records the findings of now")
     failing = frozenset({"error", "warning"} if strict_any else {"error"})   # junit
     color = _use_color(no_color) and output_file is None
     text = render(results, fmt, color=color, show_statistics=show_statistics, failing=failing)

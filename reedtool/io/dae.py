@@ -49,9 +49,27 @@ def _first(node, name: str):
     return None
 
 
+def _parse_numbers(text: str, dtype) -> np.ndarray:
+    """Whitespace-separated numbers, parsed by numpy in C (a mesh's index and position
+    arrays are most of a COLLADA file: 10^5 numbers each). What numpy's fast parser does
+    not take whole (a bad token, `nan`, an overflow) is parsed word by word as before, so
+    the result and the refusal of a bad number do not depend on the path taken."""
+    if not text.strip():
+        return np.zeros(0, dtype=dtype)       # numpy reads blank text as one number
+    import warnings
+
+    try:
+        with warnings.catch_warnings():
+            # numpy < 2.3 warns where later versions raise on text it cannot read whole.
+            warnings.simplefilter("error", DeprecationWarning)
+            return np.fromstring(text, dtype=dtype, sep=" ")
+    except (ValueError, DeprecationWarning):
+        return np.array(text.split(), dtype=dtype)
+
+
 def _floats(node, source) -> np.ndarray:
     try:
-        return np.array((node.text or "").split(), dtype=np.float64)
+        return _parse_numbers(node.text or "", np.float64)
     except ValueError as exc:
         raise ReedtoolError(f"bad number in <{_local(node.tag)}>", file=source,
                             line=node.sourceline, hint=HINT) from exc
@@ -59,11 +77,19 @@ def _floats(node, source) -> np.ndarray:
 
 def _ints(node, source) -> np.ndarray:
     try:
-        return np.array((node.text or "").split(), dtype=np.int64)
+        return _parse_numbers(node.text or "", np.int64)
     except ValueError as exc:
         raise ReedtoolError(f"bad index in <{_local(node.tag)}>", file=source,
                             line=node.sourceline, hint=HINT) from exc
 
+
+_IDENTITY = np.eye(4)
+
+
+def _transformed(triangles: np.ndarray, R: np.ndarray, t=None) -> np.ndarray:
+    """(n, 3, 3) corners rotated (and moved): one (3n x 3) product, not n small ones."""
+    out = (triangles.reshape(-1, 3) @ R.T).reshape(triangles.shape)
+    return out + t if t is not None else out
 
 # Gazebo works Z up; a Y-up (or X-up) file is turned so its up axis becomes +Z.
 _UP_AXIS_ROTATION = {
@@ -115,18 +141,25 @@ def _geometry_triangles(geometry, source) -> np.ndarray:
     mesh = _first(geometry, "mesh")
     if mesh is None:
         return np.zeros((0, 3, 3))
-    sources = {}
-    for src in _children(mesh, "source"):
-        array = _first(src, "float_array")
-        if array is None:
-            continue
-        values = _floats(array, source)
-        stride = 3
-        accessor = src.find(".//{*}accessor")
-        if accessor is not None and accessor.get("stride", "").isdigit():
-            stride = max(int(accessor.get("stride")), 3)
-        usable = values.size - values.size % stride
-        sources[src.get("id")] = values[:usable].reshape(-1, stride)[:, :3]
+    # Only the positions are read: normals and texture coordinates are as large again and
+    # nothing here needs them, so a <source> is parsed when a primitive uses it.
+    source_nodes = {src.get("id"): src for src in _children(mesh, "source")
+                    if _first(src, "float_array") is not None}
+    parsed: dict[str, np.ndarray] = {}
+
+    def positions_of(ref: str) -> np.ndarray | None:
+        if ref not in parsed:
+            src = source_nodes.get(ref)
+            if src is None:
+                return None
+            values = _floats(_first(src, "float_array"), source)
+            stride = 3
+            accessor = src.find(".//{*}accessor")
+            if accessor is not None and accessor.get("stride", "").isdigit():
+                stride = max(int(accessor.get("stride")), 3)
+            usable = values.size - values.size % stride
+            parsed[ref] = values[:usable].reshape(-1, stride)[:, :3]
+        return parsed[ref]
     vertices = {}
     for v in _children(mesh, "vertices"):
         for inp in _children(v, "input"):
@@ -143,7 +176,7 @@ def _geometry_triangles(geometry, source) -> np.ndarray:
         if vertex_input is None:
             continue
         ref = (vertex_input.get("source") or "").lstrip("#")
-        positions = sources.get(vertices.get(ref, ref))
+        positions = positions_of(vertices.get(ref, ref))
         if positions is None:
             raise ReedtoolError(f"<{kind}> refers to positions '#{ref}' the file does not hold",
                                 file=source, line=prim.sourceline, hint=HINT)
@@ -250,7 +283,9 @@ def parse_dae(data: bytes, source: str | Path = "<dae>") -> DaeFile:
             if kind == "instance_geometry":
                 tri = geometry((child.get("url") or "").lstrip("#"))
                 if len(tri):
-                    placed.append(tri @ T[:3, :3].T + T[:3, 3])
+                    # Most exports place their one geometry with an identity matrix.
+                    placed.append(tri if np.array_equal(T, _IDENTITY)
+                                  else _transformed(tri, T[:3, :3], T[:3, 3]))
             elif kind == "node":
                 walk(child, T, depth + 1)
             elif kind == "instance_node":
@@ -273,7 +308,8 @@ def parse_dae(data: bytes, source: str | Path = "<dae>") -> DaeFile:
         notes.append("no <visual_scene> node instances a geometry; read the geometries as-is")
         placed = [geometry(ref) for ref in geometries]
     triangles = np.concatenate(placed) if placed else np.zeros((0, 3, 3))
-    triangles = triangles @ R_up.T
+    if up_axis in _UP_AXIS_ROTATION and up_axis != "Z_UP":
+        triangles = _transformed(triangles, R_up)
     return DaeFile(triangles, metres, declared, up_axis, notes)
 
 

@@ -34,10 +34,62 @@ class MeshFile:
         return self.triangles * self.metres_per_unit if self.metres_per_unit != 1.0 \
             else self.triangles
 
+    def bounds_m(self) -> np.ndarray | None:
+        """(2, 3) min/max corners in metres (the file's unit applied); None when empty.
+        Computed once: a shared mesh is measured by every model that uses it."""
+        if not hasattr(self, "_bounds_m"):
+            bounds = (corner_bounds(self.triangles) * self.metres_per_unit
+                      if len(self.triangles) else None)
+            if bounds is not None:
+                bounds.flags.writeable = False
+            self._bounds_m = bounds
+        return self._bounds_m
+
+
+# Every mesh file is read once per process: a repository's models share a few propeller
+# and sensor meshes, and one model's checks ask for a mesh more than once (its extent, its
+# units, its mass properties). Keyed by the file's identity (path, device, inode, size,
+# mtime), so an edited file is read again; files above SHARED_MESH_MAX_BYTES are not kept.
+SHARED_MESHES_MAX = 64
+SHARED_MESH_MAX_BYTES = 8 * 1024 * 1024
+_read_meshes: dict[tuple, "MeshFile | ReedtoolError"] = {}
+
+
+def _identity(path: Path) -> tuple | None:
+    import os
+
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    if st.st_size > SHARED_MESH_MAX_BYTES:
+        return None
+    return (os.path.abspath(path), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+
 
 def read_mesh(path: str | Path) -> MeshFile:
-    """A mesh file as Gazebo reads it, without the `<mesh scale>`; unreadable -> ReedtoolError."""
+    """A mesh file as Gazebo reads it, without the `<mesh scale>`; unreadable -> ReedtoolError.
+
+    Read once per process (see `_read_meshes`): the triangles are shared, so read-only."""
     path = Path(path)
+    key = _identity(path)
+    found = _read_meshes.get(key) if key is not None else None
+    if found is None:
+        try:
+            found = _read_mesh(path)
+            found.triangles.flags.writeable = False
+        except ReedtoolError as exc:
+            found = exc
+        if key is not None:
+            if len(_read_meshes) >= SHARED_MESHES_MAX:
+                _read_meshes.pop(next(iter(_read_meshes)))      # the oldest first
+            _read_meshes[key] = found
+    if isinstance(found, ReedtoolError):
+        raise ReedtoolError(found.message, file=found.file, line=found.line, hint=found.hint)
+    return found
+
+
+def _read_mesh(path: Path) -> MeshFile:
     suffix = path.suffix.lower()
     if suffix == ".stl":
         stl = read_stl(path)
@@ -86,6 +138,14 @@ class MeshCheck:
     extent: np.ndarray               # bounding box size, file units
 
 
+def corner_bounds(triangles: np.ndarray) -> np.ndarray:
+    """(2, 3) min and max corner of (n, 3, 3) triangles (or (n, 3) points). Reduced per
+    coordinate over a contiguous row: numpy's reduction along axis 0 of an (n, 3) array
+    is ten times slower on the 10^5 corners of an exported mesh."""
+    columns = np.ascontiguousarray(np.asarray(triangles).reshape(-1, 3).T)
+    return np.vstack([columns.min(axis=1), columns.max(axis=1)])
+
+
 def triangle_areas(triangles: np.ndarray) -> np.ndarray:
     return 0.5 * np.linalg.norm(np.cross(triangles[:, 1] - triangles[:, 0],
                                          triangles[:, 2] - triangles[:, 0]), axis=1)
@@ -107,8 +167,8 @@ def check_triangles(triangles: np.ndarray, source: str | Path) -> MeshCheck:
     check_mesh_coordinates(triangles, source)
     areas = triangle_areas(triangles)
     total_area = float(areas.sum())
-    vertices = triangles.reshape(-1, 3)
-    extent = vertices.max(axis=0) - vertices.min(axis=0)
+    low, high = corner_bounds(triangles)
+    extent = high - low
     if total_area == 0.0:
         raise ReedtoolError(f"all {len(triangles)} triangles have zero area", file=source,
                             hint="the mesh is degenerate; export the part again")

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import fnmatch
 import glob as globmod
+import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -219,12 +220,18 @@ def _never(_path: Path) -> bool:
     return False
 
 
+def _not_excluded(_path: Path, _walked: Path | None) -> str | None:
+    return None
+
+
 def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequence[Path]],
                    display: Callable[[Path], str] = str, *,
                    include_globs: Callable[[Path], Sequence[str]] | None = None,
                    has_arguments: Callable[[Path], bool] = _never,
                    stands_alone: Callable[[Path], bool] = _never,
-                   configures_models: Callable[[Path], bool] = _never) -> list[Target]:
+                   configures_models: Callable[[Path], bool] = _never,
+                   excluded: Callable[[Path, Path | None], str | None] = _not_excluded
+                   ) -> list[Target]:
     """Every model the targets name, in order, each once.
 
     `include_tree(path)` lists the files a xacro model reads (itself first); it decides
@@ -234,6 +241,8 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
     per-file table of the config). `stands_alone(path)`: the file loads alone into a robot
     with links (the caller may keep what it loaded). `configures_models(path)`: the file is
     a reedtool configuration (its directory's models are checked when it changes).
+    `excluded(path, walked)`: why a file found walking directory `walked` (None: a file
+    named on the command line) is left out, or None (the configuration's `exclude`).
     """
     include_tree = _memo(include_tree)
     include_globs = _memo(include_globs) if include_globs is not None else None
@@ -255,6 +264,7 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
             files = _model_files(path, recursive=True)
         templates = {f.with_name(f.name[:-len(".jinja")]) for f in files if _is_sdf_template(f)}
         files = [f for f in files if f not in templates]
+        files = [f for f in files if excluded(f, path) is None]
         models = _top_level(files, include_tree, include_globs)
         if not models:
             out.append(Target(raw, None, "no model file (" + ", ".join(MODEL_SUFFIXES)
@@ -263,6 +273,10 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
             add(model)
 
     def add_file(path: Path) -> None:
+        why = excluded(path, None)
+        if why is not None:
+            out.append(Target(display(path), None, skipped=why))
+            return
         xacro = path.is_file() and path.suffix.lower() in XACRO_SUFFIXES
         includers = _includers(path, include_tree, include_globs) if xacro else []
         root, children = _root_and_children(path) if xacro else (None, [])
@@ -304,7 +318,11 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
 
     for raw in targets:
         path = Path(raw)
-        if path.is_file() and path.name in CONFIG_NAMES:
+        if path.is_file() and path.name == "package.xml":
+            # The manifest names the package; its models are in the directory beside it.
+            out.append(Target(display(path), None, error=PACKAGE_XML_MESSAGE.format(
+                directory=display(path.parent) if str(path.parent) != "." else ".")))
+        elif path.is_file() and path.name in CONFIG_NAMES:
             if configures_models(path):
                 add_directory(path.parent, raw)
             else:
@@ -323,21 +341,67 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
             if not files:
                 out.append(Target(raw, None, "no file matches this pattern"))
             for match in files:
-                add(match)
+                why = excluded(match, None)
+                if why is not None:
+                    out.append(Target(display(match), None, skipped=why))
+                else:
+                    add(match)
         else:
             out.append(Target(raw, None, not_found_message(raw)))
     return out
 
 
+PACKAGE_XML_MESSAGE = ("package.xml is the package's manifest, not a model; pass the package "
+                       "directory: reedtool validate {directory}")
+
+
 def not_found_message(word: str) -> str:
-    """"file not found", or what the word looks like it meant (an argument without `:=`)."""
+    """"file not found", and what the word looks like it meant: an argument without `:=`,
+    or a file or directory whose name is close to it."""
     from reedtool.io.mappings import suggest_mapping
 
     suggestion = suggest_mapping(word)
     if suggestion is not None:
         return (f"file not found; xacro arguments are written name:=value: did you mean "
                 f"'{suggestion}'?")
+    nearby = suggest_path(word)
+    if nearby is not None:
+        return f"file not found; did you mean '{nearby}'?"
     return "file not found"
+
+
+def suggest_path(word: str) -> str | None:
+    """The existing path nearest a mistyped one, component by component from the deepest
+    directory that exists (`urdf/mav_generic_odometry_sensr.gazebo` ->
+    `urdf/mav_generic_odometry_sensor.gazebo`), or None when no name is close."""
+    from difflib import get_close_matches
+
+    path = Path(word)
+    parts = path.parts
+    if not parts:
+        return None
+    # The longest prefix that exists; every component after it gets its nearest name.
+    start = 0
+    base = Path(parts[0]) if path.is_absolute() else Path(".")
+    if path.is_absolute():
+        start = 1
+    while start < len(parts) and (base / parts[start]).exists():
+        base, start = base / parts[start], start + 1
+    if start == len(parts):
+        return None        # it exists (a race, or a dangling link): nothing to suggest
+    for part in parts[start:]:
+        try:
+            names = sorted(entry.name for entry in base.iterdir()
+                           if not entry.name.startswith("."))
+        except OSError:
+            return None
+        # 0.75: a slip or two in a name (`sensr`, `urfd`), not another file of the same
+        # pattern (`missing.urdf` is 0.52 from `broken.urdf`).
+        close = get_close_matches(part, names, n=1, cutoff=0.75)
+        if not close:
+            return None
+        base = base / close[0]
+    return str(base) if path.is_absolute() else os.path.normpath(str(base))
 
 
 def include_tree_of(mappings_for: Callable[[Path], Mapping[str, str]],

@@ -28,6 +28,7 @@ class ModelResult:
     error_file: str | None = None
     error_line: int | None = None
     suppressed: int = 0                         # findings silenced inline or per file
+    baselined: int = 0                          # findings the baseline accepts
     skipped: str | None = None                  # why the file was not checked
 
 

@@ -22,6 +22,7 @@ def _model(result: ModelResult) -> dict:
         "findings": [{**f.to_dict(), "file": display_path(f.file)} for f in result.findings],
         "summary": severity_counts(result.findings),
         "suppressed": result.suppressed,
+        "baselined": result.baselined,
         "error": None,
         "skipped": result.skipped,
     }

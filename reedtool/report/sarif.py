@@ -94,6 +94,11 @@ def format_sarif(results: list[ModelResult]) -> str:
                 else finding.message
             if finding.hint:
                 message += f" (hint: {finding.hint})"
+            _path, bracket, which = result.name.partition(" [")
+            if bracket:
+                # An argument variant or one model of a world: the same line may carry a
+                # finding in one variant and not in another, so the alert names which.
+                message += f" [{which}"
             entry: dict = {
                 "ruleId": finding.code,
                 "ruleIndex": index[finding.code],

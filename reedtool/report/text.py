@@ -51,6 +51,8 @@ def _model_block(result: ModelResult, style) -> list[str]:
     tail = f"{result.name}: {summary_line(result.findings)}"
     if result.suppressed:
         tail += f" ({result.suppressed} suppressed)"
+    if result.baselined:
+        tail += f" ({result.baselined} in the baseline)"
     lines.append(style(tail, fg=_tail_colour(result.findings), bold=True))
     return lines
 

@@ -1,6 +1,6 @@
 """The hover simulation compiled with numba: one vehicle, or a batch across the cores.
 
-Optional (`pip install 'reedtool[fast]'`): without numba, `available()` is False and the
+Optional (the `fast` extra, numba: `pip install numba`): without numba, `available()` is False and the
 numpy engines (`run`, `batch`) are all there is; they stay the reference. The equations
 are theirs, step for step: the Lee controller at heading 0 and its allocation
 (`controller`), the motor model (`motor`), the semi-implicit Euler rigid body with the
@@ -45,7 +45,7 @@ def available() -> bool:
 
 
 def unavailable_reason() -> str:
-    return ("the compiled engine needs numba: pip install 'reedtool[fast]'")
+    return ("the compiled engine needs numba: pip install numba (reedtool's `fast` extra)")
 
 
 # Reason codes: batch.REASONS indices (kept literal here: numba needs constants).
