@@ -98,8 +98,6 @@ MODEL_FRAME = "__model__"
 # nested (not merged) model reads them in that model's scope.
 _SCOPED_PLUGIN_PARAMS = {"jointName", "linkName", "joint_name", "link_name", "bodyName",
                          "body_name"}
-# sdformat writes "no limit" as +-1e16; anything beyond this is unbounded.
-UNBOUNDED_LIMIT = 1e15
 _SDF_VERSION = re.compile(r"<sdf\b[^>]*\bversion\s*=\s*[\"']([\d.]+)[\"']")
 SDF_DEFAULT_MASS_KG = 1.0
 
@@ -291,7 +289,9 @@ class _ModelReader:
             self._issue("bad-number", f"<{el.tag}>{raw}</{el.tag}> has {len(values)} number(s), "
                         f"expected {expected}", el, subject)
             return np.full(len(default), math.nan)
-        values, problem = magnitude_problem(values, unbounded_ok=unbounded_ok)
+        # libsdformat parses "inf": in a limit that is "no limit" (reedtool.io.limits).
+        values, problem = magnitude_problem(values, unbounded_ok=unbounded_ok,
+                                            infinity_ok=unbounded_ok)
         if problem is not None:
             self._issue("non-finite", f"<{el.tag}>{raw}</{el.tag}> {problem}", el, subject)
         return np.array(values, dtype=float)
@@ -454,6 +454,9 @@ class _ModelReader:
     # ------------------------------------------------------------ elements
     def read(self, model: etree._Element) -> Robot:
         name = model.get("name", "")
+        # The model's own pose places it in the world, which nothing here computes; its
+        # numbers are still read, so one the loader refuses is a finding like any other.
+        self._pose(model.find("pose"), name or None)
         self._collect(model, "")
         canonical = model.get("canonical_link")
         robot = Robot(name=name, loc=self.loc(model), source_file=self.file,
@@ -637,18 +640,18 @@ class _ModelReader:
                     name: str) -> tuple[str, JointLimit | None]:
         if sdf_type not in ("revolute", "prismatic", "continuous"):
             return sdf_type, None
+        from reedtool.io.limits import as_limit, unbounded
+
+        # Every "no limit" spelling libsdformat reads (+-inf, DBL_MAX, +-1e16, -1 for
+        # effort and velocity) becomes +-inf here: reedtool.io.limits.
         lower, upper, effort, velocity = (
-            self._number(limit_el, tag, default, name, unbounded_ok=True)
+            as_limit(self._number(limit_el, tag, default, name, unbounded_ok=True), tag, "sdf")
             for tag, default in (("lower", -1e16), ("upper", 1e16), ("effort", -1.0),
                                  ("velocity", -1.0)))
-        # SDF writes "no effort/velocity limit" as -1; URDF needs a number, so: unlimited.
-        limit = JointLimit(lower=lower, upper=upper,
-                           effort=effort if effort >= 0 else math.inf,
-                           velocity=velocity if velocity >= 0 else math.inf,
+        limit = JointLimit(lower=lower, upper=upper, effort=effort, velocity=velocity,
                            loc=self.loc(limit_el) if limit_el is not None else SourceLoc(
                                str(self.file)))
-        if sdf_type == "continuous" or (sdf_type == "revolute" and lower <= -UNBOUNDED_LIMIT
-                                        and upper >= UNBOUNDED_LIMIT):
+        if sdf_type == "continuous" or (sdf_type == "revolute" and unbounded(lower, upper)):
             return "continuous", limit if limit_el is not None else None
         return sdf_type, limit
 

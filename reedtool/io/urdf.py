@@ -277,9 +277,13 @@ class _RobotReader:
         limit_el = el.find("limit")
         limit = None
         if limit_el is not None:
-            # DBL_MAX in a limit is "no limit" (urdfdom stores it as given)
+            from reedtool.io.limits import as_limit
+
+            # DBL_MAX in a limit is "no limit" (urdfdom stores it as given); "inf" is not,
+            # urdfdom refuses it (reedtool.io.limits).
             lower, upper, effort, velocity = (
-                self._float(limit_el, attr, None, name, unbounded_ok=True)
+                as_limit(self._float(limit_el, attr, None, name, unbounded_ok=True), attr,
+                         "urdf")
                 for attr in ("lower", "upper", "effort", "velocity"))
             limit = JointLimit(lower=lower, upper=upper, effort=effort, velocity=velocity,
                                loc=self.locate(limit_el))

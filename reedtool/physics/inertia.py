@@ -461,7 +461,8 @@ class LinkComparison:
     trace_ratio: float | None          # trace(declared) / trace(derived)
     com_offset_m: float | None
     verdict: str                       # see VERDICT_SEVERITY; also ok | differs | com-off |
-    #   slowdown-scaled | massless | no-geometry | no-inertial | geometry-error
+    #   slowdown-scaled | massless | no-geometry | no-inertial | geometry-error |
+    #   unjudged (a number it needs is not a number: the reader's finding speaks)
     message: str
     slowdown: float | None = None      # rotorVelocitySlowdownSim of the rotor on this link
     tensor_problem: str | None = None  # see tensor_problem()
@@ -559,6 +560,14 @@ def compare_link(link: Link, *, moving: bool = False, slowdown: float | None = N
             return result("massless-moving", "mass 0 kg on a link that moves on its own joint")
         return result("massless", "mass 0 kg (a frame merged into its parent): nothing to compare")
     problem = tensor_problem(declared.inertia_kg_m2)
+    if problem == "non-finite" or not np.all(np.isfinite(declared.com_m)):
+        # The reader reported the number (S101/S102); nothing here can be judged from it.
+        return result("unjudged", "the declared inertial has a number that is not a "
+                                  "number (the reader's finding names it): not compared",
+                      problem=problem)
+    if found is not None and not np.all(np.isfinite(found[1])):
+        return result("unjudged", f"the {label}'s pose is not a number (the reader's "
+                                  "finding names it): not compared")
     if found is None:
         if problem:
             return result("invalid", "declared tensor is not physically possible "
@@ -706,6 +715,8 @@ def _robot_frame(robot: Robot):
         poses = link_poses(robot)
     except (ReedtoolError, KeyError, ValueError):
         return None
+    if not all(np.all(np.isfinite(T)) for T in poses.values()):
+        return None     # a pose the reader could not read: no whole robot to judge in
     parts = []
     for name, T_base_link in poses.items():
         declared = declared_mass_properties(robot.link_map[name])

@@ -1,0 +1,85 @@
+"""Issue 27's false-alarm classes, each held against an independent reference: the good
+fixture stays quiet for the rule that once fired on its upstream shape, and the bad one
+of the same class keeps its true finding (tests/fixtures/false_alarms/README.md)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from reedtool.checks.runner import run_checks
+from reedtool.io.loader import load_robots
+
+FIXTURES = Path(__file__).parent / "fixtures" / "false_alarms"
+
+
+def _findings(path: Path, *extra_args):
+    return [f for robot in load_robots(path) for f in run_checks(robot)]
+
+
+def _codes(path: Path, severities=("error", "warning")) -> set[str]:
+    return {f.code for f in _findings(path) if f.severity in severities}
+
+
+# ------------------------------------------------------------------ "no limit" numbers
+
+def _libsdformat_error(path: Path) -> str | None:
+    """libsdformat's verdict in a child process (Drake aborts the process on some limits)."""
+    code = ("import sys; sys.path.insert(0, %r); import sdformat_oracle as o; "
+            "e = o.libsdformat_error(%r, []); print('OK' if e is None else 'ERR ' + e)"
+            % (str(Path(__file__).parent), str(path)))
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=120)
+    return None if out.stdout.strip().endswith("OK") else out.stdout + out.stderr
+
+
+def test_sdf_infinite_limits_are_no_limit():
+    """libsdformat parses <lower>-inf</lower> as a number: the joint has no limit, as with
+    DBL_MAX or sdformat's own +-1e16, and -1 effort/velocity."""
+    path = FIXTURES / "S102_good_sdf_inf_limits.sdf"
+    assert _libsdformat_error(path) is None
+    assert _codes(path) == set()
+    (robot,) = load_robots(path)
+    joint = robot.joint_map["yaw_joint"]
+    assert joint.type == "continuous"          # unbounded both ways, as the loader reads it
+    assert joint.limit.effort == float("inf") and joint.limit.velocity == float("inf")
+
+
+def test_urdf_infinite_limit_stays_an_error():
+    """urdfdom (through Pinocchio) refuses "-inf" in a limit: S102 is right there."""
+    pinocchio = pytest.importorskip("pinocchio")
+    path = FIXTURES / "S102_bad_urdf_inf_limit.urdf"
+    with pytest.raises(ValueError):
+        pinocchio.buildModelFromUrdf(str(path))
+    assert pinocchio.buildModelFromXML(path.read_text().replace('lower="-inf"',
+                                                                'lower="-1.79769e+308"'))
+    assert "S102" in _codes(path)
+    assert "S102" not in {f.code for f in run_checks(load_robots(path)[0])
+                          if "1.79769e+308" in f.message}
+
+
+def test_nan_is_never_a_limit(tmp_path):
+    path = tmp_path / "nan.sdf"
+    path.write_text((FIXTURES / "S102_good_sdf_inf_limits.sdf").read_text()
+                    .replace("<lower>-inf</lower>", "<lower>nan</lower>"))
+    assert "S102" in _codes(path)
+
+
+# ------------------------------------------------------------------ messages
+
+def test_a_possessive_is_not_a_quote():
+    """shorten_names cut the text between the apostrophes of "link 'x'" and "geometry's"
+    as if it were an 80-character name (RotorS omav's I204: "...apping it for its
+    geometry's")."""
+    from reedtool.errors import shorten_names
+
+    message = ("link 'omav/tilt_unit_3': inertia is 12.3x larger than its visual mesh's "
+               "(radius of gyration 0.05 m vs 0.014 m); swapping it for its geometry's "
+               "changes the whole-robot inertia by 4 % at most, so a wrong tensor and a "
+               "placeholder geometry fly alike")
+    assert shorten_names(message) == message
+    long_name = "n" * 500
+    assert len(shorten_names(f"link '{long_name}' has no mass")) < 200
