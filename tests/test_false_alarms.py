@@ -83,3 +83,26 @@ def test_a_possessive_is_not_a_quote():
     assert shorten_names(message) == message
     long_name = "n" * 500
     assert len(shorten_names(f"link '{long_name}' has no mass")) < 200
+
+
+# ------------------------------------------------------------------ Fuel / web URIs
+
+def test_fuel_mesh_and_include_are_not_errors():
+    """gz-sim fetches https://fuel... meshes and includes when the world loads (gz-fuel-
+    tools): not S115 with "pass --package-path", one S190 info per URI instead, and the
+    rest of the model is still checked."""
+    path = FIXTURES / "S115_good_fuel" / "model.sdf"
+    findings = _findings(path)
+    assert {f.code for f in findings if f.severity != "info"} == set()
+    infos = [f for f in findings if f.code == "S190"]
+    assert len(infos) == 2 and all("could not check it" in f.message for f in infos)
+    assert {f.line for f in infos} == {10, 17}
+
+
+def test_a_missing_local_mesh_is_still_an_error(tmp_path):
+    text = (FIXTURES / "S115_good_fuel" / "model.sdf").read_text().replace(
+        "https://fuel.gazebosim.org/1.0/OpenRobotics/models/X3 UAV/4/files/meshes/x3.dae",
+        "meshes/x3.dae")
+    path = tmp_path / "model.sdf"
+    path.write_text(text)
+    assert "S115" in _codes(path)

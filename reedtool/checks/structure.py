@@ -30,6 +30,7 @@ _ROUTED_KINDS = frozenset({
     "xml-declaration-late",     # S124
     "sdf-short-pose",           # S125
     "package-duplicate",        # S150
+    "remote-uri",               # S190
 })
 # libsdformat's joint types (sdf/1.x/joint.sdf): what an SDF <joint type=> may be.
 SDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "ball", "screw",
@@ -337,9 +338,11 @@ def mesh_unresolved(ctx: CheckContext) -> Iterator[Issue]:
     keeps looking (its model database included) and the world never comes up (a known
     classic defect). gz-sim logs the error and spawns the model without that geometry.
     """
+    from reedtool.io.resources import is_remote_uri
+
     for link, kind, shape, mesh in _mesh_shapes(ctx):
-        if _refused(ctx, mesh):
-            continue
+        if _refused(ctx, mesh) or is_remote_uri(mesh.uri):
+            continue        # a web URI Gazebo fetches: S190 says it was not checked
         if mesh.path is None:
             reason = mesh.resolve_error or "cannot be resolved"
             yield Issue(f"link '{link.name}' {kind} mesh '{mesh.uri}': {reason}",
@@ -353,6 +356,31 @@ def mesh_unresolved(ctx: CheckContext) -> Iterator[Issue]:
             yield Issue(f"link '{link.name}' {kind} mesh '{mesh.uri}': "
                         f"{ctx.mesh_error(mesh)}", shape.loc, link.name,
                         hint=f"export the part again as {mesh.path.suffix.lstrip('.').upper()}")
+
+
+@rule("S190", "remote-resource-not-checked", "info",
+      "A mesh or included model comes from the web (Fuel): Gazebo fetches it, reedtool "
+      "could not check it offline.", clause="explains")
+def remote_resource_not_checked(ctx: CheckContext) -> Iterator[Issue]:
+    """An `https://fuel.gazebosim.org/...` (or any http/https) URI in a `<mesh>` or an
+    `<include>` is fetched by Gazebo when the world loads: gz-sim through gz-fuel-tools
+    (into ~/.gz/fuel), Gazebo Classic through its model database. reedtool works offline,
+    so the model is checked without it: an included model is left out, a mesh is not
+    measured. Nothing is wrong with the model for that.
+
+    Severity (info, explains): Gazebo loads such a model; what reedtool could not check is
+    said so, once per URI. To check it, download it (`gz fuel download -u URI`) and pass
+    `--package-path DIR` with the folder holding it, with the URI as a `model://` one.
+    """
+    from reedtool.io.resources import REMOTE_NOT_CHECKED, is_remote_uri
+
+    yield from _reader_issues(ctx, "remote-uri")
+    seen = set()
+    for link, kind, shape, mesh in _mesh_shapes(ctx):
+        if is_remote_uri(mesh.uri) and mesh.uri not in seen:
+            seen.add(mesh.uri)
+            yield Issue(f"link '{link.name}' {kind} mesh '{mesh.uri}' {REMOTE_NOT_CHECKED}",
+                        shape.loc, link.name)
 
 
 @rule("S120", "sdf-link-default-inertial", "warning",

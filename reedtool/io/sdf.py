@@ -64,7 +64,7 @@ from lxml import etree
 from reedtool.errors import ReedtoolError
 from reedtool.io.fileio import magnitude_problem
 from reedtool.frames import make_T, matrix_to_rpy, rpy_to_matrix
-from reedtool.io.resources import resolve_model_file_uri
+from reedtool.io.resources import REMOTE_NOT_CHECKED, is_remote_uri, resolve_model_file_uri
 from reedtool.io.sdf_include import SourceFile, SourceMap, expand_includes
 from reedtool.io.tolerant_xml import (
     late_declaration_issues,
@@ -150,6 +150,12 @@ def _document(xml_text: str, file: Path, resolver):
 
 def _read_model(model: etree._Element, file: Path, resolver, sources: SourceMap) -> Robot:
     robot = _ModelReader(file, resolver, sources).read(model)
+    # Includes Gazebo fetches from the web (Fuel): left out here, and said so (S190).
+    for include in sources.remote:
+        if is_remote_uri(include.uri):
+            robot.parse_issues.append(ParseIssue(
+                "remote-uri", f"<include> '{include.uri}' {REMOTE_NOT_CHECKED}",
+                SourceLoc(str(include.file), include.line), include.name))
     robot.urdf_xml = equivalent_urdf(robot)
     return robot
 
@@ -183,7 +189,9 @@ def _candidate_models(root: etree._Element, file: Path,
         first = sources.unresolved[0]
         raise ReedtoolError(f"the world's <include> could not be read: {first.reason}",
                             file=first.file, line=first.line,
-                            hint="set GZ_SIM_RESOURCE_PATH or pass --package-path DIR")
+                            hint=("download it (gz fuel download -u URI) and pass "
+                                  "--package-path DIR to check it" if is_remote_uri(first.uri)
+                                  else "set GZ_SIM_RESOURCE_PATH or pass --package-path DIR"))
     if _children(root, "world"):
         raise ReedtoolError("no <model> found in the world but static ones: a launch file "
                             "spawns the robot into such a world", file=file, line=root.sourceline,
@@ -585,8 +593,8 @@ class _ModelReader:
         file = self.file_of(el)   # the file that names the URI, which may be an included one
         if uri.startswith("model://"):
             return resolve_model_file_uri(uri, file, getattr(self.resolver, "package_paths", ()))
-        if uri.startswith(("http://", "https://")):
-            raise ReedtoolError("Fuel/HTTP URIs are not fetched")
+        if is_remote_uri(uri):
+            raise ReedtoolError(REMOTE_NOT_CHECKED)
         return Path(self.resolver.resolve_uri(uri, file.parent))
 
     def _joint(self, scoped: str, scope: str, el: etree._Element) -> Joint:

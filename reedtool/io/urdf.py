@@ -255,6 +255,10 @@ class _RobotReader:
         if not uri:
             self._issue("missing-attribute", "<mesh> has no filename= attribute", el, link)
             return Mesh(uri="", path=None, scale=scale, resolve_error="no filename")
+        from reedtool.io.resources import REMOTE_NOT_CHECKED, is_remote_uri
+
+        if is_remote_uri(uri):
+            return Mesh(uri=uri, path=None, scale=scale, resolve_error=REMOTE_NOT_CHECKED)
         try:
             # Relative mesh paths are relative to the file the user passed, as in xacro.
             path = self.resolver.resolve_uri(uri, self.file.parent, requested_by=self.locate(el))
