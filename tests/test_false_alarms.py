@@ -106,3 +106,50 @@ def test_a_missing_local_mesh_is_still_an_error(tmp_path):
     path = tmp_path / "model.sdf"
     path.write_text(text)
     assert "S115" in _codes(path)
+
+
+# ------------------------------------------------------------------ static scenery
+
+RUNWAY_SDF = """<?xml version="1.0"?>
+<sdf version="1.9">
+  <model name="runway">
+    <static>{static}</static>
+    <link name="link">
+      <visual name="visual">
+        <geometry><mesh><uri>runway.dae</uri></mesh></geometry>
+      </visual>
+      <collision name="collision">
+        <geometry><box><size>1500 30 0.1</size></box></geometry>
+      </collision>
+    </link>
+  </model>
+</sdf>
+"""
+
+
+@pytest.fixture
+def runway(tmp_path):
+    """ardupilot_gz's runway in shape: a static model, one link without <inertial>, a
+    COLLADA strip 1500 m long in metres (<unit meter="1">)."""
+    from mesh_helpers import box_triangles, write_dae
+
+    write_dae(tmp_path / "runway.dae", box_triangles((1500.0, 30.0, 0.1)), meter=1.0)
+
+    def write(static: str) -> Path:
+        path = tmp_path / "model.sdf"
+        path.write_text(RUNWAY_SDF.format(static=static))
+        return path
+    return write
+
+
+def test_a_static_runway_is_scenery_not_a_millimetre_part(runway):
+    """A static model is never moved by Gazebo: its 1.5 km mesh is not a unit mistake
+    (I210) and its missing <inertial> gives no kilogram anything is computed from (S120)."""
+    assert _codes(runway("true"), ("error", "warning", "info")) & {"I206", "I210", "S120",
+                                                                   "I204", "I209"} == set()
+    assert _codes(runway("1")) == set()
+
+
+def test_the_same_mesh_on_a_moving_model_stays_found(runway):
+    codes = _codes(runway("false"))
+    assert "I210" in codes and "S120" in codes

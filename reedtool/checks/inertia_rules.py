@@ -429,6 +429,8 @@ def _unit_certainly_wrong(ctx: CheckContext, extent_m: float) -> bool:
 
 
 def _mesh_scale_findings(ctx: CheckContext, certain: bool) -> Iterator[Issue]:
+    if ctx.robot.static:
+        return      # scenery (a 1.5 km runway, a warehouse floor): any size is a size
     low, high = MESH_EXTENT_RANGE_M
     for link in ctx.robot.links:
         for shape, mesh, extent in _mesh_extents(ctx, link):
@@ -488,5 +490,9 @@ def mesh_unit_wrong(ctx: CheckContext) -> Iterator[Issue]:
 
     Severity (error, cannot-fly): the body collides and weighs as one a thousand times
     its size (or invisible).
+
+    A static model (`<static>true</static>`) is scenery, not a robot part: a runway mesh
+    1.5 km across or a 20 m warehouse floor is what it is, and neither I206 nor I210
+    judges its size.
     """
     yield from _mesh_scale_findings(ctx, certain=True)

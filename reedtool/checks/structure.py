@@ -393,7 +393,12 @@ def sdf_link_default_inertial(ctx: CheckContext) -> Iterator[Issue]:
 
     Severity (warning: suspicious, but the model loads and flies): the element is valid
     SDF; whether the kilogram is meant cannot be told.
+
+    A static model (`<static>true</static>`: a building, a runway, a tree) is never moved
+    by the physics engine, so its mass is never used: not reported.
     """
+    if ctx.robot.static:
+        return
     yield from _reader_issues(
         ctx, "sdf-default-inertial",
         hint="give the link its <inertial> (mass and inertia), even a small one")

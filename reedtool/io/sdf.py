@@ -468,7 +468,7 @@ class _ModelReader:
         self._collect(model, "")
         canonical = model.get("canonical_link")
         robot = Robot(name=name, loc=self.loc(model), source_file=self.file,
-                      source_format="sdf")
+                      source_format="sdf", static=_is_static(model))
         for scoped, scope, el in self.link_els:
             robot.links.append(self._link(scoped, scope, el))
         for scoped, scope, el in self.joint_els:

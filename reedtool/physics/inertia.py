@@ -462,7 +462,8 @@ class LinkComparison:
     com_offset_m: float | None
     verdict: str                       # see VERDICT_SEVERITY; also ok | differs | com-off |
     #   slowdown-scaled | massless | no-geometry | no-inertial | geometry-error |
-    #   unjudged (a number it needs is not a number: the reader's finding speaks)
+    #   unjudged (a number it needs is not a number: the reader's finding speaks) |
+    #   static (scenery: its mass properties are never used)
     message: str
     slowdown: float | None = None      # rotorVelocitySlowdownSim of the rotor on this link
     tensor_problem: str | None = None  # see tensor_problem()
@@ -649,6 +650,12 @@ def compare_links(robot: Robot) -> list[LinkComparison]:
     """compare_link for every link of the robot, in document order, then judged in the
     robot (judge_in_robot): a placeholder link, or a tensor whose error does not change
     how the robot flies, is not an error."""
+    if robot.static:
+        # Scenery: Gazebo never moves a static model, so no mass property of it is used.
+        return [LinkComparison(link.name, link.loc, declared_mass_properties(link), None,
+                               None, None, None, None, "static",
+                               "a static model: Gazebo never moves it, its mass and "
+                               "inertia are not used") for link in robot.links]
     moving = moving_links(robot)
     slowdowns = rotor_slowdown_by_link(robot)
     unreadable = unreadable_masses(robot)
