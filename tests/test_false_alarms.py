@@ -153,3 +153,32 @@ def test_a_static_runway_is_scenery_not_a_millimetre_part(runway):
 def test_the_same_mesh_on_a_moving_model_stays_found(runway):
     codes = _codes(runway("false"))
     assert "I210" in codes and "S120" in codes
+
+
+# ------------------------------------------------------------------ Classic scoped names
+
+def test_classic_scoped_names_resolve_as_classic_does():
+    """`iris_cam::base_link` inside model iris_cam (SDF 1.6, Classic plugins) is its own
+    base_link for Gazebo Classic: no S104/S105, one tree of two links."""
+    path = FIXTURES / "S105_good_classic_scoped_name.sdf"
+    assert _codes(path) == set()
+    (robot,) = load_robots(path)
+    (joint,) = robot.joints
+    assert (joint.parent, joint.child) == ("base_link", "camera_link")
+
+
+def test_classic_scoped_names_warn_when_gz_sim_may_be_the_target(tmp_path):
+    """Without Classic plugins the file may be meant for gz-sim, whose libsdformat refuses
+    the scoped name (the oracle says so): a warning, still no structure error."""
+    text = (FIXTURES / "S105_good_classic_scoped_name.sdf").read_text()
+    start = text.index('    <plugin name="camera_controller"')
+    end = text.index("</plugin>", start) + len("</plugin>\n")
+    path = tmp_path / "model.sdf"
+    path.write_text(text[:start] + text[end:])
+    assert "not found" in (_libsdformat_error(path) or "")
+    codes = _codes(path)
+    assert "S191" in codes and not codes & {"S104", "S105"}
+
+
+def test_a_link_of_another_model_stays_missing():
+    assert {"S105", "S104"} <= _codes(FIXTURES / "S105_bad_classic_other_model.sdf")

@@ -31,6 +31,7 @@ _ROUTED_KINDS = frozenset({
     "sdf-short-pose",           # S125
     "package-duplicate",        # S150
     "remote-uri",               # S190
+    "classic-scoped-name",      # S191
 })
 # libsdformat's joint types (sdf/1.x/joint.sdf): what an SDF <joint type=> may be.
 SDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "ball", "screw",
@@ -456,6 +457,27 @@ def sdf_pose_short(ctx: CheckContext) -> Iterator[Issue]:
     if ctx.simulator == "classic":
         return
     yield from _reader_issues(ctx, "sdf-short-pose", hint="write all six numbers: x y z 0 0 0")
+
+
+@rule("S191", "sdf-classic-scoped-name", "warning",
+      "A joint names its own model's link by the scoped name only Gazebo Classic resolves.",
+      clause="suspicious")
+def sdf_classic_scoped_name(ctx: CheckContext) -> Iterator[Issue]:
+    """Inside model `iris`, `<parent>iris::base_link</parent>` is `base_link`: Gazebo Classic
+    (libsdformat 9, files before SDF 1.8) finds a joint's link by its scoped name in the
+    world when the model has none of that name (Joint::Load falls back to
+    World::BaseByName). libsdformat 12 and later (gz-sim) look in the model only and refuse
+    the file ("Child frame with name[iris::base_link] ... not found"). reedtool resolves it
+    as Classic does, so the tree and every computation are those Classic simulates, and
+    no structure error (S104, S105) is reported for it.
+
+    Severity (warning): a model made for Gazebo classic (classic plugins) loads where it
+    is meant to and is not reported; for any other model gz-sim may be its target.
+    """
+    if ctx.simulator == "classic":
+        return
+    yield from _reader_issues(ctx, "classic-scoped-name",
+                              hint="name the link without its model's name")
 
 
 @rule("S130", "mesh-format-unsupported", "error",

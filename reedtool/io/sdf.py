@@ -255,6 +255,7 @@ class _ModelReader:
         self.model_els: dict[str, etree._Element] = {}              # scope "a::" -> <model>
         self.attached_to: dict[str, str] = {}                       # frame -> what it is on
         self.canonical: str | None = None
+        self.model_name: str = ""
 
     # ------------------------------------------------------------ helpers
     def loc(self, el: etree._Element) -> SourceLoc:
@@ -462,6 +463,7 @@ class _ModelReader:
     # ------------------------------------------------------------ elements
     def read(self, model: etree._Element) -> Robot:
         name = model.get("name", "")
+        self.model_name = name
         # The model's own pose places it in the world, which nothing here computes; its
         # numbers are still read, so one the loader refuses is a finding like any other.
         self._pose(model.find("pose"), name or None)
@@ -597,11 +599,33 @@ class _ModelReader:
             raise ReedtoolError(REMOTE_NOT_CHECKED)
         return Path(self.resolver.resolve_uri(uri, file.parent))
 
+    def _reference(self, scope: str, text: str, el: etree._Element, subject: str) -> str:
+        """A joint's <parent>/<child> as a scoped frame name.
+
+        Gazebo Classic (libsdformat 9, files before SDF 1.8) also finds a link by its
+        scoped name in the world: `iris::base_link` written inside model `iris` is its own
+        `base_link` (Joint::Load falls back to World::BaseByName). libsdformat 12+ refuses
+        that ("not found in model"): resolved as Classic does, and said so (S191)."""
+        name = self._scoped(scope, text)
+        if name in self.frames or text == "world" or self._version(el) >= (1, 8):
+            return name
+        own = (scope[:-2].rsplit("::", 1)[-1] if scope else self.model_name) or ""
+        prefix = own + "::"
+        if own and text.startswith(prefix) and self._scoped(scope, text[len(prefix):]) in self.frames:
+            self._issue("classic-scoped-name",
+                        f"joint '{subject}' names '{text}', its own model's '{text[len(prefix):]}' "
+                        "by the scoped name Gazebo Classic finds in the world; libsdformat 12+ "
+                        "(gz-sim) refuses it", el, subject)
+            return self._scoped(scope, text[len(prefix):])
+        return name
+
     def _joint(self, scoped: str, scope: str, el: etree._Element) -> Joint:
         sdf_type = el.get("type", "")
         parent_text, child_text = el.findtext("parent"), el.findtext("child")
-        parent = self.body_of(self._scoped(scope, parent_text.strip())) if parent_text else None
-        child = self.body_of(self._scoped(scope, child_text.strip())) if child_text else None
+        parent = self.body_of(self._reference(scope, parent_text.strip(), el, scoped)) \
+            if parent_text else None
+        child = self.body_of(self._reference(scope, child_text.strip(), el, scoped)) \
+            if child_text else None
         if parent is None:
             self._issue("missing-element", f"joint '{scoped}' has no <parent>", el, scoped)
         if child is None:
