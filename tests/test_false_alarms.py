@@ -182,3 +182,30 @@ def test_classic_scoped_names_warn_when_gz_sim_may_be_the_target(tmp_path):
 
 def test_a_link_of_another_model_stays_missing():
     assert {"S105", "S104"} <= _codes(FIXTURES / "S105_bad_classic_other_model.sdf")
+
+
+# ------------------------------------------------------------------ a joint named like a link
+
+def test_a_joint_named_like_its_link_is_not_a_frame_cycle():
+    """Classic keeps joints and links apart: no "cycle of relative_to frames", the camera
+    hangs where its link's pose puts it."""
+    path = FIXTURES / "S192_good_classic_joint_named_like_link.sdf"
+    findings = _findings(path)
+    assert not [f for f in findings if "cycle" in f.message]
+    assert {f.code for f in findings if f.severity != "info"} == set()
+    (robot,) = load_robots(path)
+    (joint,) = robot.joints
+    assert joint.child == "camera_link"
+    assert joint.T_parent_joint[0, 3] == pytest.approx(0.1, abs=1e-12)   # <pose>0.1 0 0 ...
+
+
+def test_gz_sim_refuses_the_shared_name(tmp_path):
+    text = (FIXTURES / "S192_good_classic_joint_named_like_link.sdf").read_text()
+    start = text.index('    <plugin name="camera_controller"')
+    end = text.index("</plugin>", start) + len("</plugin>\n")
+    path = tmp_path / "model.sdf"
+    path.write_text(text[:start] + text[end:])
+    assert "Non-unique name" in (_libsdformat_error(path) or "")
+    findings = _findings(path)
+    assert [f.code for f in findings if f.severity == "error"] == ["S192"]
+    assert not [f for f in findings if "cycle" in f.message]

@@ -32,6 +32,7 @@ _ROUTED_KINDS = frozenset({
     "package-duplicate",        # S150
     "remote-uri",               # S190
     "classic-scoped-name",      # S191
+    "frame-name-shared",        # S192
 })
 # libsdformat's joint types (sdf/1.x/joint.sdf): what an SDF <joint type=> may be.
 SDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "ball", "screw",
@@ -478,6 +479,26 @@ def sdf_classic_scoped_name(ctx: CheckContext) -> Iterator[Issue]:
         return
     yield from _reader_issues(ctx, "classic-scoped-name",
                               hint="name the link without its model's name")
+
+
+@rule("S192", "sdf-joint-named-like-link", "error",
+      "A joint has the name of a link (or frame) of its model: gz-sim refuses it.",
+      clause="refused")
+def sdf_joint_named_like_link(ctx: CheckContext) -> Iterator[Issue]:
+    """Links, joints and frames of one model share one namespace in libsdformat 12 and
+    later (gz-sim): `<joint name="rotor_0">` beside `<link name="rotor_0">` is refused
+    ("Non-unique name[rotor_0] detected 2 times in XML children of model"). Gazebo Classic
+    keeps joints and links apart (Model::GetJoint, Model::GetLink), and such files are
+    common there. reedtool reads the name as the link's frame, as Classic does, so it is
+    not mistaken for a frame that is relative to itself.
+
+    Severity (error, refused): gz-sim's libsdformat refuses the file. A model made for
+    Gazebo classic (classic plugins) loads where it is meant to and is not reported.
+    """
+    if ctx.simulator == "classic":
+        return
+    yield from _reader_issues(ctx, "frame-name-shared",
+                              hint="rename the joint (RotorS and PX4 add _joint)")
 
 
 @rule("S130", "mesh-format-unsupported", "error",

@@ -434,14 +434,30 @@ class _ModelReader:
             name = el.get("name") or ""
             if el.tag == "link":
                 T, rel = self._pose(el.find("pose"), name)
+                earlier = self.frames.get(scope + name)
+                if earlier is not None and earlier.el.tag == "joint":
+                    self._issue("frame-name-shared",
+                                f"joint '{scope + name}' has the name of another element of "
+                                "its model: libsdformat 12+ (gz-sim) refuses non-unique names; "
+                                "Gazebo Classic keeps joints and links apart", earlier.el,
+                                scope + name)
                 self.frames[scope + name] = _FrameEntry(self._scoped(scope, rel), T, el)
                 self.link_els.append((scope + name, scope, el))
             elif el.tag == "joint":
                 T, rel = self._pose(el.find("pose"), name)
                 child = (el.findtext("child") or "").strip()
+                self.joint_els.append((scope + name, scope, el))
+                if scope + name in self.frames:
+                    # A joint named like a link (or frame) of its model: libsdformat 12+
+                    # refuses the shared name; Gazebo Classic keeps joints and links apart.
+                    # The link keeps the name as a frame (not a cycle through itself).
+                    self._issue("frame-name-shared",
+                                f"joint '{scope + name}' has the name of another element of "
+                                "its model: libsdformat 12+ (gz-sim) refuses non-unique names; "
+                                "Gazebo Classic keeps joints and links apart", el, scope + name)
+                    continue
                 self.frames[scope + name] = _FrameEntry(
                     self._scoped(scope, rel) if rel else self._scoped(scope, child), T, el)
-                self.joint_els.append((scope + name, scope, el))
             elif el.tag == "frame":
                 T, rel = self._pose(el.find("pose"), name)
                 placement = el.get("placement_frame")   # set on merged-include proxy frames
