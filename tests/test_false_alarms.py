@@ -209,3 +209,46 @@ def test_gz_sim_refuses_the_shared_name(tmp_path):
     findings = _findings(path)
     assert [f.code for f in findings if f.severity == "error"] == ["S192"]
     assert not [f for f in findings if "cycle" in f.message]
+
+
+# ------------------------------------------------------------------ hover-test refusals
+
+def _judged(tmp_path, edit):
+    from reedtool.assembly.models import ModelRequest
+    from reedtool.assembly.validation import judge
+
+    text = (Path(__file__).parent / "fixtures/validate/clean_quad_x.urdf").read_text()
+    path = tmp_path / "quad.urdf"
+    path.write_text(edit(text))
+    (robot,) = load_robots(path)
+    return judge(path, robot, ModelRequest(), "hover-test")
+
+
+def _rotor_izz(text: str, izz: str) -> str:
+    start = text.index('<link name="rotor_1">')
+    at = text.index('izz="2.5e-05"', start)
+    return text[:at] + f'izz="{izz}"' + text[at + len('izz="2.5e-05"'):]
+
+
+def test_a_rotor_tensor_error_does_not_refuse_the_flight(tmp_path):
+    """rotor_1's disc tensor breaks the triangle inequality (1.25e-5 + 1.25e-5 < 5e-5):
+    I203, an error validate keeps. Its largest moment, 5e-5 kg·m², is 0.5 % of the
+    quad's smallest principal moment (about 0.0101 kg·m²: 0.00964 for the body plus the
+    rotors' 4 x 0.005 kg at 0.177 m on each axis), far inside the ±10 % hover-test's
+    batch flies: listed beside the result, not refused."""
+    verdict = _judged(tmp_path, lambda t: _rotor_izz(t, "5e-05"))
+    assert [f.code for f in verdict.reported] == ["I203"]
+    assert verdict.refusing == []
+
+
+def test_the_body_tensor_error_still_refuses(tmp_path):
+    """The body's own tensor is most of the robot's: I203 on it refuses."""
+    verdict = _judged(tmp_path, lambda t: t.replace('izz="0.018"', 'izz="0.05"'))
+    assert [f.code for f in verdict.refusing] == ["I203"]
+
+
+def test_a_rotor_tensor_that_could_change_the_flight_refuses(tmp_path):
+    """The same rotor with a 0.004 kg·m² tensor (40 % of the smallest robot moment)
+    could fly differently from any valid one: refused."""
+    verdict = _judged(tmp_path, lambda t: _rotor_izz(t, "0.004"))
+    assert "I203" in [f.code for f in verdict.refusing]

@@ -772,6 +772,25 @@ def placeholder_links(robot: Robot) -> set[str]:
     return out
 
 
+def own_tensor_share(robot: Robot, link_name: str) -> float | None:
+    """The link's own tensor (about its COM: what an I202/I203 error is about; its mass
+    and position are judged elsewhere) as a fraction of the whole robot's smallest
+    principal moment; None when the robot's mass properties are undefined.
+
+    Any tensor of that size or smaller in its place changes each whole-robot principal
+    moment by at most this fraction."""
+    frame = _robot_frame(robot)
+    link = robot.link_map.get(link_name)
+    if frame is None or link is None or link.inertial is None:
+        return None
+    _poses, whole = frame
+    smallest = float(principal_moments(whole.inertia_kg_m2)[0])
+    I = np.asarray(link.inertial.inertia_kg_m2, dtype=float)
+    if smallest <= 0 or not np.all(np.isfinite(I)):
+        return None
+    return float(np.max(np.abs(np.linalg.eigvalsh((I + I.T) / 2.0)))) / smallest
+
+
 def judge_in_robot(robot: Robot, comparisons: list[LinkComparison]) -> list[LinkComparison]:
     """Lower way-off and implausible verdicts that cannot matter to the robot; the others
     are returned unchanged.
