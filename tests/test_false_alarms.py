@@ -252,3 +252,50 @@ def test_a_rotor_tensor_that_could_change_the_flight_refuses(tmp_path):
     could fly differently from any valid one: refused."""
     verdict = _judged(tmp_path, lambda t: _rotor_izz(t, "0.004"))
     assert "I203" in [f.code for f in verdict.refusing]
+
+
+# ------------------------------------------------------------------ several collisions
+
+def test_a_rotor_of_can_and_disc_is_judged_by_both():
+    """The first collision is the motor can (r 14 mm, 20 mm long), the second the prop disc
+    (r 0.1 m, 5 mm): the declared tensor is the disc's. Judged by the can alone it was
+    38x too large (a false I204 on every rotor); judged by the link's body it is right."""
+    path = FIXTURES / "I204_good_motor_can_and_prop_disc.urdf"
+    assert _codes(path) == set()
+
+
+def test_the_link_body_is_its_shapes_at_one_density():
+    """By hand: the disc holds pi 0.1² 0.005 = 1.5708e-4 m³, the can pi 0.014² 0.02 =
+    1.2315e-5 m³, so 0.005 kg splits 0.92730 : 0.07270; about the spin axis (both on it)
+    Izz = m_disc r_disc²/2 + m_can r_can²/2."""
+    import math
+
+    from reedtool.physics.inertia import link_geometry
+
+    (robot,) = load_robots(FIXTURES / "I204_good_motor_can_and_prop_disc.urdf")
+    body = link_geometry(robot.link_map["rotor_0"], 0.005).body
+    v_disc, v_can = math.pi * 0.1 ** 2 * 0.005, math.pi * 0.014 ** 2 * 0.02
+    m_disc, m_can = 0.005 * v_disc / (v_disc + v_can), 0.005 * v_can / (v_disc + v_can)
+    izz = m_disc * 0.1 ** 2 / 2 + m_can * 0.014 ** 2 / 2
+    assert body.inertia_kg_m2[2, 2] == pytest.approx(izz, rel=1e-12)   # analytic both ways
+    # The can sits 12 mm below the disc: the COM moves down by m_can 0.012 / m.
+    assert body.com_m[2] == pytest.approx(-0.012 * m_can / 0.005, rel=1e-12)
+
+
+def test_a_rotor_tensor_no_shape_explains_stays_found(tmp_path):
+    """1e-3 kg·m² on the same 5 g rotor: 40x the disc's, 2,000x the can's: no
+    distribution of its mass over its shapes gives it."""
+    text = (FIXTURES / "I204_good_motor_can_and_prop_disc.urdf").read_text()
+    old = 'ixx="1.25104167e-05" ixy="0" ixz="0" iyy="1.25104167e-05" iyz="0" izz="2.5e-05"'
+    start = text.index('<link name="rotor_0">')
+    at = text.index(old, start)
+    path = tmp_path / "quad.urdf"
+    path.write_text(text[:at] + 'ixx="5e-04" ixy="0" ixz="0" iyy="5e-04" iyz="0" izz="1e-03"'
+                    + text[at + len(old):])
+    assert _codes(path) & {"I204", "I209"}
+
+
+def test_a_tilt_unit_on_a_placeholder_box_is_not_compared():
+    """0.28 kg in a 5 mm box needs 2.24e6 kg/m³ (osmium: 22,590): a placeholder."""
+    path = Path(__file__).parent / "fixtures/inertia/tilt_unit_placeholder_box.urdf"
+    assert "I204" not in _codes(path)
