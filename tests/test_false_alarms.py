@@ -299,3 +299,19 @@ def test_a_tilt_unit_on_a_placeholder_box_is_not_compared():
     """0.28 kg in a 5 mm box needs 2.24e6 kg/m³ (osmium: 22,590): a placeholder."""
     path = Path(__file__).parent / "fixtures/inertia/tilt_unit_placeholder_box.urdf"
     assert "I204" not in _codes(path)
+
+
+# ------------------------------------------------------------------ discovery
+
+def test_a_package_keeping_its_models_elsewhere_is_not_empty(tmp_path):
+    """ntnu-arl's rmf_gz keeps its robot under resources/robots/: validate on the package
+    checks it rather than saying the package holds no model."""
+    from reedtool.io.model_inputs import expand_targets
+
+    pkg = tmp_path / "rmf_gz"
+    (pkg / "resources" / "robots" / "rmf").mkdir(parents=True)
+    (pkg / "package.xml").write_text("<package><name>rmf_gz</name></package>")
+    model = pkg / "resources" / "robots" / "rmf" / "model.sdf"
+    model.write_text((FIXTURES / "S102_good_sdf_inf_limits.sdf").read_text())
+    targets = expand_targets([str(pkg)], include_tree=lambda path: [path])
+    assert [t.path for t in targets] == [model]
