@@ -315,3 +315,29 @@ def test_a_package_keeping_its_models_elsewhere_is_not_empty(tmp_path):
     model.write_text((FIXTURES / "S102_good_sdf_inf_limits.sdf").read_text())
     targets = expand_targets([str(pkg)], include_tree=lambda path: [path])
     assert [t.path for t in targets] == [model]
+
+
+# ------------------------------------------------------------------ xacro recursion
+
+def test_a_macro_looping_once_per_led_expands_as_xacro_does():
+    """58 levels of a self-calling macro (COEX Clover's LED strip shape): xacro expands
+    it, so reedtool does too (it refused at 50 as a "runaway recursion")."""
+    import xacro
+
+    path = FIXTURES / "xacro_good_led_ring_loop.urdf.xacro"
+    reference = xacro.process_file(str(path)).toxml()
+    assert reference.count("<visual>") == 58
+    (robot,) = load_robots(path)
+    assert len(robot.link_map["led_ring"].visuals) == 58
+    assert _codes(path) == set()
+
+
+def test_a_recursion_xacro_cannot_expand_is_still_refused(tmp_path):
+    """Beyond 248 levels xacro itself fails (RecursionError): one clean input error."""
+    from reedtool.errors import ReedtoolError
+
+    path = tmp_path / "deep.urdf.xacro"
+    path.write_text((FIXTURES / "xacro_good_led_ring_loop.urdf.xacro").read_text()
+                    .replace('count="58"', 'count="400"'))
+    with pytest.raises(ReedtoolError, match="nested more than"):
+        load_robots(path)
