@@ -341,3 +341,21 @@ def test_a_recursion_xacro_cannot_expand_is_still_refused(tmp_path):
                     .replace('count="58"', 'count="400"'))
     with pytest.raises(ReedtoolError, match="nested more than"):
         load_robots(path)
+
+
+def test_a_static_floor_with_an_impossible_tensor_loads(tmp_path):
+    """aws-robomaker's warehouse floor shape: static, 1000 kg, a tensor breaking the
+    triangle inequality. libsdformat loads it (the oracle), and Gazebo never moves it:
+    no I203. The same model made dynamic keeps I203."""
+    text = RUNWAY_SDF.format(static="1").replace(
+        '<link name="link">',
+        '<link name="link"><inertial><mass>1000</mass><inertia><ixx>1.2e6</ixx>'
+        '<iyy>2.0e6</iyy><izz>8.3e6</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia>'
+        '</inertial>').replace("<mesh><uri>runway.dae</uri></mesh>",
+                               "<box><size>20 20 0.1</size></box>")
+    path = tmp_path / "floor.sdf"
+    path.write_text(text)
+    assert _libsdformat_error(path) is None
+    assert _codes(path) == set()
+    path.write_text(text.replace("<static>1</static>", "<static>0</static>"))
+    assert "I203" in _codes(path)
