@@ -359,3 +359,29 @@ def test_a_static_floor_with_an_impossible_tensor_loads(tmp_path):
     assert _codes(path) == set()
     path.write_text(text.replace("<static>1</static>", "<static>0</static>"))
     assert "I203" in _codes(path)
+
+
+def test_a_world_model_wrapping_a_static_include_is_scenery(runway):
+    """aws-robomaker's worlds wrap each static asset as <model><include>...</include>
+    </model>: the wrapper has no body of its own, so it is as static as what it holds."""
+    model_dir = runway("true").parent
+    world = model_dir.parent / "world.sdf"
+    world.write_text(f"""<?xml version="1.0"?>
+<sdf version="1.6">
+  <world name="w">
+    <model name="runway_001">
+      <include><uri>{model_dir / "model.sdf"}</uri></include>
+      <pose>0 0 -0.09 0 0 0</pose>
+    </model>
+    <model name="crate">
+      <link name="crate_link">
+        <inertial><mass>1</mass><inertia><ixx>0.1667</ixx><iyy>0.1667</iyy><izz>0.1667</izz>
+          <ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>
+        <collision name="c"><geometry><box><size>1 1 1</size></box></geometry></collision>
+      </link>
+    </model>
+  </world>
+</sdf>
+""")
+    robots = load_robots(world)
+    assert [r.name for r in robots] == ["crate"]

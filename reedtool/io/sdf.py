@@ -165,8 +165,13 @@ def _children(el: etree._Element, tag: str) -> list[etree._Element]:
 
 
 def _is_static(model: etree._Element) -> bool:
+    """A static model, or one whose every body is in static nested models (a world's
+    `<model><include>` of a static warehouse floor): Gazebo moves none of it."""
     static = model.find("static")
-    return static is not None and (static.text or "").strip().lower() in ("true", "1")
+    if static is not None and (static.text or "").strip().lower() in ("true", "1"):
+        return True
+    nested = _children(model, "model")
+    return not _children(model, "link") and bool(nested) and all(map(_is_static, nested))
 
 
 def _has_motor_plugin(model: etree._Element) -> bool:
