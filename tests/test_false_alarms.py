@@ -385,3 +385,37 @@ def test_a_world_model_wrapping_a_static_include_is_scenery(runway):
 """)
     robots = load_robots(world)
     assert [r.name for r in robots] == ["crate"]
+
+
+# ------------------------------------------------------------------ SDF trees
+
+def test_a_static_stand_may_hold_a_free_ball():
+    path = FIXTURES / "S104_good_static_stand_free_ball.sdf"
+    assert _libsdformat_error(path) is None
+    assert _codes(path) == set()
+
+
+def test_a_loose_link_in_a_moving_model_stays_a_second_root(tmp_path):
+    path = tmp_path / "loose.sdf"
+    path.write_text((FIXTURES / "S104_good_static_stand_free_ball.sdf").read_text()
+                    .replace("<static>true</static>", "<static>false</static>")
+                    .replace('<link name="stand">', '<link name="stand"><inertial><mass>1'
+                             '</mass><inertia><ixx>0.08</ixx><iyy>0.08</iyy><izz>0.001</izz>'
+                             '<ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>'))
+    assert "S104" in _codes(path)
+
+
+def test_a_joint_to_the_sdf_world_frame_is_no_missing_link():
+    path = FIXTURES / "S105_good_sdf_joint_to_world.sdf"
+    assert _libsdformat_error(path) is None
+    assert _codes(path) == set()
+
+
+def test_a_urdf_world_link_must_still_exist(tmp_path):
+    path = tmp_path / "arm.urdf"
+    path.write_text("""<robot name="arm">
+  <link name="base_link"><inertial><mass value="2"/><inertia ixx="0.02" iyy="0.02" izz="0.02"
+    ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="rig_to_world" type="fixed"><parent link="world"/><child link="base_link"/></joint>
+</robot>""")
+    assert "S105" in _codes(path)

@@ -116,6 +116,9 @@ def single_root(ctx: CheckContext) -> Iterator[Issue]:
     joint is missing (or names the wrong child); urdfdom rejects the file with "two root
     links found". A model without any link is rejected too.
 
+    A static SDF model (a stand with a ball resting on it) may hold free bodies: its own
+    links are fixed in the world, and libsdformat loads several roots; not reported there.
+
     Severity (error, refused): urdfdom rejects a URDF without exactly one root.
     """
     if not ctx.robot.links:
@@ -123,7 +126,7 @@ def single_root(ctx: CheckContext) -> Iterator[Issue]:
                     hint="a URDF needs at least one link")
         return
     roots = ctx.tree.roots
-    if len(roots) > 1:
+    if len(roots) > 1 and not ctx.robot.static:
         first, *others = roots
         for name in others:
             link = ctx.robot.link_map[name]
@@ -137,11 +140,17 @@ def joint_link_missing(ctx: CheckContext) -> Iterator[Issue]:
     """Every joint's `<parent link=>` and `<child link=>` must name a link of the model.
     A typo or a missing namespace prefix here makes urdfdom reject the file.
 
+    In SDF, `<parent>world</parent>` names the world frame (libsdformat accepts it): a
+    joint that pins the model in the world, not a missing link.
+
     Severity (error, refused): urdfdom rejects the joint and Gazebo cannot create it.
     """
     links = ctx.robot.link_map
+    sdf = ctx.robot.source_format == "sdf"
     for joint in ctx.robot.joints:
         for role, name in (("parent", joint.parent), ("child", joint.child)):
+            if sdf and role == "parent" and name == "world":
+                continue    # SDF's fixed frame: a joint to it pins the model in the world
             if name is not None and name not in links:
                 yield Issue(f"joint '{joint.name}': {role} link '{name}' does not exist",
                             joint.loc, joint.name, hint=_closest_hint(name, links))
