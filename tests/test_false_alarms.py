@@ -419,3 +419,17 @@ def test_a_urdf_world_link_must_still_exist(tmp_path):
   <joint name="rig_to_world" type="fixed"><parent link="world"/><child link="base_link"/></joint>
 </robot>""")
     assert "S105" in _codes(path)
+
+
+def test_a_file_of_gazebo_extensions_only_is_not_a_model(tmp_path):
+    """mantis' slung_load.gazebo: <robot> holding only <gazebo> plugin blocks, a fragment
+    for a model to include; no "the model has no <link>" on it."""
+    from reedtool.io.model_inputs import expand_targets
+
+    (tmp_path / "quad.urdf").write_text((Path(__file__).parent /
+                                         "fixtures/validate/clean_quad_x.urdf").read_text())
+    (tmp_path / "extras.gazebo").write_text(
+        '<?xml version="1.0"?>\n<robot>\n  <gazebo>\n    <plugin name="p" '
+        'filename="libgazebo_ros_control.so"/>\n  </gazebo>\n</robot>\n')
+    targets = expand_targets([str(tmp_path)], include_tree=lambda path: [path])
+    assert [t.path.name for t in targets if t.path] == ["quad.urdf"]

@@ -92,6 +92,8 @@ def _library_by_text(root: str | None, children: list[str]) -> bool:
         return False     # unreadable: let the loader report it
     if root not in ("robot", "sdf"):
         return True
+    if root == "robot" and children and all(c == "gazebo" for c in children):
+        return True     # only <gazebo> extensions: a fragment another file includes
     return bool(children) and all(c in _LIBRARY_CHILDREN for c in children)
 
 
