@@ -38,7 +38,9 @@ class ReedtoolError(Exception):
 # a 1 MB link name echoed whole makes the message useless (issue 14).
 MAX_SHOWN_NAME = 80
 MAX_SHOWN_PATH = 240
-_QUOTED = re.compile(rf"'([^']{{{MAX_SHOWN_NAME + 1},}})'")
+# A quoted name: an apostrophe inside a word ("geometry's") neither opens nor closes one,
+# or the text between two such words would be cut as if it were a name.
+_QUOTED = re.compile(rf"(?<!\w)'([^']{{{MAX_SHOWN_NAME + 1},}})'(?!\w)")
 
 
 def shorten(text: str, limit: int = MAX_SHOWN_NAME) -> str:

@@ -264,6 +264,8 @@ class Robot:
     source_format: str = "urdf"          # "urdf" (also from xacro) or "sdf": Gazebo converts
                                          # only the former, with fixed-joint lumping
     urdf_xml: str | None = None          # the URDF text the model was read from
+    static: bool = False                 # SDF <static>: scenery Gazebo never moves (a
+                                         # runway, a warehouse), not a vehicle
 
     # Lookups keep the first element of a name; duplicates stay visible in the lists.
     @cached_property

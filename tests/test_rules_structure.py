@@ -64,6 +64,13 @@ CASES = [
     ("S124_bad_comment_before_declaration.sdf", ["S119", "S124"]),
     # A 3-number <pose>: libsdformat 9 reads a position, 12+ refuses (S125, not S101).
     ("S125_bad_short_pose.sdf", ["S125", "S125"]),
+    # Issue 27's classes (tests/fixtures/false_alarms, tests/test_false_alarms.py): a Fuel
+    # mesh and a Fuel include are said unchecked (S190, info), not missing.
+    ("../false_alarms/S190_bad_fuel_mesh_and_include.sdf", ["S190", "S190"]),
+    ("../false_alarms/S191_bad_scoped_name_gz_target.sdf", ["S191", "S191"]),
+    ("../false_alarms/S161_bad_joint_named_like_link_1_9.sdf", ["S161"]),
+    ("../false_alarms/S105_good_classic_scoped_name.sdf", []),
+    ("../false_alarms/S161_good_classic_joint_named_like_link.sdf", []),
     # Good fixtures: the arm has a zero-mass fixed tool frame (fine), a plugin on a fixed
     # link kept by preserveFixedJoint, a limited revolute joint; the car a mesh in metres.
     ("clean_arm.urdf", []),

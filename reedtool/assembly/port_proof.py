@@ -126,7 +126,7 @@ class _Comparer:
 
 def compare_structure(original: Robot, port: Robot, fold: dict, proof: Proof) -> None:
     """Links, poses and joints; `fold` maps every original link to (port link, T)."""
-    from reedtool.io.sdf import is_no_limit
+    from reedtool.io.limits import is_no_limit
     from reedtool.physics.inertia import combine_inertials
     from reedtool.physics.kinematics import link_poses
 
@@ -186,7 +186,7 @@ def compare_structure(original: Robot, port: Robot, fold: dict, proof: Proof) ->
         if joint.type in ("revolute", "prismatic", "continuous"):
             for tag in ("effort", "velocity"):
                 # "No limit" is one notion whatever its spelling (-1 in SDF, DBL_MAX in
-                # URDF, absent): io.sdf.is_no_limit.
+                # URDF, absent): io.limits.is_no_limit.
                 a, b = (math.inf if limit is None or is_no_limit(getattr(limit, tag))
                         or getattr(limit, tag) < 0 else getattr(limit, tag)
                         for limit in (joint.limit, other.limit))

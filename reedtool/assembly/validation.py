@@ -115,6 +115,12 @@ REFUSAL_GROUPS: dict[str, tuple[str, ...]] = {
     # authority compute and report themselves.
     "rotors": ("R303", "R313", "R314", "R315", "R316", "R318"),
 }
+# An impossible tensor (I202 not positive definite, I203 the triangle inequality) is about
+# the link's own tensor. Where that tensor is smaller than the inertia spread hover-test's
+# robustness batch already flies (sim.batch.Spreads.inertia_rel: each principal moment
+# +-10 %) against the whole robot's smallest moment, any valid tensor in its place flies
+# the same: reported beside the result, not refused (a rotor's disc tensor on a quad).
+OWN_TENSOR_CODES = ("I202", "I203")
 # What each command builds on. inertia's own output is the mass verdicts and layout's the
 # rotors (drawn, the rotors findings name in red), so neither refuses on those.
 COMMAND_NEEDS: dict[str, tuple[str, ...]] = {
@@ -172,8 +178,20 @@ def judge(model: Path, robot, request: ModelRequest, command: str) -> Verdict:
     verdict = Verdict(findings=kept)
     for f in kept:
         if f.severity == "error":
-            (verdict.refusing if refuses(f.code, needs) else verdict.reported).append(f)
+            refusing = refuses(f.code, needs) and not _flies_the_same(robot, f)
+            (verdict.refusing if refusing else verdict.reported).append(f)
     return verdict
+
+
+def _flies_the_same(robot, finding) -> bool:
+    """An impossible tensor too small to change the flight (OWN_TENSOR_CODES)."""
+    from reedtool.physics.inertia import own_tensor_share
+    from reedtool.sim.batch import Spreads
+
+    if finding.code not in OWN_TENSOR_CODES or not finding.subject:
+        return False
+    share = own_tensor_share(robot, finding.subject)
+    return share is not None and share < Spreads().inertia_rel
 
 
 def refusal_table() -> list[tuple[str, str, str]]:

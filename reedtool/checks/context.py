@@ -295,18 +295,17 @@ class CheckContext:
         if link.name in self._geometry_props:
             return self._geometry_props[link.name]
         result = None
-        shape = link.geometry_for_mass()
         mass = link.inertial.mass_kg if link.inertial else None
-        if shape is not None and mass is not None and np.isfinite(mass) and mass > 0:
-            geometry, T_link_geom = shape
-            if getattr(geometry, "path", True) is not None:  # meshes must be resolved
-                from reedtool.errors import ReedtoolError
-                from reedtool.physics.inertia import geometry_mass_properties
+        if mass is not None and np.isfinite(mass) and mass > 0:
+            from reedtool.errors import ReedtoolError
+            from reedtool.physics.inertia import link_geometry
 
-                try:
-                    result = geometry_mass_properties(geometry, T_link_geom, mass)
-                except ReedtoolError:
-                    result = None
+            try:
+                # Every collision shape (else visual) at one density: the body I204 judges.
+                found = link_geometry(link, mass)
+                result = found.body if found is not None else None
+            except ReedtoolError:
+                result = None
         self._geometry_props[link.name] = result
         return result
 

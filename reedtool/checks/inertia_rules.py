@@ -82,6 +82,12 @@ def _geometry_hint(ctx: CheckContext, link: Link) -> tuple[str, np.ndarray] | No
     R_link_com = link.inertial.T_link_com[:3, :3]
     I_com_axes = R_link_com.T @ np.asarray(props.inertia_kg_m2, dtype=float) @ R_link_com
     geometry, _T = link.geometry_for_mass()
+    kind = "collision" if any(c.geometry is geometry for c in link.collisions) else "visual"
+    count = sum(s.geometry is not None
+                for s in (link.collisions if kind == "collision" else link.visuals))
+    if count > 1:
+        return (f"a {_fmt(link.inertial.mass_kg)} kg body of its {count} {kind} shapes "
+                "(one density)", I_com_axes)
     return describe_geometry(geometry, link.inertial.mass_kg), I_com_axes
 
 
@@ -204,7 +210,10 @@ def _trace_findings(ctx: CheckContext, verdict: str) -> Iterator[Issue]:
         declared, expected = float(np.trace(I)), float(np.trace(I_geom))
         if expected <= 0:
             continue
-        ratio = declared / expected
+        # The verdict's ratio: with several shapes, against the mass distribution over
+        # them that fits best (physics.inertia.compare_link).
+        ratio = comparison.trace_ratio if comparison.trace_ratio else declared / expected
+        expected = declared / ratio if ratio > 0 else expected
         r_decl = math.sqrt(declared / (2 * link.inertial.mass_kg))
         r_geom = math.sqrt(expected / (2 * link.inertial.mass_kg))
         way = "larger" if ratio > 1 else "smaller"
@@ -223,18 +232,25 @@ def _trace_findings(ctx: CheckContext, verdict: str) -> Iterator[Issue]:
       "A link's inertia is 10x above (or 100x below) what its geometry and mass give, "
       "without changing how the robot flies.", clause="ambiguous")
 def inertia_implausible_for_geometry(ctx: CheckContext) -> Iterator[Issue]:
-    """Compares the declared tensor with that of the link's geometry (first collision,
-    else first visual) filled uniformly with the declared mass, through the trace (twice
-    the mass times the squared radius of gyration). 10x larger is no real mass
+    """Compares the declared tensor with that of the link's geometry (all its collision
+    shapes, else all its visual shapes, filled with the declared mass at one density)
+    through the trace (twice the mass times the squared radius of gyration). With several
+    shapes the mass may sit in any of them (a motor can and its prop disc): the tensor is
+    judged against the distribution that fits it best, the uniform one or all of the mass
+    in one shape. 10x larger is no real mass
     distribution (all mass in the corners of a box gives only 3x the solid box's inertia);
     smaller is, down to any share (a hub inside a large collision cylinder), so the
     smaller side is reported from 100x (a radius of gyration a tenth of the solid's).
 
     Severity (warning: suspicious, but the model loads and flies): reedtool cannot tell
-    which of the two is wrong, the tensor or a placeholder geometry (RotorS omav's
-    0.28 kg tilt units on 5 mm boxes), and the robot flies the same either way: swapping
-    the tensor for the geometry's changes none of the whole robot's principal moments by
-    2x. A tensor 100x off that does change them 2x or more is I209, an error.
+    which of the two is wrong, the tensor or the geometry, and the robot flies the same
+    either way: swapping the tensor for the geometry's changes none of the whole robot's
+    principal moments by 2x. A tensor 100x off that does change them 2x or more is I209,
+    an error.
+
+    A geometry that no material could fill with the declared mass (denser than osmium,
+    22,590 kg/m³: RotorS omav's 0.28 kg tilt units on 5 mm boxes need 2.2e6) is a
+    placeholder standing for the part, not its body: the tensor is not compared with it.
 
     Placeholder links are not compared: a link whose mass and whose inertia about the
     robot's centre of mass are both under 0.1 % of the robot's (control surfaces of
@@ -430,6 +446,8 @@ def _unit_certainly_wrong(ctx: CheckContext, extent_m: float) -> bool:
 
 
 def _mesh_scale_findings(ctx: CheckContext, certain: bool) -> Iterator[Issue]:
+    if ctx.robot.static:
+        return      # scenery (a 1.5 km runway, a warehouse floor): any size is a size
     low, high = MESH_EXTENT_RANGE_M
     for link in ctx.robot.links:
         for shape, mesh, extent in _mesh_extents(ctx, link):
@@ -512,5 +530,9 @@ def mesh_unit_wrong(ctx: CheckContext) -> Iterator[Issue]:
 
     Severity (error, cannot-fly): the body collides and weighs as one a thousand times
     its size (or invisible).
+
+    A static model (`<static>true</static>`) is scenery, not a robot part: a runway mesh
+    1.5 km across or a 20 m warehouse floor is what it is, and neither I206 nor I210
+    judges its size.
     """
     yield from _mesh_scale_findings(ctx, certain=True)

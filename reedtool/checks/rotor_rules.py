@@ -142,19 +142,22 @@ def motor_numbers_not_contiguous(ctx: CheckContext) -> Iterator[Issue]:
     A motor whose number the interface never fills never spins. A missing or unreadable
     `<motorNumber>` / `<actuator_number>` is reported as well.
 
-    Without such an interface (gz-sim, where PX4's gz bridge or another node sends the
-    commands) the numbers are the flight stack's outputs and a gap is no mistake by itself:
-    `--airframe` compares them with PX4's outputs (C414).
+    Without such an interface, RotorS' motor model (and PX4 classic's copy of it) still
+    reads entry `motorNumber` of whatever the controller sends (gazebo_motor_model.cpp),
+    and RotorS' controllers send one entry per rotor: with n rotors, a number beyond n-1
+    (a gap below it) is a motor that never receives a command. On gz-sim, where PX4's gz
+    bridge or another node sends the commands, the numbers are the flight stack's outputs
+    and a gap is no mistake by itself: `--airframe` compares them with PX4's outputs (C414).
 
     Severity (error, cannot-fly): the motor never receives a command.
     """
-    from reedtool.physics.rotors import command_vector
+    from reedtool.physics.rotors import command_vector, controller_command_vector
 
     # ArduPilot channels are servo outputs mapped by SERVOn_FUNCTION: any channel is fine.
     rotors = [r for r in _rotors(ctx) if r.kind != "ardupilot"]
     if not rotors:
         return
-    vector = command_vector(ctx.robot)
+    vector = command_vector(ctx.robot) or controller_command_vector(rotors)
     for rotor in rotors:
         if rotor.motor_number is None:
             tag = rotor.number_tag
@@ -174,8 +177,9 @@ def motor_numbers_not_contiguous(ctx: CheckContext) -> Iterator[Issue]:
                                                                               indices[-1] + 1))
                      else ", ".join(map(str, indices)))
             yield Issue(f"rotor '{rotor.name}' has {_number_what(rotor)} {rotor.motor_number}, "
-                        f"but the autopilot interface fills entries {shown} ({vector.what}, "
-                        f"{vector.loc}): this motor never receives a command",
+                        f"but {vector.sender} entries {shown} ({vector.what}"
+                        f"{f', {vector.loc}' if vector.loc else ''}): this motor never "
+                        "receives a command",
                         _number_loc(rotor), rotor.name,
                         hint=f"unused numbers: {', '.join(map(str, free))}" if free else None)
 

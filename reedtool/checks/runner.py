@@ -8,6 +8,9 @@ Each rule runs on its own: an exception in one becomes one error finding of that
 ("internal error in this rule: ..."), the other rules' findings are kept, and `validate`
 exits 3 (`has_internal_errors`). REEDTOOL_DEBUG=1 lets the exception through instead.
 
+A static SDF model is scenery: the inertia (I) and rotor (R) families, which judge a
+vehicle, do not run on it (SCENERY_EXEMPT_FAMILIES).
+
 After the rules ran, `apply_suppressions` drops findings silenced by an inline XML comment
 (reedtool.checks.suppressions) or by a per-file ignore of the configuration.
 """
@@ -27,6 +30,10 @@ from reedtool.model import Robot
 
 _SELECTOR = re.compile(r"^[A-Z]\d{0,3}$")
 INTERNAL_ERROR = "internal error in this rule: "
+# A static SDF model (a warehouse floor, a runway) is never moved by the physics engine:
+# the inertia family (masses, tensors, mesh units against a vehicle's size) and the rotor
+# family judge a vehicle, and libsdformat loads a static model whatever they would say.
+SCENERY_EXEMPT_FAMILIES = ("I", "R")
 
 
 def has_internal_errors(findings: Iterable[Finding]) -> bool:
@@ -129,6 +136,8 @@ def run_checks(robot: Robot, selection: Selection | None = None, *,
     for rule in all_rules():
         if rule.run_level or not selection.enabled(rule.code):
             continue      # a run-level rule is judged over the whole run (validate)
+        if robot.static and rule.code.startswith(SCENERY_EXEMPT_FAMILIES):
+            continue    # scenery: Gazebo never moves a static model, its masses are unused
         severity = selection.severity_of(rule)
         issues, crashed = _issues_of(rule, ctx)
         for issue in issues:

@@ -34,6 +34,8 @@ _ROUTED_KINDS = frozenset({
         "double-colon", "name-collision", "reserved-name", "canonical-link", "attached-to",
         "relative-to", "joint-frames", "model-without-link", "version", "script-uri", "root-elements")),
     "absolute-uri",             # S169
+    "remote-uri",               # S190
+    "classic-scoped-name",      # S191
 })
 # libsdformat's joint types (sdf/1.x/joint.sdf): what an SDF <joint type=> may be.
 SDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "ball", "screw",
@@ -117,6 +119,9 @@ def single_root(ctx: CheckContext) -> Iterator[Issue]:
     joint is missing (or names the wrong child); urdfdom rejects the file with "two root
     links found". A model without any link is rejected too.
 
+    A static SDF model (a stand with a ball resting on it) may hold free bodies: its own
+    links are fixed in the world, and libsdformat loads several roots; not reported there.
+
     Severity (error, refused): urdfdom rejects a URDF without exactly one root.
     """
     if not ctx.robot.links:
@@ -124,7 +129,7 @@ def single_root(ctx: CheckContext) -> Iterator[Issue]:
                     hint="a URDF needs at least one link")
         return
     roots = ctx.tree.roots
-    if len(roots) > 1:
+    if len(roots) > 1 and not ctx.robot.static:
         first, *others = roots
         for name in others:
             link = ctx.robot.link_map[name]
@@ -140,6 +145,9 @@ def joint_link_missing(ctx: CheckContext) -> Iterator[Issue]:
     parent may also be `world` (the model welded to the world), and a parent or child a
     frame, joint, nested model or `__model__`, each standing for the link it is on.
 
+    In SDF, `<parent>world</parent>` names the world frame (libsdformat accepts it): a
+    joint that pins the model in the world, not a missing link.
+
     Severity (error, refused): urdfdom rejects the joint and Gazebo cannot create it.
     """
     links = ctx.robot.link_map
@@ -147,7 +155,7 @@ def joint_link_missing(ctx: CheckContext) -> Iterator[Issue]:
     for joint in ctx.robot.joints:
         for role, name in (("parent", joint.parent), ("child", joint.child)):
             if sdf and role == "parent" and name == "world":
-                continue   # an SDF model welded to the world (a child 'world' is S166)
+                continue    # SDF's fixed frame: a joint to it pins the model in the world
             if name is not None and name not in links:
                 yield Issue(f"joint '{joint.name}': {role} link '{name}' does not exist",
                             joint.loc, joint.name, hint=_closest_hint(name, links))
@@ -346,9 +354,11 @@ def mesh_unresolved(ctx: CheckContext) -> Iterator[Issue]:
     keeps looking (its model database included) and the world never comes up (a known
     classic defect). gz-sim logs the error and spawns the model without that geometry.
     """
+    from reedtool.io.resources import is_remote_uri
+
     for link, kind, shape, mesh in _mesh_shapes(ctx):
-        if _refused(ctx, mesh):
-            continue
+        if _refused(ctx, mesh) or is_remote_uri(mesh.uri):
+            continue        # a web URI Gazebo fetches: S190 says it was not checked
         if mesh.path is None:
             reason = mesh.resolve_error or "cannot be resolved"
             yield Issue(f"link '{link.name}' {kind} mesh '{mesh.uri}': {reason}",
@@ -364,6 +374,31 @@ def mesh_unresolved(ctx: CheckContext) -> Iterator[Issue]:
                         hint=f"export the part again as {mesh.path.suffix.lstrip('.').upper()}")
 
 
+@rule("S190", "remote-resource-not-checked", "info",
+      "A mesh or included model comes from the web (Fuel): Gazebo fetches it, reedtool "
+      "could not check it offline.", clause="explains")
+def remote_resource_not_checked(ctx: CheckContext) -> Iterator[Issue]:
+    """An `https://fuel.gazebosim.org/...` (or any http/https) URI in a `<mesh>` or an
+    `<include>` is fetched by Gazebo when the world loads: gz-sim through gz-fuel-tools
+    (into ~/.gz/fuel), Gazebo Classic through its model database. reedtool works offline,
+    so the model is checked without it: an included model is left out, a mesh is not
+    measured. Nothing is wrong with the model for that.
+
+    Severity (info, explains): Gazebo loads such a model; what reedtool could not check is
+    said so, once per URI. To check it, download it (`gz fuel download -u URI`) and pass
+    `--package-path DIR` with the folder holding it, with the URI as a `model://` one.
+    """
+    from reedtool.io.resources import REMOTE_NOT_CHECKED, is_remote_uri
+
+    yield from _reader_issues(ctx, "remote-uri")
+    seen = set()
+    for link, kind, shape, mesh in _mesh_shapes(ctx):
+        if is_remote_uri(mesh.uri) and mesh.uri not in seen:
+            seen.add(mesh.uri)
+            yield Issue(f"link '{link.name}' {kind} mesh '{mesh.uri}' {REMOTE_NOT_CHECKED}",
+                        shape.loc, link.name)
+
+
 @rule("S120", "sdf-link-default-inertial", "warning",
       "An SDF link has no <inertial>: sdformat gives it 1 kg and a 1 kg·m² inertia.",
       clause="suspicious")
@@ -374,7 +409,12 @@ def sdf_link_default_inertial(ctx: CheckContext) -> Iterator[Issue]:
 
     Severity (warning: suspicious, but the model loads and flies): the element is valid
     SDF; whether the kilogram is meant cannot be told.
+
+    A static model (`<static>true</static>`: a building, a runway, a tree) is never moved
+    by the physics engine, so its mass is never used: not reported.
     """
+    if ctx.robot.static:
+        return
     yield from _reader_issues(
         ctx, "sdf-default-inertial",
         hint="give the link its <inertial> (mass and inertia), even a small one")
@@ -432,6 +472,27 @@ def sdf_pose_short(ctx: CheckContext) -> Iterator[Issue]:
     if ctx.simulator == "classic":
         return
     yield from _reader_issues(ctx, "sdf-short-pose", hint="write all six numbers: x y z 0 0 0")
+
+
+@rule("S191", "sdf-classic-scoped-name", "warning",
+      "A joint names its own model's link by the scoped name only Gazebo Classic resolves.",
+      clause="suspicious")
+def sdf_classic_scoped_name(ctx: CheckContext) -> Iterator[Issue]:
+    """Inside model `iris`, `<parent>iris::base_link</parent>` is `base_link`: Gazebo Classic
+    (libsdformat 9, files before SDF 1.8) finds a joint's link by its scoped name in the
+    world when the model has none of that name (Joint::Load falls back to
+    World::BaseByName). libsdformat 12 and later (gz-sim) look in the model only and refuse
+    the file ("Child frame with name[iris::base_link] ... not found"). reedtool resolves it
+    as Classic does, so the tree and every computation are those Classic simulates, and
+    no structure error (S104, S105) is reported for it.
+
+    Severity (warning): a model made for Gazebo classic (classic plugins) loads where it
+    is meant to and is not reported; for any other model gz-sim may be its target.
+    """
+    if ctx.simulator == "classic":
+        return
+    yield from _reader_issues(ctx, "classic-scoped-name",
+                              hint="name the link without its model's name")
 
 
 @rule("S130", "mesh-format-unsupported", "error",

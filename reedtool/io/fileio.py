@@ -83,14 +83,17 @@ MAX_MESH_COORDINATE = 1e9
 MAX_MAGNITUDE = 1e100
 
 
-def magnitude_problem(values: list[float], *, unbounded_ok: bool = False
-                      ) -> tuple[list[float], str | None]:
+def magnitude_problem(values: list[float], *, unbounded_ok: bool = False,
+                      infinity_ok: bool = False) -> tuple[list[float], str | None]:
     """The numbers as a reader keeps them (beyond MAX_MAGNITUDE: infinite) and what is
     wrong with them, for the reader's own finding; None when they are usable.
 
     `unbounded_ok`: a joint limit, where a huge finite number is the exporters' way of
-    writing "no limit" (DBL_MAX, 1.79769e+308, which the loaders store as given)."""
-    if not all(math.isfinite(v) for v in values):
+    writing "no limit" (DBL_MAX, 1.79769e+308, which the loaders store as given).
+    `infinity_ok`: such a limit in a format whose loader also parses `inf` (SDF:
+    reedtool.io.limits). NaN is never usable."""
+    if any(math.isnan(v) for v in values) or (
+            not infinity_ok and not all(math.isfinite(v) for v in values)):
         return values, "is not finite"
     if all(abs(v) <= MAX_MAGNITUDE for v in values):
         return values, None

@@ -15,8 +15,9 @@ a list of model files:
   passes it when it changes);
 - a directory holding `model.sdf`: that SDF model;
 - a ROS package (a directory with `package.xml`): the top-level models of its `urdf/`
-  (and `models/`, `sdf/`, `worlds/` for SDF), skipping xacro macro libraries and worlds
-  that hold no vehicle (only static models: the launch file spawns the robot);
+  (and `models/`, `sdf/`, `worlds/` for SDF; with none of those, anywhere in it),
+  skipping xacro macro libraries and worlds that hold no vehicle (only static models:
+  the launch file spawns the robot);
 - any other directory: the top-level models below it, recursively;
 - a glob (`urdf/*.xacro`, `**/*.urdf`): the matching files, sorted.
 
@@ -94,6 +95,8 @@ def _library_by_text(root: str | None, children: list[str]) -> bool:
         return False     # unreadable: let the loader report it
     if root not in ("robot", "sdf"):
         return True
+    if root == "robot" and children and all(c == "gazebo" for c in children):
+        return True     # only <gazebo> extensions: a fragment another file includes
     return bool(children) and all(c in _LIBRARY_CHILDREN for c in children)
 
 
@@ -260,6 +263,9 @@ def expand_targets(targets: Sequence[str], include_tree: Callable[[Path], Sequen
             files = [f for sub in PACKAGE_MODEL_DIRS if (path / sub).is_dir()
                      for f in _model_files(path / sub, recursive=sub != "urdf",
                                            suffixes=PACKAGE_SUFFIXES)]
+            if not files:
+                # Models kept elsewhere in the package (ntnu-arl's rmf_gz: resources/).
+                files = _model_files(path, recursive=True, suffixes=PACKAGE_SUFFIXES)
         else:
             files = _model_files(path, recursive=True)
         templates = {f.with_name(f.name[:-len(".jinja")]) for f in files if _is_sdf_template(f)}

@@ -80,11 +80,26 @@ def _as_sdf(candidate: Path) -> Path | None:
     return None
 
 
+REMOTE_SCHEMES = ("http://", "https://")
+
+
+def is_remote_uri(uri: str) -> bool:
+    """A Fuel or other web URI: Gazebo fetches it when the world loads (gz-sim through
+    gz-fuel-tools, Classic through its model database); reedtool works offline."""
+    return uri.strip().lower().startswith(REMOTE_SCHEMES)
+
+
+REMOTE_NOT_CHECKED = ("is fetched by Gazebo from the web (Fuel) when the world loads; reedtool "
+                      "works offline and could not check it")
+
+
 def resolve_model_uri(uri: str, including_file: Path,
                       package_paths: Sequence[Path] = ()) -> Path:
     """The SDF file an `<include><uri>` names; ReedtoolError (no location) when not found."""
-    if uri.startswith(("http://", "https://")):
-        raise ReedtoolError(f"'{uri}' is a Fuel/HTTP URI, which reedtool does not fetch")
+    if is_remote_uri(uri):
+        raise ReedtoolError(f"'{uri}' {REMOTE_NOT_CHECKED}",
+                            hint="to check it, download it (gz fuel download -u URI) and "
+                                 "pass --package-path DIR with the folder holding it")
     if uri.startswith("file://"):
         uri = uri[len("file://"):]
     roots = search_roots(including_file, package_paths)

@@ -68,7 +68,7 @@ from reedtool.errors import ReedtoolError
 from reedtool.io.fileio import magnitude_problem
 from reedtool.frames import make_T, matrix_to_rpy, rpy_to_matrix
 from reedtool.io.meshes import machine_path
-from reedtool.io.resources import resolve_model_file_uri
+from reedtool.io.resources import REMOTE_NOT_CHECKED, is_remote_uri, resolve_model_file_uri
 from reedtool.io.sdf_include import SourceFile, SourceMap, expand_includes
 from reedtool.io.sdf_refusals import document_refusals, parse_version
 from reedtool.io.tolerant_xml import (
@@ -103,31 +103,6 @@ MODEL_FRAME = "__model__"
 # nested (not merged) model reads them in that model's scope.
 _SCOPED_PLUGIN_PARAMS = {"jointName", "linkName", "joint_name", "link_name", "bodyName",
                          "body_name"}
-# sdformat writes "no limit" as +-1e16; anything beyond this is unbounded.
-UNBOUNDED_LIMIT = 1e15
-# What sdformat's joint.sdf says "no limit" is: lower/upper default to -+1e16, and an
-# effort or velocity limit is "not enforced if negative" (default -1).
-SDF_NO_POSITION_LIMIT = 1e16
-
-
-def is_no_limit(value: float | None) -> bool:
-    """The one notion of "no limit" the readers leave in a JointLimit: absent (None) or
-    infinite (SDF's negative effort/velocity, URDF's DBL_MAX, beyond MAX_MAGNITUDE)."""
-    return value is None or not math.isfinite(value)
-
-
-def sdf_limit_text(tag: str, value: float | None) -> str | None:
-    """The text SDF writes for a model's joint limit `tag` (lower, upper, effort,
-    velocity), or None to leave the element out. "No limit" is never written as `inf`:
-    lower/upper become sdformat's -+1e16, effort/velocity are left out (sdformat's
-    default -1, not enforced)."""
-    if tag in ("effort", "velocity"):
-        return None if is_no_limit(value) or value < 0 else repr(float(value))
-    if is_no_limit(value) or abs(value) >= UNBOUNDED_LIMIT:
-        sign = -1.0 if (value is not None and value < 0) or (value is None and tag == "lower") \
-            else 1.0
-        return f"{sign * SDF_NO_POSITION_LIMIT:g}"
-    return "0" if value == 0 else repr(float(value))
 _SDF_VERSION = re.compile(r"<sdf\b[^>]*\bversion\s*=\s*[\"']([\d.]+)[\"']")
 SDF_DEFAULT_MASS_KG = 1.0
 
@@ -211,6 +186,12 @@ def _document(xml_text: str, file: Path, resolver):
 
 def _read_model(model: etree._Element, file: Path, resolver, sources: SourceMap) -> Robot:
     robot = _ModelReader(file, resolver, sources).read(model)
+    # Includes Gazebo fetches from the web (Fuel): left out here, and said so (S190).
+    for include in sources.remote:
+        if is_remote_uri(include.uri):
+            robot.parse_issues.append(ParseIssue(
+                "remote-uri", f"<include> '{include.uri}' {REMOTE_NOT_CHECKED}",
+                SourceLoc(str(include.file), include.line), include.name))
     robot.urdf_xml = equivalent_urdf(robot)
     return robot
 
@@ -220,8 +201,13 @@ def _children(el: etree._Element, tag: str) -> list[etree._Element]:
 
 
 def _is_static(model: etree._Element) -> bool:
+    """A static model, or one whose every body is in static nested models (a world's
+    `<model><include>` of a static warehouse floor): Gazebo moves none of it."""
     static = model.find("static")
-    return static is not None and (static.text or "").strip().lower() in ("true", "1")
+    if static is not None and (static.text or "").strip().lower() in ("true", "1"):
+        return True
+    nested = _children(model, "model")
+    return not _children(model, "link") and bool(nested) and all(map(_is_static, nested))
 
 
 def _has_motor_plugin(model: etree._Element) -> bool:
@@ -244,7 +230,9 @@ def _candidate_models(root: etree._Element, file: Path,
         first = sources.unresolved[0]
         raise ReedtoolError(f"the world's <include> could not be read: {first.reason}",
                             file=first.file, line=first.line,
-                            hint="set GZ_SIM_RESOURCE_PATH or pass --package-path DIR")
+                            hint=("download it (gz fuel download -u URI) and pass "
+                                  "--package-path DIR to check it" if is_remote_uri(first.uri)
+                                  else "set GZ_SIM_RESOURCE_PATH or pass --package-path DIR"))
     if _children(root, "world"):
         raise ReedtoolError("no <model> found in the world but static ones: a launch file "
                             "spawns the robot into such a world", file=file, line=root.sourceline,
@@ -309,6 +297,7 @@ class _ModelReader:
         self.attached_to: dict[str, str] = {}                       # frame -> what it is on
         self.canonical: str | None = None
         self.sensor_blocks: list[GazeboBlock] = []                   # <sensor>s per link
+        self.model_name: str = ""
 
     # ------------------------------------------------------------ helpers
     def loc(self, el: etree._Element) -> SourceLoc:
@@ -351,7 +340,9 @@ class _ModelReader:
             self._issue("bad-number", f"<{el.tag}>{raw}</{el.tag}> has {len(values)} number(s), "
                         f"expected {expected}", el, subject)
             return np.full(len(default), math.nan)
-        values, problem = magnitude_problem(values, unbounded_ok=unbounded_ok)
+        # libsdformat parses "inf": in a limit that is "no limit" (reedtool.io.limits).
+        values, problem = magnitude_problem(values, unbounded_ok=unbounded_ok,
+                                            infinity_ok=unbounded_ok)
         if problem is not None:
             self._issue("non-finite", f"<{el.tag}>{raw}</{el.tag}> {problem}", el, subject)
         return np.array(values, dtype=float)
@@ -506,15 +497,21 @@ class _ModelReader:
             name = el.get("name") or ""
             if el.tag == "link":
                 T, rel = self._pose(el.find("pose"), name)
+                earlier = self.frames.get(scope + name)
                 self.frames[scope + name] = _FrameEntry(self._scoped(scope, rel), T, el)
                 self.link_els.append((scope + name, scope, el))
             elif el.tag == "joint":
                 name = self._renamed(scope, name, el)
                 T, rel = self._pose(el.find("pose"), name)
                 child = (el.findtext("child") or "").strip()
+                self.joint_els.append((scope + name, scope, el))
+                if scope + name in self.frames:
+                    # A joint named like a link (or frame) of its model (from SDF 1.7
+                    # libsdformat refuses it: S161). The link keeps the name as a frame,
+                    # so the joint is not read as a frame relative to itself.
+                    continue
                 self.frames[scope + name] = _FrameEntry(
                     self._scoped(scope, rel) if rel else self._scoped(scope, child), T, el)
-                self.joint_els.append((scope + name, scope, el))
             elif el.tag == "frame":
                 name = self._renamed(scope, name, el)
                 T, rel = self._pose(el.find("pose"), name)
@@ -538,10 +535,14 @@ class _ModelReader:
     def read(self, model: etree._Element) -> Robot:
         name = model.get("name", "")
         self.canonical = model.get("canonical_link")
+        self.model_name = name
+        # The model's own pose places it in the world, which nothing here computes; its
+        # numbers are still read, so one the loader refuses is a finding like any other.
+        self._pose(model.find("pose"), name or None)
         self._collect(model, "")
         canonical = model.get("canonical_link")
         robot = Robot(name=name, loc=self.loc(model), source_file=self.file,
-                      source_format="sdf")
+                      source_format="sdf", static=_is_static(model))
         for scoped, scope, el in self.link_els:
             robot.links.append(self._link(scoped, scope, el))
         for scoped, scope, el in self.joint_els:
@@ -673,15 +674,37 @@ class _ModelReader:
         file = self.file_of(el)   # the file that names the URI, which may be an included one
         if uri.startswith("model://"):
             return resolve_model_file_uri(uri, file, getattr(self.resolver, "package_paths", ()))
-        if uri.startswith(("http://", "https://")):
-            raise ReedtoolError("Fuel/HTTP URIs are not fetched")
+        if is_remote_uri(uri):
+            raise ReedtoolError(REMOTE_NOT_CHECKED)
         return Path(self.resolver.resolve_uri(uri, file.parent))
+
+    def _reference(self, scope: str, text: str, el: etree._Element, subject: str) -> str:
+        """A joint's <parent>/<child> as a scoped frame name.
+
+        Gazebo Classic (libsdformat 9, files before SDF 1.8) also finds a link by its
+        scoped name in the world: `iris::base_link` written inside model `iris` is its own
+        `base_link` (Joint::Load falls back to World::BaseByName). libsdformat 12+ refuses
+        that ("not found in model"): resolved as Classic does, and said so (S191)."""
+        name = self._scoped(scope, text)
+        if name in self.frames or text == "world" or self._version(el) >= (1, 8):
+            return name
+        own = (scope[:-2].rsplit("::", 1)[-1] if scope else self.model_name) or ""
+        prefix = own + "::"
+        if own and text.startswith(prefix) and self._scoped(scope, text[len(prefix):]) in self.frames:
+            self._issue("classic-scoped-name",
+                        f"joint '{subject}' names '{text}', its own model's '{text[len(prefix):]}' "
+                        "by the scoped name Gazebo Classic finds in the world; libsdformat 12+ "
+                        "(gz-sim) refuses it", el, subject)
+            return self._scoped(scope, text[len(prefix):])
+        return name
 
     def _joint(self, scoped: str, scope: str, el: etree._Element) -> Joint:
         sdf_type = el.get("type", "")
         parent_text, child_text = el.findtext("parent"), el.findtext("child")
-        parent = self.body_of(self._scoped(scope, parent_text.strip())) if parent_text else None
-        child = self.body_of(self._scoped(scope, child_text.strip())) if child_text else None
+        parent = self.body_of(self._reference(scope, parent_text.strip(), el, scoped)) \
+            if parent_text else None
+        child = self.body_of(self._reference(scope, child_text.strip(), el, scoped)) \
+            if child_text else None
         if parent is None:
             self._issue("missing-element", f"joint '{scoped}' has no <parent>", el, scoped)
         if child is None:
@@ -733,18 +756,18 @@ class _ModelReader:
                     name: str) -> tuple[str, JointLimit | None]:
         if sdf_type not in ("revolute", "prismatic", "continuous"):
             return sdf_type, None
+        from reedtool.io.limits import as_limit, unbounded
+
+        # Every "no limit" spelling libsdformat reads (+-inf, DBL_MAX, +-1e16, -1 for
+        # effort and velocity) becomes +-inf here: reedtool.io.limits.
         lower, upper, effort, velocity = (
-            self._number(limit_el, tag, default, name, unbounded_ok=True)
+            as_limit(self._number(limit_el, tag, default, name, unbounded_ok=True), tag, "sdf")
             for tag, default in (("lower", -1e16), ("upper", 1e16), ("effort", -1.0),
                                  ("velocity", -1.0)))
-        # SDF writes "no effort/velocity limit" as -1; URDF needs a number, so: unlimited.
-        limit = JointLimit(lower=lower, upper=upper,
-                           effort=effort if effort >= 0 else math.inf,
-                           velocity=velocity if velocity >= 0 else math.inf,
+        limit = JointLimit(lower=lower, upper=upper, effort=effort, velocity=velocity,
                            loc=self.loc(limit_el) if limit_el is not None else SourceLoc(
                                str(self.file)))
-        if sdf_type == "continuous" or (sdf_type == "revolute" and lower <= -UNBOUNDED_LIMIT
-                                        and upper >= UNBOUNDED_LIMIT):
+        if sdf_type == "continuous" or (sdf_type == "revolute" and unbounded(lower, upper)):
             return "continuous", limit if limit_el is not None else None
         return sdf_type, limit
 

@@ -30,7 +30,7 @@ from typing import Sequence
 from lxml import etree
 
 from reedtool.errors import ReedtoolError
-from reedtool.io.resources import resolve_model_uri
+from reedtool.io.resources import is_remote_uri, resolve_model_uri
 from reedtool.io.tolerant_xml import Tolerated, parse_tolerant
 from reedtool.io.xml_lines import start_line
 
@@ -69,6 +69,8 @@ class SourceMap:
     unresolved: list[UnresolvedInclude] = field(default_factory=list)
     # (uri, file, line) of every <include> read, for what a rule says about its URI.
     include_uris: list[tuple[str, Path, int | None]] = field(default_factory=list)
+    # Includes inside a model that Gazebo fetches from the web (Fuel): left out, said so.
+    remote: list[UnresolvedInclude] = field(default_factory=list)
 
     def file_of(self, el: etree._Element) -> SourceFile:
         node = el
@@ -231,6 +233,13 @@ def expand_includes(root: etree._Element, source: SourceFile, sources: SourceMap
                 raise ReedtoolError("<include> has no <uri>")
             path = resolve_model_uri(uri, source.path, package_paths)
         except ReedtoolError as exc:
+            if not in_world and is_remote_uri(uri) and parent is not None:
+                # Gazebo downloads it; the model is checked without it (S190 says so).
+                sources.remote.append(UnresolvedInclude(
+                    (include.findtext("name") or "").strip() or None, uri, source.path, line,
+                    exc.message))
+                parent.remove(include)
+                continue
             if in_world:
                 sources.unresolved.append(UnresolvedInclude(
                     (include.findtext("name") or "").strip() or None, uri, source.path, line,

@@ -373,11 +373,16 @@ def _model(model: etree._Element, ctx: _Context) -> None:
 
 
 def _check_scope(scope: _Scope, ctx: _Context, unread: bool = False) -> None:
+    before = len(ctx.issues)
     _sibling_names(scope.model, ctx, "model", unread)
     _reserved_names(scope.model, ctx)
     for el in scope.model:
         if isinstance(el.tag, str) and el.tag in _UNIQUE_CHILDREN:
             _same_type_names(el, ctx)
+    if any(issue.kind == "sdf-refused-name-collision" for issue in ctx.issues[before:]):
+        # parser.cc checks names before it builds a frame graph and stops there: a name
+        # two frames share would otherwise read as a cycle or a joint to itself.
+        return
     _without_link(scope, ctx)
     _canonical_link(scope, ctx)
     _attached_to(scope, ctx)

@@ -255,6 +255,10 @@ class _RobotReader:
         if not uri:
             self._issue("missing-attribute", "<mesh> has no filename= attribute", el, link)
             return Mesh(uri="", path=None, scale=scale, resolve_error="no filename")
+        from reedtool.io.resources import REMOTE_NOT_CHECKED, is_remote_uri
+
+        if is_remote_uri(uri):
+            return Mesh(uri=uri, path=None, scale=scale, resolve_error=REMOTE_NOT_CHECKED)
         try:
             # Relative mesh paths are relative to the file the user passed, as in xacro.
             path = self.resolver.resolve_uri(uri, self.file.parent, requested_by=self.locate(el))
@@ -277,9 +281,13 @@ class _RobotReader:
         limit_el = el.find("limit")
         limit = None
         if limit_el is not None:
-            # DBL_MAX in a limit is "no limit" (urdfdom stores it as given)
+            from reedtool.io.limits import as_limit
+
+            # DBL_MAX in a limit is "no limit" (urdfdom stores it as given); "inf" is not,
+            # urdfdom refuses it (reedtool.io.limits).
             lower, upper, effort, velocity = (
-                self._float(limit_el, attr, None, name, unbounded_ok=True)
+                as_limit(self._float(limit_el, attr, None, name, unbounded_ok=True), attr,
+                         "urdf")
                 for attr in ("lower", "upper", "effort", "velocity"))
             limit = JointLimit(lower=lower, upper=upper, effort=effort, velocity=velocity,
                                loc=self.locate(limit_el))

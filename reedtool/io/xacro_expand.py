@@ -45,9 +45,13 @@ from reedtool.io.legacy_xacro import LegacyScan, LegacyTag, follow_includes, sca
 from reedtool.io.packages import PackageResolver, is_bundled
 from reedtool.model import SourceLoc
 
-MAX_MACRO_DEPTH = 50            # real models nest < 10 deep; deeper is a runaway recursion
+# As deep as xacro itself goes: a macro calling itself through <xacro:unless> expands to
+# 248 levels under Python's default recursion limit (xacro 2.x, measured) and fails at
+# 249. Real models loop that way (COEX Clover's LED strip: 58 levels, one per LED), so
+# what xacro expands is expanded; deeper is a runaway recursion xacro cannot expand either.
+MAX_MACRO_DEPTH = 248
 DEFAULT_TIME_BUDGET_S = 4.0     # issue 2 promises an answer in under 5 s
-_RECURSION_LIMIT = 4000         # headroom for MAX_MACRO_DEPTH nested macro bodies
+_RECURSION_LIMIT = 12000        # headroom for MAX_MACRO_DEPTH nested macro bodies
 
 _LOCK = threading.RLock()
 

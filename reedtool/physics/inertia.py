@@ -314,6 +314,61 @@ def link_volumes(link: Link) -> Iterator[LinkVolume]:
             yield LinkVolume(total, source, len(geometries), hull)
 
 
+# No material is denser than osmium (22,590 kg/m³): a geometry whose volume would need a
+# denser one to hold the declared mass is not the body but a placeholder standing for it
+# (RotorS omav's 0.28 kg tilt units on 5 mm boxes: 2.2e6 kg/m³), and says nothing about
+# the tensor.
+DENSEST_MATERIAL_KG_M3 = 22590.0
+
+
+@dataclass
+class LinkGeometry:
+    """What a link's declared inertial is compared with: its collision shapes (else its
+    visual shapes) filled with the declared mass at one uniform density."""
+
+    body: MassProperties            # the shapes together, in the link frame
+    kind: str                       # "collision" | "visual"
+    shapes: list                    # the geometries, in document order
+    alone: list[MassProperties]     # each shape holding all the mass (where it may sit)
+
+    @property
+    def density_kg_m3(self) -> float | None:
+        volume = self.body.volume_m3
+        return self.body.mass_kg / volume if volume and volume > 0 else None
+
+
+def link_geometry(link: Link, mass_kg: float) -> LinkGeometry | None:
+    """The link's geometry at `mass_kg`: every collision shape (a motor can and its prop
+    disc are one link's body together), else every visual shape; None when it has none.
+
+    Several shapes share the mass by volume (uniform density). A shape that cannot be
+    measured (an unresolved mesh: S115 says so) is left out; ReedtoolError when none can.
+    """
+    for kind, shapes in (("collision", link.collisions), ("visual", link.visuals)):
+        shapes = [s for s in shapes if s.geometry is not None]
+        if not shapes:
+            continue
+        alone, errors = [], []
+        for shape in shapes:
+            try:
+                alone.append((shape.geometry,
+                              geometry_mass_properties(shape.geometry, shape.T_link_geom,
+                                                       mass_kg)))
+            except ReedtoolError as exc:
+                errors.append(exc)
+        if not alone:
+            raise errors[0]
+        volumes = [props.volume_m3 for _g, props in alone]
+        if len(alone) == 1 or any(not v or v <= 0 for v in volumes):
+            body = alone[0][1]
+        else:
+            total = float(sum(volumes))
+            body = combine([props.scaled_to_mass(mass_kg * v / total)
+                            for (_g, props), v in zip(alone, volumes)])
+        return LinkGeometry(body, kind, [g for g, _p in alone], [p for _g, p in alone])
+    return None
+
+
 def declared_mass_properties(link: Link) -> MassProperties | None:
     """The link's <inertial> in the link frame (tensor rotated into link axes), or None."""
     inertial = link.inertial
@@ -513,7 +568,10 @@ class LinkComparison:
     com_offset_m: float | None
     verdict: str                       # invalid | way-off | implausible | negative-mass |
     #   massless-moving | massless-inertia | placeholder | point-mass | ok | differs |
-    #   com-off | slowdown-scaled | massless | no-geometry | no-inertial | geometry-error
+    #   com-off | slowdown-scaled | massless | no-geometry | no-inertial | geometry-error |
+    #   unjudged (a number it needs is not a number: the reader's finding speaks) |
+    #   static (scenery: its mass properties are never used) | placeholder-geometry (no
+    #   material is dense enough for the geometry to be the body)
     message: str
     slowdown: float | None = None      # rotorVelocitySlowdownSim of the rotor on this link
     tensor_problem: str | None = None  # see tensor_problem()
@@ -587,6 +645,10 @@ def compare_link(link: Link, *, moving: bool = False, slowdown: float | None = N
     if found is not None:
         kind = "collision" if any(c.geometry is found[0] for c in link.collisions) else "visual"
         label = _geometry_label(kind, found[0])
+        count = sum(s.geometry is not None
+                    for s in (link.collisions if kind == "collision" else link.visuals))
+        if count > 1:
+            label = f"{count} {kind} shapes"
 
     def result(verdict, message, derived=None, rel=None, ratio=None, offset=None, problem=None):
         return LinkComparison(link.name, loc, declared, derived, label, rel, ratio, offset,
@@ -610,6 +672,16 @@ def compare_link(link: Link, *, moving: bool = False, slowdown: float | None = N
             return result("massless-moving", "mass 0 kg on a link that moves on its own joint")
         return result("massless", "mass 0 kg (a frame merged into its parent): nothing to compare")
     problem = tensor_problem(declared.inertia_kg_m2)
+    if problem == "non-finite" or not np.all(np.isfinite(declared.com_m)):
+        # The reader reported the number (S101/S102); nothing here can be judged from it.
+        return result("unjudged", "the declared inertial has a number that is not a "
+                                  "number (the reader's finding names it): not compared",
+                      problem=problem)
+    shapes = link.collisions if any(c.geometry is not None for c in link.collisions) \
+        else link.visuals
+    if any(s.geometry is not None and not np.all(np.isfinite(s.T_link_geom)) for s in shapes):
+        return result("unjudged", f"the {label}'s pose is not a number (the reader's "
+                                  "finding names it): not compared")
     if found is None:
         if problem:
             return result("invalid", "declared tensor is not physically possible "
@@ -617,15 +689,32 @@ def compare_link(link: Link, *, moving: bool = False, slowdown: float | None = N
                                      "to derive one from", problem=problem)
         return result("no-geometry", "no collision or visual geometry to compare with")
     try:
-        derived = geometry_mass_properties(found[0], found[1], mass)
+        geometry = link_geometry(link, mass)
     except ReedtoolError as exc:
         if problem:
             return result("invalid", "declared tensor is not physically possible; "
                                      f"{label}: {exc.one_line()}", problem=problem)
         return result("geometry-error", f"{label}: {exc.one_line()}")
+    derived = geometry.body
+    density = geometry.density_kg_m3
+    if not problem and density is not None and density > DENSEST_MATERIAL_KG_M3:
+        return result("placeholder-geometry",
+                      f"the {label} would need {density:,.0f} kg/m³ to hold {mass:g} kg "
+                      f"(no material is denser than {DENSEST_MATERIAL_KG_M3:,.0f}): a "
+                      "placeholder, not the body, so the tensor is not compared with it",
+                      derived)
     rel = relative_difference(declared.inertia_kg_m2, derived.inertia_kg_m2)
     trace_geom = float(np.trace(derived.inertia_kg_m2))
     ratio = float(np.trace(declared.inertia_kg_m2)) / trace_geom if trace_geom > 0 else float("inf")
+    # With several shapes the mass may sit in any of them (a motor can heavier than its
+    # prop disc): the declared tensor is judged against whichever distribution fits it
+    # best, the uniform one or all of the mass in one shape.
+    trace_declared = float(np.trace(declared.inertia_kg_m2))
+    for alone in geometry.alone if len(geometry.alone) > 1 else ():
+        trace_alone = float(np.trace(alone.inertia_kg_m2))
+        if trace_alone > 0 and ratio > 0 and np.isfinite(ratio) and abs(
+                math.log(trace_declared / trace_alone)) < abs(math.log(ratio)):
+            ratio = trace_declared / trace_alone
     offset = float(np.linalg.norm(declared.com_m - derived.com_m))
     gyration_m = np.sqrt(trace_geom / (2.0 * mass)) if trace_geom > 0 else 0.0
     hull = " (of its convex hull: the mesh is open)" if derived.from_hull else ""
@@ -691,6 +780,12 @@ def compare_links(robot: Robot) -> list[LinkComparison]:
     """compare_link for every link of the robot, in document order, then judged in the
     robot (judge_in_robot): a placeholder link, or a tensor whose error does not change
     how the robot flies, is not an error."""
+    if robot.static:
+        # Scenery: Gazebo never moves a static model, so no mass property of it is used.
+        return [LinkComparison(link.name, link.loc, declared_mass_properties(link), None,
+                               None, None, None, None, "static",
+                               "a static model: Gazebo never moves it, its mass and "
+                               "inertia are not used") for link in robot.links]
     moving = moving_links(robot)
     slowdowns = rotor_slowdown_by_link(robot)
     unreadable = unreadable_masses(robot)
@@ -757,6 +852,8 @@ def _robot_frame(robot: Robot):
         poses = link_poses(robot)
     except (ReedtoolError, KeyError, ValueError):
         return None
+    if not all(np.all(np.isfinite(T)) for T in poses.values()):
+        return None     # a pose the reader could not read: no whole robot to judge in
     parts = []
     for name, T_base_link in poses.items():
         declared = declared_mass_properties(robot.link_map[name])
@@ -803,6 +900,25 @@ def placeholder_links(robot: Robot) -> set[str]:
         if mass_share < PLACEHOLDER_FRACTION and inertia_share < PLACEHOLDER_FRACTION:
             out.add(name)
     return out
+
+
+def own_tensor_share(robot: Robot, link_name: str) -> float | None:
+    """The link's own tensor (about its COM: what an I202/I203 error is about; its mass
+    and position are judged elsewhere) as a fraction of the whole robot's smallest
+    principal moment; None when the robot's mass properties are undefined.
+
+    Any tensor of that size or smaller in its place changes each whole-robot principal
+    moment by at most this fraction."""
+    frame = _robot_frame(robot)
+    link = robot.link_map.get(link_name)
+    if frame is None or link is None or link.inertial is None:
+        return None
+    _poses, whole = frame
+    smallest = float(principal_moments(whole.inertia_kg_m2)[0])
+    I = np.asarray(link.inertial.inertia_kg_m2, dtype=float)
+    if smallest <= 0 or not np.all(np.isfinite(I)):
+        return None
+    return float(np.max(np.abs(np.linalg.eigvalsh((I + I.T) / 2.0)))) / smallest
 
 
 def judge_in_robot(robot: Robot, comparisons: list[LinkComparison]) -> list[LinkComparison]:

@@ -506,7 +506,8 @@ class CommandVector:
 
     indices: set[int]
     what: str                       # how they are declared, for messages
-    loc: SourceLoc
+    loc: SourceLoc | None
+    sender: str = "the autopilot interface fills"   # who fills them, for messages
 
 
 def command_vector(robot: Robot) -> CommandVector | None:
@@ -537,6 +538,26 @@ def command_vector(robot: Robot) -> CommandVector | None:
                 return CommandVector(indices, "the input_index of its velocity control "
                                               "channels", channels.loc)
     return None
+
+
+# The motor plugins that read their command as entry `motorNumber` of the vector the
+# controller publishes, whoever publishes it: RotorS' gazebo_motor_model.cpp and its PX4
+# classic copy (`angular_velocities(motor_number_)`, an index beyond the vector's size is
+# refused with "You tried to access index ..." and the motor keeps its last command, none).
+INDEXED_MOTOR_KINDS = ("rotors", "px4")
+
+
+def controller_command_vector(rotors) -> CommandVector | None:
+    """Without an autopilot interface, what the controller sends RotorS-style motors: one
+    entry per rotor (RotorS' controllers publish `rotor_configuration`'s count, 0..n-1),
+    so a motor numbered beyond n-1 never receives a command. None when any rotor is of
+    another family (gz-sim: the flight stack's outputs, compared by --airframe)."""
+    rotors = list(rotors)
+    if not rotors or any(r.kind not in INDEXED_MOTOR_KINDS for r in rotors):
+        return None
+    count = len(rotors)
+    return CommandVector(set(range(count)), f"one per rotor, {count} rotors", None,
+                         sender="the controller sends")
 
 
 # ------------------------------------------------- ArduPilot motor response

@@ -19,7 +19,7 @@ from pathlib import Path, PurePosixPath
 import numpy as np
 from lxml import etree
 
-from reedtool.io.sdf import sdf_limit_text
+from reedtool.io.limits import sdf_limit_text
 from reedtool.scaffold.gz_port import Element, GzPort, PortRow, _num, _pose_text
 
 SDF_VERSION = "1.9"
