@@ -64,25 +64,11 @@ def build_tree(robot: Robot) -> Tree:
     return tree
 
 
-# Meshes shared by the models of one run (a repository's models use the same few files):
-# read once per process, keyed by the file's identity (device, inode, size, mtime), so an
-# edited file is read again. Large meshes are not kept.
+# What a mesh file's triangles are worth (damaged, empty, NaN: a reason; "" fine), judged
+# once per process for every model of a run that names the file. The file itself is read
+# once per process by io.meshes.read_mesh, keyed by the same identity.
 SHARED_MESHES_MAX = 64
-SHARED_MESH_MAX_BYTES = 8 * 1024 * 1024
-_shared_meshes: dict[tuple, Any] = {}        # (path, identity) -> MeshFile | ReedtoolError
-_shared_mesh_errors: dict[tuple, str] = {}   # (path, identity) -> why not usable ("": fine)
-
-
-def _shared_key(path) -> tuple | None:
-    import os
-
-    try:
-        st = os.stat(path)
-    except OSError:
-        return None
-    if st.st_size > SHARED_MESH_MAX_BYTES:
-        return None
-    return (str(path), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+_shared_mesh_errors: dict[tuple, str] = {}   # file identity -> why not usable ("": fine)
 
 
 def _remember(cache: dict, key: tuple | None, value) -> None:
@@ -323,18 +309,10 @@ class CheckContext:
                     or uri_problem(mesh.uri, mesh.path):
                 self._mesh_files[key] = None   # only the light readers run in validate
             else:
-                shared = _shared_key(mesh.path)
-                if shared in _shared_meshes:
-                    self._mesh_files[key] = _shared_meshes[shared]
-                else:
-                    try:
-                        self._mesh_files[key] = read_mesh(key)
-                    except ReedtoolError as exc:
-                        self._mesh_files[key] = exc
-                    read = self._mesh_files[key]
-                    if shared is not None and hasattr(read, "triangles"):
-                        read.triangles.flags.writeable = False   # shared: never edited
-                    _remember(_shared_meshes, shared, read)
+                try:
+                    self._mesh_files[key] = read_mesh(key)    # read once per process
+                except ReedtoolError as exc:
+                    self._mesh_files[key] = exc
         return self._mesh_files[key]
 
     def mesh_error(self, mesh) -> str | None:
@@ -349,8 +327,10 @@ class CheckContext:
             return None
         if isinstance(read, ReedtoolError):
             return read.message
+        from reedtool.io.meshes import file_identity
+
         key = str(mesh.path)
-        shared = _shared_key(mesh.path)
+        shared = file_identity(mesh.path)
         if key not in self._mesh_errors and shared in _shared_mesh_errors:
             self._mesh_errors[key] = _shared_mesh_errors[shared]
         if key not in self._mesh_errors:

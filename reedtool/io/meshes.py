@@ -55,7 +55,8 @@ SHARED_MESH_MAX_BYTES = 8 * 1024 * 1024
 _read_meshes: dict[tuple, "MeshFile | ReedtoolError"] = {}
 
 
-def _identity(path: Path) -> tuple | None:
+def file_identity(path: Path) -> tuple | None:
+    """(path, device, inode, size, mtime) of a mesh small enough to keep, else None."""
     import os
 
     try:
@@ -72,7 +73,7 @@ def read_mesh(path: str | Path) -> MeshFile:
 
     Read once per process (see `_read_meshes`): the triangles are shared, so read-only."""
     path = Path(path)
-    key = _identity(path)
+    key = file_identity(path)
     found = _read_meshes.get(key) if key is not None else None
     if found is None:
         try:
