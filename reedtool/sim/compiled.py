@@ -21,13 +21,15 @@ vehicle, `_w_motors` for a block); a per-rotor "alive" mask or failure time belo
 
 from __future__ import annotations
 
+import importlib.util
 import math
+import sys
 import time
 
 import numpy as np
 
 from reedtool.sim import HoverConfig
-from reedtool.sim.controller import ControllerDesign, ControllerGains
+from reedtool.sim.controller import ControllerDesign, ControllerGains, prioritised_one
 
 try:        # the extra; everything below the guard needs it
     import numba
@@ -162,40 +164,9 @@ if numba is not None:
         _prioritised(pinv, thrust_max, f, t0, t1, t2, T)
         return True, worst
 
-    @njit(cache=True, error_model="numpy")
-    def _prioritised(pinv, thrust_max, f, t0, t1, t2, T):
-        """controller._prioritised for one vehicle: thrust, then roll/pitch, then yaw."""
-        n = T.shape[0]
-        fit = 1.0
-        any_over = False
-        for i in range(n):
-            T[i] = pinv[i, 0] * f
-            if T[i] > thrust_max[i]:
-                ratio = thrust_max[i] / T[i]
-                if not any_over or ratio < fit:
-                    fit = ratio
-                any_over = True
-        for i in range(n):
-            b = T[i] * fit if any_over else T[i]
-            T[i] = min(max(b, 0.0), thrust_max[i])
-        for stage in range(2):
-            scale = np.inf
-            for i in range(n):
-                d = pinv[i, 1] * t0 + pinv[i, 2] * t1 if stage == 0 else pinv[i, 3] * t2
-                if d > 0.0:
-                    room = (thrust_max[i] - T[i]) / d
-                    if room < scale:
-                        scale = room
-                elif d < 0.0:
-                    room = -T[i] / d
-                    if room < scale:
-                        scale = room
-            scale = min(max(scale, 0.0), 1.0)
-            for i in range(n):
-                d = pinv[i, 1] * t0 + pinv[i, 2] * t1 if stage == 0 else pinv[i, 3] * t2
-                T[i] = T[i] + scale * d
-        for i in range(n):
-            T[i] = min(max(T[i], 0.0), thrust_max[i])
+    # The desaturation is controller.prioritised_one itself, jitted: the generated
+    # float step (run) calls the same function unjitted.
+    _prioritised = njit(cache=True, error_model="numpy")(prioritised_one)
 
     @njit(cache=True, error_model="numpy")
     def _body_wrench(pos, axis, tmap, cd, cr, k, shift, omega, R, v, w, Fb, Tb):
@@ -956,6 +927,28 @@ if numba is not None:
 
 # ------------------------------------------------------------------ Python side
 
+def _load_numba_typing() -> None:
+    """Import numba's typing of numpy without importing scipy.
+
+    numba's first compile or cache load in a process imports numba.np.arraymath, whose
+    module-level BLAS probe imports scipy.linalg (numba itself imports only scipy's top): about a third of the CPU time of a
+    cached single-vehicle run (cProfile; the kernels call no BLAS). scipy is hidden for
+    that import only; the probe's answer (read by numba's np.convolve and np.correlate
+    alone; np.dot probes again when compiled) is then set to what it would have been, so
+    nothing else in the process sees a difference.
+    """
+    if "numba.np.arraymath" in sys.modules or "scipy.linalg" in sys.modules:
+        return
+    sys.modules["scipy.linalg"] = None   # import scipy.linalg -> ImportError, here only
+    try:
+        import numba.np.arraymath as arraymath
+    finally:
+        if sys.modules.get("scipy.linalg", 0) is None:
+            del sys.modules["scipy.linalg"]
+    arraymath._HAVE_BLAS = importlib.util.find_spec("scipy.linalg") is not None
+
+
+
 def _settings(params, gains: ControllerGains, config: HoverConfig, setpoint) -> np.ndarray:
     values = {
         "dt": config.dt_s, "g": params.g_m_s2, "m_ctl": gains.mass_kg, "kp": gains.kp_1_s2,
@@ -1055,6 +1048,7 @@ def fly_batch(params, config: HoverConfig, plant,
     final = np.zeros((N, 13 + n))
     rows = config.n_steps // config.sample_every + (config.n_steps % config.sample_every != 0) + 1
     pos_rec = np.full((N, rows if record else 0), np.nan)
+    _load_numba_typing()
     if N == 1:
         _fly_one(cfg, nominal, mass[0], S[:, 0].copy(), shift[:, 0].copy(),
                  k[:, 0].copy(), state0, out_f[0], out_i[0], final[0], np.empty((0, 0)),
@@ -1079,6 +1073,7 @@ def vehicle_flyer(params, gains: ControllerGains, config: HoverConfig, setpoint_
 
     if numba is None:
         raise RuntimeError(unavailable_reason())
+    _load_numba_typing()
     cfg = _settings(params, gains, config, setpoint_m)
     nominal = _nominal(params, gains, config, Plant.from_params(params, 1))
     n = params.n_rotors
