@@ -3,35 +3,41 @@
 Run on demand: python benchmarks/bench_hover.py [--vehicles 10000] [--repeats 5] [--no-command]
 
 The machine is shared, so an absolute time says more about the other users than about
-the code. Every figure here is therefore measured next to a yardstick, repeat by repeat,
-and its target is scaled by the yardstick's rate in this run:
+the code. Every figure here is measured next to a yardstick, repeat by repeat, and its
+target is scaled by the yardstick's rate in that repeat:
 
-- the yardstick is a fixed pure-Python float loop (`yardstick`: the kind of work the
-  generated single-vehicle step does), timed right before each repeat of each measure;
-- YARDSTICK_REF_M is its rate (M iterations/s) on the machine and at the load where
-  the issue-29 targets were measured; a target printed "here" is target * (yardstick
-  now / YARDSTICK_REF_M), and "ratio" is figure / scaled target (>= 1: met).
+- the yardstick (`yardstick`) is a fixed pure-Python float loop written like the
+  generated single-vehicle step, timed in CPU seconds right before each repeat;
+- YARDSTICK_REF_M is its rate where the issue-29 targets held; "target here" is the
+  target scaled by (yardstick now / YARDSTICK_REF_M), a duration inversely, and "ratio"
+  compares the figure with it (>= 1: met), median and spread over the repeats.
+
+Figures are per CPU second (process time), which a loaded machine inflates far less than
+wall time; the batch's is per CPU second of each of numba's threads (its wall-clock rate
+is printed too).
 
 Targets (issue 29): the numpy engine's single vehicle >= 320x real time; the numba batch
 >= 47 M vehicle-steps/s; the whole `hover-test --engine numba` command on one vehicle,
-warm cache, <= 0.6 s. The command is timed as processes (CPU seconds of each child,
-which a loaded machine inflates far less than wall time), with `--engine numpy` and an
-empty `python -c pass` beside it.
+warm cache, <= 0.6 s, timed as processes (CPU seconds of each child) with
+`--engine numpy` and an empty `python -c pass` beside it.
 
-YARDSTICK_REF_M was set so that the numpy engine's single vehicle reads 332x (the middle
-of the 320-344x measured before issue 29) in the runs below: the generated step is
-byte-identical to the one measured then (sim/scalar.py's source for the benchmark's
-quad diffs empty against commit 0ae1443), so the numpy figure calibrates the yardstick
-and the other two are held to it.
+YARDSTICK_REF_M = 1.43 is the yardstick rate at which the numpy engine's single vehicle
+reads 332x (the middle of the 320-344x measured before issue 29), the median over 12
+interleaved pairs: that step is byte-identical to the one measured then (scalar.py's
+source for this quad diffs empty against commit 0ae1443), so it calibrates the yardstick
+and the numba figures are held to it.
 
-Whole-process pairs on this machine (5 runs each, A B A B, load ~5 on 2 cores; median
-of the pair ratios A/B, CPU seconds), before and after issue 29's work on sim/:
-- numpy single vehicle, 8 flights of 10 s, HEAD before this work / commit 0ae1443
-  (the 320-344x era): 1.09 (0.96-1.15): the engine had not slowed; the "162x" was load;
-- numba batch, 10,000 vehicles x 5 s, same pair: 1.06 (0.87-1.16): not slowed either;
-- `hover-test examples/reed_quad_x --engine numba` / `--engine numpy`, before: 1.92
-  (1.80-2.64), +0.93 s CPU; after (scipy.linalg no longer imported by numba's start-up):
-  see the commit message of that change and the figures printed by this script.
+Whole-process pairs (A B A B, median of the pair ratios A/B and their spread), issue 29:
+- numpy single vehicle, 8 flights of 10 s, the code before issue 29 / commit 0ae1443
+  (the 320-344x era): CPU 1.09 (0.96-1.15): the engine had not slowed, "162x" was load;
+- numba batch, 10,000 vehicles x 5 s, same pair: CPU 1.06 (0.87-1.16): not slowed;
+- `hover-test examples/reed_quad_x --engine numba`, after / before issue 29 (7 pairs):
+  wall 0.78 (0.72-1.34), 1.16 s against 1.40 s median; peak memory 271 against 289 MiB
+  (numba's start-up no longer imports scipy.linalg);
+- the same command, numba / numpy engine (5 pairs): before 1.92 (1.80-2.64, loaded);
+  after 1.94 wall (1.66-2.05) at 1.10 s against 0.55 s: numba's import (~0.3 s) and
+  cache load (~0.2 s) alone exceed 0.6 s minus the command's own 0.5 s, so one vehicle
+  flies on numpy by default (sim.choose_engine).
 """
 
 from __future__ import annotations
@@ -54,21 +60,43 @@ from reedtool.sim.run import simulate_hover
 NUMPY_SINGLE_TARGET_X = 320.0
 NUMBA_BATCH_TARGET_VS_S = 47e6
 NUMBA_COMMAND_TARGET_S = 0.6
-YARDSTICK_N = 200_000
-YARDSTICK_REF_M = 12.0      # M iterations/s per CPU second where the targets were measured (see above)
+YARDSTICK_N = 20_000
+YARDSTICK_REF_M = 1.43      # M it/s per CPU second where the targets held (see above)
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "reed_quad_x"
 
 
 def yardstick(n: int = YARDSTICK_N) -> float:
-    """M iterations/s of a fixed float loop (a damped oscillator, one sqrt a step)."""
-    sqrt = math.sqrt
+    """M iterations/s per CPU second of a fixed pure-Python float loop: a rotation from a
+    quaternion, a body-rate update and the quaternion step, written as the generated
+    single-vehicle step writes them (locals, sqrt and tan), so a loaded machine slows it
+    as it slows the engines (ratio to the numpy engine within -25%/+15% of its median over
+    12 interleaved pairs at load 3, against -40%/+60% for a four-line loop)."""
+    sqrt, tan = math.sqrt, math.tan
     start = time.process_time()
-    x, v, s = 1.0, 0.0, 0.0
+    qw, qx, qy, qz = 1.0, 0.01, 0.02, 0.0
+    wx, wy, wz = 0.3, -0.2, 0.1
     for _ in range(n):
-        a = -4.0 * x - 0.1 * v
-        v += 1e-3 * a
-        x += 1e-3 * v
-        s += sqrt(x * x + v * v)
+        x2 = qx + qx
+        y2 = qy + qy
+        z2 = qz + qz
+        xx, yy, zz = qx * x2, qy * y2, qz * z2
+        xy, xz, yz = qx * y2, qx * z2, qy * z2
+        xw, yw, zw = qw * x2, qw * y2, qw * z2
+        R00, R01, R02 = 1.0 - (yy + zz), xy - zw, xz + yw
+        R10, R11, R12 = xy + zw, 1.0 - (xx + zz), yz - xw
+        R20, R21, R22 = xz - yw, yz + xw, 1.0 - (xx + yy)
+        wx -= 1e-3 * (R01 * wy + R02 * wz)
+        wy -= 1e-3 * (R10 * wx + R12 * wz)
+        wz -= 1e-3 * (R20 * wx + R21 * wy) + 1e-4 * (R00 + R11 + R22)
+        rate = sqrt(wx * wx + wy * wy + wz * wz)
+        tan_h = tan(0.0005 * rate)
+        a = rate / tan_h if tan_h != 0.0 else 1.0
+        qw, qx, qy, qz = (qw * a - qx * wx - qy * wy - qz * wz,
+                          qx * a + qw * wx + qy * wz - qz * wy,
+                          qy * a + qw * wy + qz * wx - qx * wz,
+                          qz * a + qw * wz + qx * wy - qy * wx)
+        inv_q = 1.0 / sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+        qw, qx, qy, qz = qw * inv_q, qx * inv_q, qy * inv_q, qz * inv_q
     return n / (time.process_time() - start) / 1e6
 
 
@@ -88,27 +116,39 @@ def scaled_line(figures: list[float], sticks: list[float], target: float, unit: 
                 higher_is_better: bool = True) -> str:
     """Median figure, and the median over repeats of figure / (target scaled by that
     repeat's yardstick)."""
-    ratios = []
-    for fig, stick in zip(figures, sticks):
-        here = target * stick / YARDSTICK_REF_M
-        ratios.append(fig / here if higher_is_better else here / fig)
+    def scaled(stick: float) -> float:
+        # a rate scales with the machine's speed, a duration inversely
+        speed = stick / YARDSTICK_REF_M
+        return target * speed if higher_is_better else target / speed
+
+    ratios = [fig / scaled(stick) if higher_is_better else scaled(stick) / fig
+              for fig, stick in zip(figures, sticks)]
     m = statistics.median(figures)
-    here = target * statistics.median(sticks) / YARDSTICK_REF_M
+    here = scaled(statistics.median(sticks))
     return (f"{m:10.3g} {unit} ({min(figures):.3g}-{max(figures):.3g}); target here "
             f"{here:.3g} {unit}: ratio {statistics.median(ratios):.2f} "
             f"({min(ratios):.2f}-{max(ratios):.2f})")
 
 
 def command_cpu_s(args: list[str]) -> float:
-    """CPU seconds (user + sys) of one child process running args."""
+    """CPU seconds (user + sys) of one child process running args, which must run through
+    (hover-test exits 0 or 1 with its report). Bytecode is written and read as an
+    installed package's would be (a sandbox's PYTHONDONTWRITEBYTECODE would recompile
+    every module at each run)."""
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    subprocess.run(args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=False)
+    done = subprocess.run(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env,
+                          check=False)
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if done.returncode not in (0, 1) or (len(args) > 3 and not done.stdout):
+        raise SystemExit(f"{' '.join(args)} failed ({done.returncode}): "
+                         f"{done.stderr.decode(errors='replace')[-400:]}")
     return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
 def commands(repeats: int) -> None:
-    base = [sys.executable, "-m", "reedtool.cli", "hover-test", str(EXAMPLE)]
+    base = [sys.executable, "-c", "import sys; from reedtool.cli import main; sys.exit(main())",
+            "hover-test", str(EXAMPLE)]
     runs = {"python -c pass": [sys.executable, "-c", "pass"],
             "hover-test --engine numpy": base + ["--engine", "numpy"],
             "hover-test --engine numba": base + ["--engine", "numba"]}
