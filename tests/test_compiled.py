@@ -167,14 +167,19 @@ def test_default_engine_is_numba_for_a_batch_numpy_for_one_vehicle(monkeypatch):
 
 
 def test_desaturation_is_one_function_in_every_per_vehicle_engine():
-    """compiled's desaturation is controller.prioritised_one jitted, the generated step's
-    is the same function run by Python: bit-identical on saturating wrenches (the same
-    IEEE operations in the same order; exact by construction). The vectorised batch rule
-    agrees to rounding (matmul may sum in another order: a few ulps of ~10 N thrusts)."""
+    """compiled's desaturation and worst rotor are controller.prioritised_one and
+    most_out_of_range_one jitted, the generated step's the same functions run by Python:
+    bit-identical on saturating wrenches (the same IEEE operations in the same order;
+    exact by construction). The vectorised batch rule agrees to rounding (matmul may sum
+    in another order: a few ulps of ~10 N thrusts, 1e-12 relative is ~1e4 ulps), and
+    names the same worst rotor."""
     from reedtool.sim.controller import ControllerGains, _prioritised, prioritised_one
     from reedtool.sim.run import _prioritised as generated_step_desaturation
 
+    from reedtool.sim.controller import allocate, most_out_of_range_one
+
     assert compiled._prioritised.py_func is prioritised_one
+    assert compiled._most_out_of_range.py_func is most_out_of_range_one
     params = tilted_hex()
     gains = ControllerGains.from_params(params)
     pinv = np.ascontiguousarray(gains.allocation_pinv, dtype=float)
@@ -183,6 +188,7 @@ def test_desaturation_is_one_function_in_every_per_vehicle_engine():
     wrenches = rng.normal(size=(4, 200)) * np.array([[3 * params.weight_N], [2], [2], [1]])
     rows = [tuple(float(x) for x in row) for row in pinv]
     vectorised = _prioritised(pinv, wrenches, np.repeat(hi[:, None], 200, axis=1))
+    _, _, batch_worst = allocate(pinv, wrenches, hi)
     saturating = 0
     for j in range(200):
         f, t0, t1, t2 = (float(x) for x in wrenches[:, j])
@@ -192,6 +198,8 @@ def test_desaturation_is_one_function_in_every_per_vehicle_engine():
         compiled._prioritised(pinv, hi, f, t0, t1, t2, jitted)
         python = generated_step_desaturation(rows, [float(x) for x in hi], f, t0, t1, t2)
         assert jitted.tolist() == python
+        worst = most_out_of_range_one(tuple(float(x) for x in plain), [float(x) for x in hi])
+        assert compiled._most_out_of_range(plain, hi) == worst == batch_worst[j]
         np.testing.assert_allclose(python, vectorised[:, j], rtol=1e-12, atol=1e-12 * hi.max())
         assert np.all(jitted >= 0.0) and np.all(jitted <= hi)
     assert saturating > 150         # the wrenches exercise the desaturation, not the pinv

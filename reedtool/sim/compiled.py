@@ -29,7 +29,8 @@ import time
 import numpy as np
 
 from reedtool.sim import HoverConfig
-from reedtool.sim.controller import ControllerDesign, ControllerGains, prioritised_one
+from reedtool.sim.controller import (ControllerDesign, ControllerGains,
+                                     most_out_of_range_one, prioritised_one)
 
 try:        # the extra; everything below the guard needs it
     import numba
@@ -153,20 +154,14 @@ if numba is not None:
                 out = True
         if not out:
             return False, 0
-        worst = 0
-        worst_excess = -np.inf
-        for i in range(n):
-            hi = thrust_max[i]
-            excess = max(-T[i], T[i] - hi) / hi
-            if excess > worst_excess:
-                worst_excess = excess
-                worst = i
+        worst = _most_out_of_range(T, thrust_max)
         _prioritised(pinv, thrust_max, f, t0, t1, t2, T)
         return True, worst
 
-    # The desaturation is controller.prioritised_one itself, jitted: the generated
-    # float step (run) calls the same function unjitted.
+    # The desaturation and the worst rotor are controller's per-vehicle functions
+    # themselves, jitted: the generated float step (run) calls the same functions unjitted.
     _prioritised = njit(cache=True, error_model="numpy")(prioritised_one)
+    _most_out_of_range = njit(cache=True, error_model="numpy")(most_out_of_range_one)
 
     @njit(cache=True, error_model="numpy")
     def _body_wrench(pos, axis, tmap, cd, cr, k, shift, omega, R, v, w, Fb, Tb):
@@ -760,14 +755,9 @@ if numba is not None:
             # desaturate the (rare) vehicles with a rotor out of range
             for j in range(BLOCK):
                 if W[_OUT * BLOCK + j] > 0.0:
-                    best = -np.inf
                     for i in range(n):
-                        hi = thrust_max[i]
-                        Ti = W[(_T + i) * BLOCK + j]
-                        excess = max(-Ti, Ti - hi) / hi
-                        if excess > best:
-                            best = excess
-                            worst[j] = i
+                        Tcol[i] = W[(_T + i) * BLOCK + j]
+                    worst[j] = _most_out_of_range(Tcol, thrust_max)
                     _prioritised(pinv, thrust_max, W[(_C + 0) * BLOCK + j],
                                  W[(_C + 1) * BLOCK + j], W[(_C + 2) * BLOCK + j],
                                  W[(_C + 3) * BLOCK + j], Tcol)

@@ -449,6 +449,22 @@ def allocate(allocation_pinv: np.ndarray, wrench: np.ndarray, thrust_max_N: np.n
     return thrust, saturated, (worst if want_worst else None)
 
 
+def most_out_of_range_one(T, thrust_max) -> int:
+    """The rotor whose thrust is furthest out of its range, relative to its maximum (the
+    first on a tie): what a saturation streak reports. One source for the per-vehicle
+    engines, as `prioritised_one` (run calls it, compiled jits it); `allocation_kernel`
+    takes the same argmax over columns."""
+    worst = 0
+    best = -math.inf
+    for i in range(len(T)):
+        b, hi = T[i], thrust_max[i]
+        excess = (b - hi if b - hi > -b else -b) / hi      # max(-b, b - hi), as Python's
+        if excess > best:
+            best = excess
+            worst = i
+    return worst
+
+
 def prioritised_one(rows, thrust_max, f, t0, t1, t2, T) -> None:
     """The desaturation of `allocation_kernel` for one vehicle, into T: thrust, then
     roll/pitch, then yaw, each as much as fits.

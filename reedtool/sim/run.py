@@ -17,7 +17,8 @@ import numpy as np
 
 from reedtool.sim import ExitStatus, HoverConfig
 from reedtool.sim.batch import describe, hover_speeds
-from reedtool.sim.controller import ControllerDesign, ControllerGains, prioritised_one
+from reedtool.sim.controller import (ControllerDesign, ControllerGains,
+                                     most_out_of_range_one, prioritised_one)
 from reedtool.sim.dynamics import quat_from_rpy
 from reedtool.sim.params import VehicleParams
 from reedtool.sim.scalar import compile_vehicle
@@ -98,7 +99,7 @@ def simulate_hover(params: VehicleParams, config: HoverConfig = HoverConfig(),
 
         fly = vehicle_flyer(params, gains, config, setpoint)
     else:
-        fly = compile_vehicle(params, gains, config, setpoint, _most_out_of_range,
+        fly = compile_vehicle(params, gains, config, setpoint, most_out_of_range_one,
                               _prioritised)
 
     # ---- the disturbed start: rotors at the trim speeds, at rest
@@ -149,11 +150,6 @@ def simulate_hover(params: VehicleParams, config: HoverConfig = HoverConfig(),
 _EVENTS = {"non-finite": ExitStatus.DIVERGED, "flipped": ExitStatus.CRASHED,
            "ground": ExitStatus.CRASHED, "yaw-spin": ExitStatus.YAW_SPIN,
            "drifted": ExitStatus.DIVERGED, "rate": ExitStatus.DIVERGED}
-
-
-def _most_out_of_range(thrust: list[float], thrust_max: list[float]) -> int:
-    excess = [max(-T, T - hi) / hi for T, hi in zip(thrust, thrust_max)]
-    return excess.index(max(excess))
 
 
 def _prioritised(rows: list[tuple], thrust_max: list[float], f: float, t0: float, t1: float,
