@@ -38,6 +38,14 @@ Whole-process pairs (A B A B, median of the pair ratios A/B and their spread), i
   after 1.94 wall (1.66-2.05) at 1.10 s against 0.55 s: numba's import (~0.3 s) and
   cache load (~0.2 s) alone exceed 0.6 s minus the command's own 0.5 s, so one vehicle
   flies on numpy by default (sim.choose_engine).
+
+This script after issue 29's work on sim/ (load ~2, 5 repeats; ratio to the scaled
+target, median and spread): numpy single vehicle 171x, ratio 1.13 (0.90-1.46); numba
+batch 22.3 M vehicle-steps/s per thread's CPU second, ratio 0.80 (0.73-1.43), 15x the
+numpy batch; the numba command 1.44 s CPU, ratio 1.10 (0.85-1.24), +0.63 s over the
+numpy command's 0.78 s. The batch's shortfall is not a slowdown of its code (pairs
+above); two threads on two logical CPUs that others share scale below 2x, which the
+single-threaded yardstick does not see.
 """
 
 from __future__ import annotations
