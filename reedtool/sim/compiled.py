@@ -518,11 +518,11 @@ if numba is not None:
         """The pseudo-inverse thrusts; row _OUT > 0 where a rotor is out of range."""
         for i in range(n):
             c0, c1, c2, c3, hi = pinv[i, 0], pinv[i, 1], pinv[i, 2], pinv[i, 3], thrust_max[i]
-            row = (_T + i) * BLOCK
+            T_i = W[(_T + i) * BLOCK:(_T + i + 1) * BLOCK]     # a view (see _w_motors)
             for j in range(BLOCK):
                 Ti = (c0 * W[(_C + 0) * BLOCK + j] + c1 * W[(_C + 1) * BLOCK + j]
                       + c2 * W[(_C + 2) * BLOCK + j] + c3 * W[(_C + 3) * BLOCK + j])
-                W[row + j] = Ti
+                T_i[j] = Ti
                 W[_OUT * BLOCK + j] += 1.0 if (Ti < 0.0) | (Ti > hi) else 0.0
 
     @njit(cache=True, error_model="numpy")
@@ -550,11 +550,13 @@ if numba is not None:
             m0, m1, m2 = tmap[0, i], tmap[1, i], tmap[2, i]
             r0, r1, r2 = pos_r[i, 0], pos_r[i, 1], pos_r[i, 2]
             cdi, cri = cd[i], cr[i]
-            om_row, k_row = (_OM + i) * BLOCK, (_K + i) * BLOCK
+            # the rotor's rows as views (see _w_motors)
+            om_i = W[(_OM + i) * BLOCK:(_OM + i + 1) * BLOCK]
+            k_i = W[(_K + i) * BLOCK:(_K + i + 1) * BLOCK]
             if cdi != 0.0 or cri != 0.0:
                 for j in range(BLOCK):
-                    om = W[om_row + j]
-                    Th = W[k_row + j] * om * om
+                    om = om_i[j]
+                    Th = k_i[j] * om * om
                     w0, w1, w2 = (W[(_W + 0) * BLOCK + j], W[(_W + 1) * BLOCK + j],
                                   W[(_W + 2) * BLOCK + j])
                     u0 = W[(_XI + 0) * BLOCK + j] + (w1 * r2 - w2 * r1)
@@ -575,8 +577,8 @@ if numba is not None:
                     W[(_TQ + 2) * BLOCK + j] += m2 * Th + (r0 * d1 - r1 * d0 + rc * p2)
             else:
                 for j in range(BLOCK):
-                    om = W[om_row + j]
-                    Th = W[k_row + j] * om * om
+                    om = om_i[j]
+                    Th = k_i[j] * om * om
                     W[(_F + 0) * BLOCK + j] += a0 * Th
                     W[(_F + 1) * BLOCK + j] += a1 * Th
                     W[(_F + 2) * BLOCK + j] += a2 * Th
@@ -589,21 +591,25 @@ if numba is not None:
         for i in range(n):
             ik, fu, fd = inv_k[i], up[i], down[i]
             lu, ld, top = lead_up[i], lead_down[i], omega_max[i]
-            t_row, om_row = (_T + i) * BLOCK, (_OM + i) * BLOCK
+            # The rotor's rows as two views: their distance depends on i, which the
+            # compiler cannot prove apart in one array; two arrays take one run-time
+            # overlap check, and the loop vectorises.
+            T_i = W[(_T + i) * BLOCK:(_T + i + 1) * BLOCK]
+            om_i = W[(_OM + i) * BLOCK:(_OM + i + 1) * BLOCK]
             if lead:
                 for j in range(BLOCK):
-                    Ti = W[t_row + j]
+                    Ti = T_i[j]
                     want = math.sqrt(Ti * ik) if Ti > 0.0 else 0.0
-                    om = W[om_row + j]
+                    om = om_i[j]
                     cmd = om + (want - om) * (lu if want > om else ld)
                     cmd = top if cmd > top else (0.0 if cmd < 0.0 else cmd)
-                    W[om_row + j] = cmd + (om - cmd) * (fu if cmd > om else fd)
+                    om_i[j] = cmd + (om - cmd) * (fu if cmd > om else fd)
             else:
                 for j in range(BLOCK):
-                    Ti = W[t_row + j]
+                    Ti = T_i[j]
                     cmd = math.sqrt(Ti * ik) if Ti > 0.0 else 0.0
-                    om = W[om_row + j]
-                    W[om_row + j] = cmd + (om - cmd) * (fu if cmd > om else fd)
+                    om = om_i[j]
+                    om_i[j] = cmd + (om - cmd) * (fu if cmd > om else fd)
 
     @njit(cache=True, error_model="numpy")
     def _w_body(W, cfg, J0, J0inv):
