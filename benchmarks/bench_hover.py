@@ -39,13 +39,16 @@ Whole-process pairs (A B A B, median of the pair ratios A/B and their spread), i
   cache load (~0.2 s) alone exceed 0.6 s minus the command's own 0.5 s, so one vehicle
   flies on numpy by default (sim.choose_engine).
 
-This script after issue 29's work on sim/ (load ~2, 5 repeats; ratio to the scaled
-target, median and spread): numpy single vehicle 171x, ratio 1.13 (0.90-1.46); numba
-batch 22.3 M vehicle-steps/s per thread's CPU second, ratio 0.80 (0.73-1.43), 15x the
-numpy batch; the numba command 1.44 s CPU, ratio 1.10 (0.85-1.24), +0.63 s over the
-numpy command's 0.78 s. The batch's shortfall is not a slowdown of its code (pairs
-above); two threads on two logical CPUs that others share scale below 2x, which the
-single-threaded yardstick does not see.
+- numba batch, 10,000 vehicles x 5 s, after / before issue 29 (5 pairs): CPU 0.53
+  (0.49-0.65), wall 0.51 (0.48-0.66): the block kernel's per-rotor loops now vectorise
+  (compiled._w_motors); the report of 2,000 perturbed vehicles is byte-identical.
+
+This script after issue 29's work on sim/ (load ~2.6, 5 repeats; ratio to the scaled
+target, median and spread): numpy single vehicle 142x, ratio 1.02 (0.62-1.54); numba
+batch 34.9 M vehicle-steps/s per thread's CPU second (30.6 M on the wall clock at that
+load), ratio 1.66 (1.44-3.82), 40x the numpy batch; the numba command 1.44 s CPU, ratio
+1.12 (0.84-1.86), +0.70 s over the numpy command's 0.75 s (before: ratio 0.80 for the
+batch, 1.10 for the command, in a run at load ~2).
 """
 
 from __future__ import annotations
