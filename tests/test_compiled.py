@@ -226,3 +226,20 @@ def test_numba_loads_without_importing_scipy_linalg():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True).stdout.split()
     assert out == ["False", "True", "5.0"]
+
+
+def test_kernel_cache_is_stamped_with_the_shared_functions_sources():
+    """numba keys a cached kernel to its own file; the kernels inline functions of
+    controller.py and motor.py, so their cache stamp carries those files' digests too
+    (an edit there recompiles them instead of flying old code)."""
+    import hashlib
+    import inspect
+
+    from reedtool.sim import controller, motor
+
+    stamp = compiled._fly_block._cache._impl.locator.get_source_stamp()
+    digests = sorted(hashlib.sha256(open(inspect.getfile(m), "rb").read()).digest()
+                     for m in (controller, motor))
+    assert sorted(stamp[1:]) == digests
+    # numba's own locators still serve functions of other files
+    assert not type(compiled._prioritised._cache._impl.locator).__name__.startswith("Shared")

@@ -21,8 +21,11 @@ vehicle, `_w_motors` for a block); a per-rotor "alive" mask or failure time belo
 
 from __future__ import annotations
 
+import hashlib
 import importlib.util
+import inspect
 import math
+import os
 import sys
 import time
 
@@ -31,6 +34,7 @@ import numpy as np
 from reedtool.sim import HoverConfig
 from reedtool.sim.controller import (ControllerDesign, ControllerGains,
                                      most_out_of_range_one, prioritised_one)
+from reedtool.sim.motor import next_speed_one
 
 try:        # the extra; everything below the guard needs it
     import numba
@@ -76,7 +80,51 @@ _NROWS = _K + MAX_BLOCK_ROTORS
 REC_FIXED = 11          # t, x, y, z, R00, R10, R20, R21, R22, pos, cos_att; then omega
 
 
+def _cache_with_shared_sources() -> None:
+    """Stamp this module's numba cache with the sources of the functions it jits from
+    other modules too.
+
+    numba keys a cached kernel to its own file only (its documented limit: a change in a
+    function called from another file is not seen), and the kernels here inline
+    controller.prioritised_one, controller.most_out_of_range_one and
+    motor.next_speed_one, the one source of those steps. So the locators that serve this
+    file also hash those files: an edit there recompiles the kernels, never flies old
+    code. Other files' functions go to numba's own locators unchanged.
+    """
+    from numba.core import caching
+
+    here = os.path.abspath(__file__)
+    shared = sorted({os.path.abspath(inspect.getfile(f))
+                     for f in (prioritised_one, most_out_of_range_one, next_speed_one)})
+
+    def stamped(base):
+        class Locator(base):
+            @classmethod
+            def from_function(cls, py_func, py_file):
+                if os.path.abspath(py_file) != here:
+                    return None
+                return super().from_function(py_func, py_file)
+
+            def get_source_stamp(self):
+                digests = []
+                for path in shared:
+                    with open(path, "rb") as f:
+                        digests.append(hashlib.sha256(f.read()).digest())
+                return (super().get_source_stamp(), *digests)
+
+        Locator.__name__ = Locator.__qualname__ = f"Shared{base.__name__}"
+        return Locator
+
+    bases = [getattr(caching, name, None) or getattr(caching, "_" + name, None)
+             for name in ("UserProvidedCacheLocator", "InTreeCacheLocator",
+                          "UserWideCacheLocator")]
+    impl = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl", None)
+    if impl is not None and all(bases):  # else numba's own: edits elsewhere need a touch here
+        impl._locator_classes[:0] = [stamped(b) for b in bases]
+
+
 if numba is not None:
+    _cache_with_shared_sources()
 
     @njit(cache=True, error_model="numpy")
     def _rotation(q, R):
@@ -253,18 +301,16 @@ if numba is not None:
         q[2] = ny * inv_q
         q[3] = nz * inv_q
 
+    # One rotor's motor step is motor.next_speed_one itself, jitted and inlined.
+    _next_speed = njit(cache=True, error_model="numpy", inline="always")(next_speed_one)
+
     @njit(cache=True, error_model="numpy")
     def _advance_motors(T, inv_k, up, down, omega, lead, lead_up, lead_down, omega_max):
-        """motor.speed_command (the allocation keeps T in range), the controller's lead
-        on it when `lead` (ControllerGains.motor_lead_factors), and the first-order lag.
-        The one place a per-rotor failure (alive mask) would zero the command and speed."""
+        """motor.next_speed_one for every rotor. The one place a per-rotor failure (alive
+        mask) would zero the command and speed."""
         for i in range(omega.shape[0]):
-            cmd = math.sqrt(T[i] * inv_k[i]) if T[i] > 0.0 else 0.0
-            if lead:
-                om = omega[i]
-                cmd = om + (cmd - om) * (lead_up[i] if cmd > om else lead_down[i])
-                cmd = omega_max[i] if cmd > omega_max[i] else (0.0 if cmd < 0.0 else cmd)
-            omega[i] = cmd + (omega[i] - cmd) * (up[i] if cmd > omega[i] else down[i])
+            omega[i] = _next_speed(T[i], inv_k[i], omega[i], up[i], down[i], lead,
+                                   lead_up[i], lead_down[i], omega_max[i])
 
     @njit(cache=True, error_model="numpy")
     def _fly(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final, rec, pos_rec):
@@ -596,20 +642,12 @@ if numba is not None:
             # overlap check, and the loop vectorises.
             T_i = W[(_T + i) * BLOCK:(_T + i + 1) * BLOCK]
             om_i = W[(_OM + i) * BLOCK:(_OM + i + 1) * BLOCK]
-            if lead:
+            if lead:            # two loops: each inlines a branch-free step
                 for j in range(BLOCK):
-                    Ti = T_i[j]
-                    want = math.sqrt(Ti * ik) if Ti > 0.0 else 0.0
-                    om = om_i[j]
-                    cmd = om + (want - om) * (lu if want > om else ld)
-                    cmd = top if cmd > top else (0.0 if cmd < 0.0 else cmd)
-                    om_i[j] = cmd + (om - cmd) * (fu if cmd > om else fd)
+                    om_i[j] = _next_speed(T_i[j], ik, om_i[j], fu, fd, True, lu, ld, top)
             else:
                 for j in range(BLOCK):
-                    Ti = T_i[j]
-                    cmd = math.sqrt(Ti * ik) if Ti > 0.0 else 0.0
-                    om = om_i[j]
-                    om_i[j] = cmd + (om - cmd) * (fu if cmd > om else fd)
+                    om_i[j] = _next_speed(T_i[j], ik, om_i[j], fu, fd, False, lu, ld, top)
 
     @njit(cache=True, error_model="numpy")
     def _w_body(W, cfg, J0, J0inv):
