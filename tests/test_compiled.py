@@ -145,3 +145,101 @@ def test_hover_test_says_which_engine_ran():
         assert report["sim"]["engine"] == engine and report["batch"]["engine"] == engine
     code, out = run_cli("hover-test", SEED_MODEL, *ARGV, "--duration", "3", "--engine", "numba")
     assert "engine numba" in out
+
+
+def test_default_engine_is_numba_for_a_batch_numpy_for_one_vehicle(monkeypatch):
+    from cli_helpers import run_cli
+    from test_hover_test_cli import ARGV, SEED_MODEL
+
+    from reedtool.sim import choose_engine
+
+    _, out = run_cli("hover-test", SEED_MODEL, *ARGV, "--duration", "3", "--format", "json",
+                     "--samples", "4")
+    report = json.loads(out)
+    assert report["sim"]["engine"] == "numba" and report["batch"]["engine"] == "numba"
+    _, out = run_cli("hover-test", SEED_MODEL, *ARGV, "--duration", "3", "--format", "json")
+    assert json.loads(out)["sim"]["engine"] == "numpy"
+    # an explicit choice is kept; without numba a batch falls back to the reference
+    assert choose_engine("numpy", batch=True) == "numpy"
+    assert choose_engine("numba", batch=False) == "numba"
+    monkeypatch.setattr(compiled, "available", lambda: False)
+    assert choose_engine("auto", batch=True) == "numpy"
+
+
+def test_desaturation_is_one_function_in_every_per_vehicle_engine():
+    """compiled's desaturation and worst rotor are controller.prioritised_one and
+    most_out_of_range_one jitted, the generated step's the same functions run by Python:
+    bit-identical on saturating wrenches (the same IEEE operations in the same order;
+    exact by construction). The vectorised batch rule agrees to rounding (matmul may sum
+    in another order: a few ulps of ~10 N thrusts, 1e-12 relative is ~1e4 ulps), and
+    names the same worst rotor."""
+    from reedtool.sim.controller import ControllerGains, _prioritised, prioritised_one
+    from reedtool.sim.run import _prioritised as generated_step_desaturation
+
+    from reedtool.sim.controller import allocate, most_out_of_range_one
+
+    assert compiled._prioritised.py_func is prioritised_one
+    assert compiled._most_out_of_range.py_func is most_out_of_range_one
+    params = tilted_hex()
+    gains = ControllerGains.from_params(params)
+    pinv = np.ascontiguousarray(gains.allocation_pinv, dtype=float)
+    hi = gains.motor_constant * gains.omega_max_rad_s ** 2
+    rng = np.random.default_rng(3)
+    wrenches = rng.normal(size=(4, 200)) * np.array([[3 * params.weight_N], [2], [2], [1]])
+    rows = [tuple(float(x) for x in row) for row in pinv]
+    vectorised = _prioritised(pinv, wrenches, np.repeat(hi[:, None], 200, axis=1))
+    _, _, batch_worst = allocate(pinv, wrenches, hi)
+    saturating = 0
+    for j in range(200):
+        f, t0, t1, t2 = (float(x) for x in wrenches[:, j])
+        plain = pinv @ wrenches[:, j]
+        saturating += bool(np.any(plain < 0.0) or np.any(plain > hi))
+        jitted = np.empty(len(hi))
+        compiled._prioritised(pinv, hi, f, t0, t1, t2, jitted)
+        python = generated_step_desaturation(rows, [float(x) for x in hi], f, t0, t1, t2)
+        assert jitted.tolist() == python
+        worst = most_out_of_range_one(tuple(float(x) for x in plain), [float(x) for x in hi])
+        assert compiled._most_out_of_range(plain, hi) == worst == batch_worst[j]
+        np.testing.assert_allclose(python, vectorised[:, j], rtol=1e-12, atol=1e-12 * hi.max())
+        assert np.all(jitted >= 0.0) and np.all(jitted <= hi)
+    assert saturating > 150         # the wrenches exercise the desaturation, not the pinv
+
+
+def test_numba_loads_without_importing_scipy_linalg():
+    """The compiled engine's start-up leaves scipy.linalg unimported (numba's BLAS probe
+    would import it: ~0.3 s of a single-vehicle run) and numba's answer as it was."""
+    import subprocess
+    import sys
+
+    code = ("import sys, importlib.util\n"
+            "from reedtool.sim import HoverConfig\n"
+            "from reedtool.sim.params import symmetric_multirotor\n"
+            "from reedtool.sim.run import simulate_hover\n"
+            "run = simulate_hover(symmetric_multirotor(4), HoverConfig(duration_s=0.02, "
+            "hold_s=0.01), engine='numba')\n"
+            "assert run.engine == 'numba'\n"
+            "print('scipy.linalg' in sys.modules)\n"
+            "import numba.np.arraymath as a\n"
+            "print(a._HAVE_BLAS == (importlib.util.find_spec('scipy.linalg') is not None))\n"
+            "import numba, numpy as np\n"
+            "print(numba.njit(lambda x: np.dot(x, x))(np.arange(3.0)))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout.split()
+    assert out == ["False", "True", "5.0"]
+
+
+def test_kernel_cache_is_stamped_with_the_shared_functions_sources():
+    """numba keys a cached kernel to its own file; the kernels inline functions of
+    controller.py and motor.py, so their cache stamp carries those files' digests too
+    (an edit there recompiles them instead of flying old code)."""
+    import hashlib
+    import inspect
+
+    from reedtool.sim import controller, motor
+
+    stamp = compiled._fly_block._cache._impl.locator.get_source_stamp()
+    digests = sorted(hashlib.sha256(open(inspect.getfile(m), "rb").read()).digest()
+                     for m in (controller, motor))
+    assert sorted(stamp[1:]) == digests
+    # numba's own locators still serve functions of other files
+    assert not type(compiled._prioritised._cache._impl.locator).__name__.startswith("Shared")

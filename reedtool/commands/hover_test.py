@@ -82,10 +82,11 @@ PROGRESS_AFTER_S = 2.0
               show_default=True, help=f"{SPREAD_HELP} of each principal moment (fraction).")
 @click.option("--motor-spread", type=FiniteFloatRange(0.0, 0.9), default=0.05,
               show_default=True, help=f"{SPREAD_HELP} of each motor constant (fraction).")
-@click.option("--engine", type=click.Choice(["numpy", "numba"]), default="numpy",
+@click.option("--engine", type=click.Choice(["auto", "numpy", "numba"]), default="auto",
               show_default=True,
               help="Simulator engine: numpy (the reference) or numba (compiled, all cores; "
-                   "needs numba: pip install numba).")
+                   "needs numba: pip install numba); auto: numba for a --samples batch "
+                   "when it is installed, numpy for one vehicle (faster as a whole).")
 @click.option("--min-pass-rate", type=FiniteFloatRange(0.0, 1.0), default=0.95,
               show_default=True, help="Batch pass rate needed to exit 0.")
 @click.option("--require", "require", default="flies", show_default=True,
@@ -171,12 +172,15 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
                                     "controller flies one vehicle on the numpy engine",
                                     hint=f"drop {option}, or drop --controller to fly "
                                          "reedtool's own controller")
+    from reedtool.sim import choose_engine
+
+    engine = choose_engine(engine, batch=samples is not None and not controller_files)
     if engine == "numba":
         from reedtool.sim.compiled import available, unavailable_reason
 
         if not available():
             raise ReedtoolError(f"bad option: --engine numba: {unavailable_reason()}",
-                                hint="or use --engine numpy (the default)")
+                                hint="or use --engine numpy")
     from reedtool.io.fileio import check_writable, note_input
 
     note_model_files(inputs)          # the model is never an output of its own run

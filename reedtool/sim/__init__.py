@@ -92,3 +92,25 @@ class HoverConfig:
         values = (*self.offset_m, self.roll_rad, self.pitch_rad, self.yaw_rad)
         if not all(math.isfinite(v) for v in values):
             raise ValueError("the disturbance must be finite numbers")
+
+
+ENGINES = ("auto", "numpy", "numba")
+
+
+def choose_engine(requested: str, batch: bool) -> str:
+    """The engine that flies a run: `requested` unless "auto".
+
+    "auto" is numba for a run with a batch, when numba imports, and numpy otherwise.
+    Measured as whole `hover-test` processes (benchmarks/bench_hover.py, docs/hover-test.md):
+    one vehicle flies 10 s in ~30 ms on numpy, less than numba's own start-up (importing
+    numba and loading its cached kernels, ~0.5 s), so numpy finishes first; a batch, even of
+    2 vehicles, is ~2x faster as a whole on numba, the numpy batch paying its per-step
+    array overhead ~10,000 times.
+    """
+    if requested != "auto":
+        return requested
+    if not batch:
+        return "numpy"
+    from reedtool.sim.compiled import available
+
+    return "numba" if available() else "numpy"

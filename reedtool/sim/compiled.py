@@ -21,13 +21,20 @@ vehicle, `_w_motors` for a block); a per-rotor "alive" mask or failure time belo
 
 from __future__ import annotations
 
+import hashlib
+import importlib.util
+import inspect
 import math
+import os
+import sys
 import time
 
 import numpy as np
 
 from reedtool.sim import HoverConfig
-from reedtool.sim.controller import ControllerDesign, ControllerGains
+from reedtool.sim.controller import (ControllerDesign, ControllerGains,
+                                     most_out_of_range_one, prioritised_one)
+from reedtool.sim.motor import next_speed_one
 
 try:        # the extra; everything below the guard needs it
     import numba
@@ -73,7 +80,51 @@ _NROWS = _K + MAX_BLOCK_ROTORS
 REC_FIXED = 11          # t, x, y, z, R00, R10, R20, R21, R22, pos, cos_att; then omega
 
 
+def _cache_with_shared_sources() -> None:
+    """Stamp this module's numba cache with the sources of the functions it jits from
+    other modules too.
+
+    numba keys a cached kernel to its own file only (its documented limit: a change in a
+    function called from another file is not seen), and the kernels here inline
+    controller.prioritised_one, controller.most_out_of_range_one and
+    motor.next_speed_one, the one source of those steps. So the locators that serve this
+    file also hash those files: an edit there recompiles the kernels, never flies old
+    code. Other files' functions go to numba's own locators unchanged.
+    """
+    from numba.core import caching
+
+    here = os.path.abspath(__file__)
+    shared = sorted({os.path.abspath(inspect.getfile(f))
+                     for f in (prioritised_one, most_out_of_range_one, next_speed_one)})
+
+    def stamped(base):
+        class Locator(base):
+            @classmethod
+            def from_function(cls, py_func, py_file):
+                if os.path.abspath(py_file) != here:
+                    return None
+                return super().from_function(py_func, py_file)
+
+            def get_source_stamp(self):
+                digests = []
+                for path in shared:
+                    with open(path, "rb") as f:
+                        digests.append(hashlib.sha256(f.read()).digest())
+                return (super().get_source_stamp(), *digests)
+
+        Locator.__name__ = Locator.__qualname__ = f"Shared{base.__name__}"
+        return Locator
+
+    bases = [getattr(caching, name, None) or getattr(caching, "_" + name, None)
+             for name in ("UserProvidedCacheLocator", "InTreeCacheLocator",
+                          "UserWideCacheLocator")]
+    impl = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl", None)
+    if impl is not None and all(bases):  # else numba's own: edits elsewhere need a touch here
+        impl._locator_classes[:0] = [stamped(b) for b in bases]
+
+
 if numba is not None:
+    _cache_with_shared_sources()
 
     @njit(cache=True, error_model="numpy")
     def _rotation(q, R):
@@ -151,51 +202,14 @@ if numba is not None:
                 out = True
         if not out:
             return False, 0
-        worst = 0
-        worst_excess = -np.inf
-        for i in range(n):
-            hi = thrust_max[i]
-            excess = max(-T[i], T[i] - hi) / hi
-            if excess > worst_excess:
-                worst_excess = excess
-                worst = i
+        worst = _most_out_of_range(T, thrust_max)
         _prioritised(pinv, thrust_max, f, t0, t1, t2, T)
         return True, worst
 
-    @njit(cache=True, error_model="numpy")
-    def _prioritised(pinv, thrust_max, f, t0, t1, t2, T):
-        """controller._prioritised for one vehicle: thrust, then roll/pitch, then yaw."""
-        n = T.shape[0]
-        fit = 1.0
-        any_over = False
-        for i in range(n):
-            T[i] = pinv[i, 0] * f
-            if T[i] > thrust_max[i]:
-                ratio = thrust_max[i] / T[i]
-                if not any_over or ratio < fit:
-                    fit = ratio
-                any_over = True
-        for i in range(n):
-            b = T[i] * fit if any_over else T[i]
-            T[i] = min(max(b, 0.0), thrust_max[i])
-        for stage in range(2):
-            scale = np.inf
-            for i in range(n):
-                d = pinv[i, 1] * t0 + pinv[i, 2] * t1 if stage == 0 else pinv[i, 3] * t2
-                if d > 0.0:
-                    room = (thrust_max[i] - T[i]) / d
-                    if room < scale:
-                        scale = room
-                elif d < 0.0:
-                    room = -T[i] / d
-                    if room < scale:
-                        scale = room
-            scale = min(max(scale, 0.0), 1.0)
-            for i in range(n):
-                d = pinv[i, 1] * t0 + pinv[i, 2] * t1 if stage == 0 else pinv[i, 3] * t2
-                T[i] = T[i] + scale * d
-        for i in range(n):
-            T[i] = min(max(T[i], 0.0), thrust_max[i])
+    # The desaturation and the worst rotor are controller's per-vehicle functions
+    # themselves, jitted: the generated float step (run) calls the same functions unjitted.
+    _prioritised = njit(cache=True, error_model="numpy")(prioritised_one)
+    _most_out_of_range = njit(cache=True, error_model="numpy")(most_out_of_range_one)
 
     @njit(cache=True, error_model="numpy")
     def _body_wrench(pos, axis, tmap, cd, cr, k, shift, omega, R, v, w, Fb, Tb):
@@ -287,18 +301,16 @@ if numba is not None:
         q[2] = ny * inv_q
         q[3] = nz * inv_q
 
+    # One rotor's motor step is motor.next_speed_one itself, jitted and inlined.
+    _next_speed = njit(cache=True, error_model="numpy", inline="always")(next_speed_one)
+
     @njit(cache=True, error_model="numpy")
     def _advance_motors(T, inv_k, up, down, omega, lead, lead_up, lead_down, omega_max):
-        """motor.speed_command (the allocation keeps T in range), the controller's lead
-        on it when `lead` (ControllerGains.motor_lead_factors), and the first-order lag.
-        The one place a per-rotor failure (alive mask) would zero the command and speed."""
+        """motor.next_speed_one for every rotor. The one place a per-rotor failure (alive
+        mask) would zero the command and speed."""
         for i in range(omega.shape[0]):
-            cmd = math.sqrt(T[i] * inv_k[i]) if T[i] > 0.0 else 0.0
-            if lead:
-                om = omega[i]
-                cmd = om + (cmd - om) * (lead_up[i] if cmd > om else lead_down[i])
-                cmd = omega_max[i] if cmd > omega_max[i] else (0.0 if cmd < 0.0 else cmd)
-            omega[i] = cmd + (omega[i] - cmd) * (up[i] if cmd > omega[i] else down[i])
+            omega[i] = _next_speed(T[i], inv_k[i], omega[i], up[i], down[i], lead,
+                                   lead_up[i], lead_down[i], omega_max[i])
 
     @njit(cache=True, error_model="numpy")
     def _fly(cfg, nominal, mass, S, shift, k, state0, out_f, out_i, final, rec, pos_rec):
@@ -552,11 +564,11 @@ if numba is not None:
         """The pseudo-inverse thrusts; row _OUT > 0 where a rotor is out of range."""
         for i in range(n):
             c0, c1, c2, c3, hi = pinv[i, 0], pinv[i, 1], pinv[i, 2], pinv[i, 3], thrust_max[i]
-            row = (_T + i) * BLOCK
+            T_i = W[(_T + i) * BLOCK:(_T + i + 1) * BLOCK]     # a view (see _w_motors)
             for j in range(BLOCK):
                 Ti = (c0 * W[(_C + 0) * BLOCK + j] + c1 * W[(_C + 1) * BLOCK + j]
                       + c2 * W[(_C + 2) * BLOCK + j] + c3 * W[(_C + 3) * BLOCK + j])
-                W[row + j] = Ti
+                T_i[j] = Ti
                 W[_OUT * BLOCK + j] += 1.0 if (Ti < 0.0) | (Ti > hi) else 0.0
 
     @njit(cache=True, error_model="numpy")
@@ -584,11 +596,13 @@ if numba is not None:
             m0, m1, m2 = tmap[0, i], tmap[1, i], tmap[2, i]
             r0, r1, r2 = pos_r[i, 0], pos_r[i, 1], pos_r[i, 2]
             cdi, cri = cd[i], cr[i]
-            om_row, k_row = (_OM + i) * BLOCK, (_K + i) * BLOCK
+            # the rotor's rows as views (see _w_motors)
+            om_i = W[(_OM + i) * BLOCK:(_OM + i + 1) * BLOCK]
+            k_i = W[(_K + i) * BLOCK:(_K + i + 1) * BLOCK]
             if cdi != 0.0 or cri != 0.0:
                 for j in range(BLOCK):
-                    om = W[om_row + j]
-                    Th = W[k_row + j] * om * om
+                    om = om_i[j]
+                    Th = k_i[j] * om * om
                     w0, w1, w2 = (W[(_W + 0) * BLOCK + j], W[(_W + 1) * BLOCK + j],
                                   W[(_W + 2) * BLOCK + j])
                     u0 = W[(_XI + 0) * BLOCK + j] + (w1 * r2 - w2 * r1)
@@ -609,8 +623,8 @@ if numba is not None:
                     W[(_TQ + 2) * BLOCK + j] += m2 * Th + (r0 * d1 - r1 * d0 + rc * p2)
             else:
                 for j in range(BLOCK):
-                    om = W[om_row + j]
-                    Th = W[k_row + j] * om * om
+                    om = om_i[j]
+                    Th = k_i[j] * om * om
                     W[(_F + 0) * BLOCK + j] += a0 * Th
                     W[(_F + 1) * BLOCK + j] += a1 * Th
                     W[(_F + 2) * BLOCK + j] += a2 * Th
@@ -623,21 +637,17 @@ if numba is not None:
         for i in range(n):
             ik, fu, fd = inv_k[i], up[i], down[i]
             lu, ld, top = lead_up[i], lead_down[i], omega_max[i]
-            t_row, om_row = (_T + i) * BLOCK, (_OM + i) * BLOCK
-            if lead:
+            # The rotor's rows as two views: their distance depends on i, which the
+            # compiler cannot prove apart in one array; two arrays take one run-time
+            # overlap check, and the loop vectorises.
+            T_i = W[(_T + i) * BLOCK:(_T + i + 1) * BLOCK]
+            om_i = W[(_OM + i) * BLOCK:(_OM + i + 1) * BLOCK]
+            if lead:            # two loops: each inlines a branch-free step
                 for j in range(BLOCK):
-                    Ti = W[t_row + j]
-                    want = math.sqrt(Ti * ik) if Ti > 0.0 else 0.0
-                    om = W[om_row + j]
-                    cmd = om + (want - om) * (lu if want > om else ld)
-                    cmd = top if cmd > top else (0.0 if cmd < 0.0 else cmd)
-                    W[om_row + j] = cmd + (om - cmd) * (fu if cmd > om else fd)
+                    om_i[j] = _next_speed(T_i[j], ik, om_i[j], fu, fd, True, lu, ld, top)
             else:
                 for j in range(BLOCK):
-                    Ti = W[t_row + j]
-                    cmd = math.sqrt(Ti * ik) if Ti > 0.0 else 0.0
-                    om = W[om_row + j]
-                    W[om_row + j] = cmd + (om - cmd) * (fu if cmd > om else fd)
+                    om_i[j] = _next_speed(T_i[j], ik, om_i[j], fu, fd, False, lu, ld, top)
 
     @njit(cache=True, error_model="numpy")
     def _w_body(W, cfg, J0, J0inv):
@@ -789,14 +799,9 @@ if numba is not None:
             # desaturate the (rare) vehicles with a rotor out of range
             for j in range(BLOCK):
                 if W[_OUT * BLOCK + j] > 0.0:
-                    best = -np.inf
                     for i in range(n):
-                        hi = thrust_max[i]
-                        Ti = W[(_T + i) * BLOCK + j]
-                        excess = max(-Ti, Ti - hi) / hi
-                        if excess > best:
-                            best = excess
-                            worst[j] = i
+                        Tcol[i] = W[(_T + i) * BLOCK + j]
+                    worst[j] = _most_out_of_range(Tcol, thrust_max)
                     _prioritised(pinv, thrust_max, W[(_C + 0) * BLOCK + j],
                                  W[(_C + 1) * BLOCK + j], W[(_C + 2) * BLOCK + j],
                                  W[(_C + 3) * BLOCK + j], Tcol)
@@ -956,6 +961,28 @@ if numba is not None:
 
 # ------------------------------------------------------------------ Python side
 
+def _load_numba_typing() -> None:
+    """Import numba's typing of numpy without importing scipy.
+
+    numba's first compile or cache load in a process imports numba.np.arraymath, whose
+    module-level BLAS probe imports scipy.linalg (numba itself imports only scipy's top): about a third of the CPU time of a
+    cached single-vehicle run (cProfile; the kernels call no BLAS). scipy is hidden for
+    that import only; the probe's answer (read by numba's np.convolve and np.correlate
+    alone; np.dot probes again when compiled) is then set to what it would have been, so
+    nothing else in the process sees a difference.
+    """
+    if "numba.np.arraymath" in sys.modules or "scipy.linalg" in sys.modules:
+        return
+    sys.modules["scipy.linalg"] = None   # import scipy.linalg -> ImportError, here only
+    try:
+        import numba.np.arraymath as arraymath
+    finally:
+        if sys.modules.get("scipy.linalg", 0) is None:
+            del sys.modules["scipy.linalg"]
+    arraymath._HAVE_BLAS = importlib.util.find_spec("scipy.linalg") is not None
+
+
+
 def _settings(params, gains: ControllerGains, config: HoverConfig, setpoint) -> np.ndarray:
     values = {
         "dt": config.dt_s, "g": params.g_m_s2, "m_ctl": gains.mass_kg, "kp": gains.kp_1_s2,
@@ -1055,6 +1082,7 @@ def fly_batch(params, config: HoverConfig, plant,
     final = np.zeros((N, 13 + n))
     rows = config.n_steps // config.sample_every + (config.n_steps % config.sample_every != 0) + 1
     pos_rec = np.full((N, rows if record else 0), np.nan)
+    _load_numba_typing()
     if N == 1:
         _fly_one(cfg, nominal, mass[0], S[:, 0].copy(), shift[:, 0].copy(),
                  k[:, 0].copy(), state0, out_f[0], out_i[0], final[0], np.empty((0, 0)),
@@ -1079,6 +1107,7 @@ def vehicle_flyer(params, gains: ControllerGains, config: HoverConfig, setpoint_
 
     if numba is None:
         raise RuntimeError(unavailable_reason())
+    _load_numba_typing()
     cfg = _settings(params, gains, config, setpoint_m)
     nominal = _nominal(params, gains, config, Plant.from_params(params, 1))
     n = params.n_rotors

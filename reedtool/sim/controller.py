@@ -449,6 +449,69 @@ def allocate(allocation_pinv: np.ndarray, wrench: np.ndarray, thrust_max_N: np.n
     return thrust, saturated, (worst if want_worst else None)
 
 
+def most_out_of_range_one(T, thrust_max) -> int:
+    """The rotor whose thrust is furthest out of its range, relative to its maximum (the
+    first on a tie): what a saturation streak reports. One source for the per-vehicle
+    engines, as `prioritised_one` (run calls it, compiled jits it); `allocation_kernel`
+    takes the same argmax over columns."""
+    worst = 0
+    best = -math.inf
+    for i in range(len(T)):
+        b, hi = T[i], thrust_max[i]
+        excess = (b - hi if b - hi > -b else -b) / hi      # max(-b, b - hi), as Python's
+        if excess > best:
+            best = excess
+            worst = i
+    return worst
+
+
+def prioritised_one(rows, thrust_max, f, t0, t1, t2, T) -> None:
+    """The desaturation of `allocation_kernel` for one vehicle, into T: thrust, then
+    roll/pitch, then yaw, each as much as fits.
+
+    The single source of the per-vehicle engines: run (the generated float step) calls it
+    as it is, on tuples and a list; compiled jits this very function (numba) for its
+    kernels, on arrays. So it is written in the subset both run: index loops, `rows[i][k]`
+    (row i of the pseudo-inverse), comparisons instead of min/max (the same NaN
+    behaviour in both). The vectorised `_prioritised` below is the same rule over the
+    columns of a batch; tests/test_sim.py and test_compiled.py hold them together.
+    """
+    n = len(T)
+    fit = 1.0
+    any_over = False
+    for i in range(n):
+        b = rows[i][0] * f
+        T[i] = b
+        if b > thrust_max[i]:
+            ratio = thrust_max[i] / b
+            if not any_over or ratio < fit:
+                fit = ratio
+            any_over = True
+    for i in range(n):
+        b = T[i] * fit if any_over else T[i]
+        hi = thrust_max[i]
+        T[i] = hi if b > hi else (0.0 if b < 0.0 else b)
+    for stage in range(2):
+        scale = math.inf
+        for i in range(n):
+            d = rows[i][1] * t0 + rows[i][2] * t1 if stage == 0 else rows[i][3] * t2
+            if d > 0.0:
+                room = (thrust_max[i] - T[i]) / d
+                if room < scale:
+                    scale = room
+            elif d < 0.0:
+                room = -T[i] / d
+                if room < scale:
+                    scale = room
+        scale = 0.0 if scale < 0.0 else (1.0 if scale > 1.0 else scale)
+        for i in range(n):
+            d = rows[i][1] * t0 + rows[i][2] * t1 if stage == 0 else rows[i][3] * t2
+            T[i] = T[i] + scale * d
+    for i in range(n):
+        b, hi = T[i], thrust_max[i]
+        T[i] = hi if b > hi else (0.0 if b < 0.0 else b)
+
+
 def _prioritised(allocation_pinv: np.ndarray, wrench: np.ndarray, hi: np.ndarray) -> np.ndarray:
     base = allocation_pinv[:, 0:1] * wrench[0]
     over = base > hi

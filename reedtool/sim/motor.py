@@ -14,6 +14,8 @@ Per rotor i spinning at omega_i (physical speed, rad/s, >= 0):
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 
@@ -23,6 +25,23 @@ def speed_filter_factors(dt_s: float, time_constant_up_s: np.ndarray,
     up = np.exp(-dt_s / np.asarray(time_constant_up_s, dtype=float))
     down = np.exp(-dt_s / np.asarray(time_constant_down_s, dtype=float))
     return up, down
+
+
+def next_speed_one(thrust_N, inv_k, omega, up, down, lead, lead_up, lead_down, omega_max):
+    """One rotor's speed after a step: the speed command for `thrust_N` (the allocation
+    keeps it within [0, k omega_max^2]), the controller's lead on it when `lead`
+    (ControllerGains.motor_lead_factors, clamped to [0, omega_max]), then the lag.
+
+    The single source of the compiled engine's motor step, one vehicle and a block alike
+    (compiled jits this function and inlines it); written in the subset numba compiles,
+    comparisons instead of min/max. The generated float step and the numpy batch write the
+    same operations in their own form, held to it by the engine agreement tests.
+    """
+    cmd = math.sqrt(thrust_N * inv_k) if thrust_N > 0.0 else 0.0
+    if lead:
+        cmd = omega + (cmd - omega) * (lead_up if cmd > omega else lead_down)
+        cmd = omega_max if cmd > omega_max else (0.0 if cmd < 0.0 else cmd)
+    return cmd + (omega - cmd) * (up if cmd > omega else down)
 
 
 def speed_command(thrust_cmd_N: np.ndarray, motor_constant: np.ndarray,

@@ -17,7 +17,8 @@ import numpy as np
 
 from reedtool.sim import ExitStatus, HoverConfig
 from reedtool.sim.batch import describe, hover_speeds
-from reedtool.sim.controller import ControllerDesign, ControllerGains
+from reedtool.sim.controller import (ControllerDesign, ControllerGains,
+                                     most_out_of_range_one, prioritised_one)
 from reedtool.sim.dynamics import quat_from_rpy
 from reedtool.sim.params import VehicleParams
 from reedtool.sim.scalar import compile_vehicle
@@ -98,7 +99,7 @@ def simulate_hover(params: VehicleParams, config: HoverConfig = HoverConfig(),
 
         fly = vehicle_flyer(params, gains, config, setpoint)
     else:
-        fly = compile_vehicle(params, gains, config, setpoint, _most_out_of_range,
+        fly = compile_vehicle(params, gains, config, setpoint, most_out_of_range_one,
                               _prioritised)
 
     # ---- the disturbed start: rotors at the trim speeds, at rest
@@ -151,42 +152,13 @@ _EVENTS = {"non-finite": ExitStatus.DIVERGED, "flipped": ExitStatus.CRASHED,
            "drifted": ExitStatus.DIVERGED, "rate": ExitStatus.DIVERGED}
 
 
-def _most_out_of_range(thrust: list[float], thrust_max: list[float]) -> int:
-    excess = [max(-T, T - hi) / hi for T, hi in zip(thrust, thrust_max)]
-    return excess.index(max(excess))
-
-
 def _prioritised(rows: list[tuple], thrust_max: list[float], f: float, t0: float, t1: float,
                  t2: float) -> list[float]:
-    """controller._prioritised for one vehicle: thrust, then roll/pitch, then yaw.
-
-    Written out with comparisons instead of min/max calls (same NaN behaviour): it runs
-    on every saturated step.
-    """
-    base = [r[0] * f for r in rows]
-    fit = None
-    for b, hi in zip(base, thrust_max):
-        if b > hi:
-            ratio = hi / b
-            if fit is None or ratio < fit:
-                fit = ratio
-    if fit is not None:
-        base = [b * fit for b in base]
-    base = [hi if b > hi else (0.0 if b < 0.0 else b) for b, hi in zip(base, thrust_max)]
-    for part in ([r[1] * t0 + r[2] * t1 for r in rows], [r[3] * t2 for r in rows]):
-        scale = math.inf
-        for b, d, hi in zip(base, part, thrust_max):
-            if d > 0.0:
-                room = (hi - b) / d
-                if room < scale:
-                    scale = room
-            elif d < 0.0:
-                room = -b / d
-                if room < scale:
-                    scale = room
-        scale = 0.0 if scale < 0.0 else (1.0 if scale > 1.0 else scale)
-        base = [b + scale * d for b, d in zip(base, part)]
-    return [hi if b > hi else (0.0 if b < 0.0 else b) for b, hi in zip(base, thrust_max)]
+    """controller.prioritised_one (the one desaturation of the per-vehicle engines) as the
+    generated step calls it: the thrusts returned as a list."""
+    thrust = [0.0] * len(rows)
+    prioritised_one(rows, thrust_max, f, t0, t1, t2, thrust)
+    return thrust
 
 
 def sample_series(rec: list[tuple], rotor_names: tuple[str, ...]) -> dict[str, np.ndarray]:
