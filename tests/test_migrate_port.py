@@ -607,3 +607,24 @@ def test_px4_contract_moves_are_proved_in_the_base_frame(tmp_path):
     proof = prove(robot, sdf, port, MigrateRequest(IRIS_GPS, tmp_path, fly=False), contract)
     differences = {(d.section, d.quantity) for d in proof.differences if "imu" in d.subject}
     assert differences == {("sensors", "T_base_sensor")}
+
+
+def test_motor_type_is_read_as_the_motor_plugin_reads_it(tmp_path):
+    """PX4 classic's gazebo_motor_model never reads <motorType>: a 'position' there is still
+    a propeller, so the port keeps four velocity motors (and the proof its four rotors).
+    The port and validate's rotor reading share one notion (physics.rotors.motor_type)."""
+    source = tmp_path / "iris_gps"
+    source.mkdir()
+    for item in (MODELS / "iris_gps").iterdir():
+        (source / item.name).write_bytes(item.read_bytes())
+    text = (source / "model.sdf").read_text()
+    text = text.replace("<motorNumber>0</motorNumber>",
+                        "<motorNumber>0</motorNumber>\n      <motorType>position</motorType>", 1)
+    assert "<motorType>position</motorType>" in text
+    (source / "model.sdf").write_text(text)
+    code, document, target = migrate(tmp_path / "out", source / "model.sdf",
+                                     "--package-path", str(MODELS))
+    assert code == 0, document["proof"]["differences"]
+    plugins = etree.parse(str(target / "model.sdf")).iter("plugin")
+    motors = [p for p in plugins if p.get("name") == "gz::sim::systems::MulticopterMotorModel"]
+    assert len(motors) == 4

@@ -239,13 +239,20 @@ def discover_rotors(robot: Robot) -> list[Rotor]:
     return rotors
 
 
+def motor_type(plugin: Plugin, kind: str | None = None) -> str:
+    """What a motor plugin runs as: "velocity" (a propeller), "position" or "force" (a servo).
+
+    RotorS' gazebo_motor_model and gz-sim's MulticopterMotorModel compare the trimmed
+    word exactly: "position" or "force" is a servo (a tilt arm), not a propeller; any other
+    word ("POSITION") leaves their default, a velocity motor, with an error in Gazebo's
+    log. PX4 classic's gazebo_motor_model does not read <motorType> at all."""
+    kind = kind or motor_plugin_kind(plugin)
+    word = (plugin.param("motorType") or "velocity").strip()
+    return word if kind != "px4" and word in ("position", "force") else "velocity"
+
+
 def _motor_model_rotor(robot: Robot, plugin: Plugin, kind: str, poses, index: int):
-    # RotorS' gazebo_motor_model and gz-sim's MulticopterMotorModel compare the trimmed
-    # word exactly: "position" or "force" is a servo (a tilt arm), not a propeller; any
-    # other word ("POSITION") leaves their default, a velocity motor, with an error in
-    # Gazebo's log. PX4 classic's gazebo_motor_model does not read <motorType> at all.
-    motor_type = (plugin.param("motorType") or "velocity").strip()
-    if kind != "px4" and motor_type in ("position", "force"):
+    if motor_type(plugin, kind) != "velocity":
         return None
     link = plugin.param("linkName")
     joint = plugin.param("jointName")

@@ -608,7 +608,9 @@ def _gz_plugin(system: tuple[str, str], name: str | None = None) -> Element:
 
 def _motor(port: GzPort, robot, plugin: Plugin, family: Family, fold, by_name) -> None:
     node = plugin.node
-    motor_type = (plugin.param("motorType") or "velocity").strip().lower()
+    from reedtool.physics.rotors import motor_type as motor_type_of
+
+    motor_type = motor_type_of(plugin)     # as the motor plugin reads it (exact words)
     if motor_type == "position":
         out = _gz_plugin(JOINT_POSITION_SYSTEM)
         out.add("joint_name", plugin.param("jointName"))
@@ -663,6 +665,8 @@ def _motor(port: GzPort, robot, plugin: Plugin, family: Family, fold, by_name) -
         if tag not in GZ_MOTOR_PARAMS:
             dropped.append(tag)
             continue
+        if tag == "motorType":
+            text = motor_type    # what the source's plugin ran as (PX4 classic's ignores it)
         out.add(tag, text)
         carried[child.tag if child.tag != tag else tag] = text
     if out.find("motorType") is None:
