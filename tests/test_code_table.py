@@ -73,3 +73,16 @@ def test_documented_examples_do_what_they_say(code, tmp_path):
         found[kind] = {f.code for f in run_checks(load_robot(path), Selection())}
     assert code in found["bad"]
     assert code not in found["good"]
+
+
+def test_rules_json_carries_stack_and_lifecycle(capsys):
+    import json
+
+    from reedtool.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(["rules", "--format", "json"])
+    assert exc.value.code == 0
+    listed = {r["code"]: (r["slug"], r["stack"], r["lifecycle"])
+              for r in json.loads(capsys.readouterr().out)["rules"]}
+    assert listed == CODES
