@@ -159,9 +159,10 @@ RETIRED: dict[str, tuple[str, str]] = {
 }
 
 # A two-link arm, written out in each example so that every snippet is a whole model.
+_BASE_INERTIAL = ('<inertial><mass value="2"/><inertia ixx="0.0083" ixy="0" ixz="0" '
+                  'iyy="0.0083" iyz="0" izz="0.0133"/></inertial>')
 _BASE = ('  <link name="base_link">\n'
-         '    <inertial><mass value="2"/><inertia ixx="0.0083" ixy="0" ixz="0" iyy="0.0083" '
-         'iyz="0" izz="0.0133"/></inertial>\n'
+         '    {inertial}\n'
          '    <collision><geometry><box size="0.2 0.2 0.1"/></geometry></collision>\n'
          '  </link>\n')
 _ARM_INERTIAL = ('<inertial><mass value="0.5"/><inertia ixx="0.004" ixy="0" ixz="0" '
@@ -171,8 +172,9 @@ _ARM_INERTIAL = ('<inertial><mass value="0.5"/><inertia ixx="0.004" ixy="0" ixz=
 def _arm(joint: str = '<axis xyz="0 1 0"/><limit lower="-1.57" upper="1.57" effort="10" '
                       'velocity="2"/>',
          arm: str = _ARM_INERTIAL, joint_type: str = "revolute", extra: str = "",
-         joint_name: str = "elbow", origin: str = "0 0 0.05") -> str:
-    return ('<robot name="arm">\n' + _BASE +
+         joint_name: str = "elbow", origin: str = "0 0 0.05",
+         base: str = _BASE_INERTIAL) -> str:
+    return ('<robot name="arm">\n' + _BASE.format(inertial=base) +
             f'  <joint name="{joint_name}" type="{joint_type}">\n'
             f'    <parent link="base_link"/><child link="arm"/><origin xyz="{origin}"/>\n'
             f'    {joint}\n'
@@ -208,6 +210,26 @@ EXAMPLES: dict[str, tuple[str, str]] = {
     "I201": (_arm(arm=_mass("0")), _arm(arm=_mass("0.5"))),
     "I202": (_arm(arm=_mass("0.5", 'ixx="0.004" iyy="0" izz="0.0006"')), _arm()),
     "I203": (_arm(arm=_mass("0.5", 'ixx="0.004" iyy="0.001" izz="0.0006"')), _arm()),
+    "S105": (_arm().replace('<child link="arm"/>', '<child link="forearm"/>'), _arm()),
+    "S108": (_arm(extra='  <joint name="arm_again" type="fixed"><parent link="base_link"/>'
+                        '<child link="arm"/></joint>\n'), _arm()),
+    "S109": (_arm(extra='  <joint name="back" type="fixed"><parent link="arm"/>'
+                        '<child link="base_link"/></joint>\n'), _arm()),
+    "S114": (_arm(extra='  <gazebo reference="arm_link"><material>Gazebo/Orange</material>'
+                        '</gazebo>\n'),
+             _arm(extra='  <gazebo reference="arm"><material>Gazebo/Orange</material>'
+                        '</gazebo>\n')),
+    "S116": (_arm(arm=_ARM_INERTIAL + '<visual><geometry><box size="0.05 0 0.3"/></geometry>'
+                                      '</visual>'),
+             _arm(arm=_ARM_INERTIAL + '<visual><geometry><box size="0.05 0.05 0.3"/>'
+                                      '</geometry></visual>')),
+    "S117": (_arm(arm='<collision><geometry><box size="0.05 0.05 0.3"/></geometry></collision>'),
+             _arm(arm=_ARM_INERTIAL + '<collision><geometry><box size="0.05 0.05 0.3"/>'
+                                      '</geometry></collision>')),
+    "I207": (_arm(arm=_mass("0", 'ixx="0" iyy="0" izz="0"'), joint_type="fixed",
+                  base=_mass("0", 'ixx="0" iyy="0" izz="0"')), _arm()),
+    "I208": (_arm(arm=_mass("0"), joint_type="fixed"),
+             _arm(arm=_mass("0", 'ixx="0" iyy="0" izz="0"'), joint_type="fixed")),
 }
 # The rules whose documentation must carry a bad and a good example (the rest: to come
 # in this table, not in the page).
