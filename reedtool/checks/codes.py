@@ -168,6 +168,17 @@ _BASE = ('  <link name="base_link">\n'
 _ARM_INERTIAL = ('<inertial><mass value="0.5"/><inertia ixx="0.004" ixy="0" ixz="0" '
                  'iyy="0.004" iyz="0" izz="0.0006"/></inertial>')
 
+# The arm as a 0.05 x 0.05 x 0.3 m box: its tensor is the solid box's, m (b^2 + c^2) / 12.
+_ARM_BOX = ('<collision><origin xyz="0 0 0.15"/><geometry><box size="0.05 0.05 0.3"/>'
+            '</geometry></collision>')
+
+
+def _box_arm(mass_kg: str = "0.5", ixx: str = "0.00385", izz: str = "0.000208",
+             com_z: str = "0.15") -> str:
+    return (f'<inertial><origin xyz="0 0 {com_z}"/><mass value="{mass_kg}"/><inertia '
+            f'ixx="{ixx}" ixy="0" ixz="0" iyy="{ixx}" iyz="0" izz="{izz}"/></inertial>'
+            + _ARM_BOX)
+
 
 def _arm(joint: str = '<axis xyz="0 1 0"/><limit lower="-1.57" upper="1.57" effort="10" '
                       'velocity="2"/>',
@@ -230,6 +241,11 @@ EXAMPLES: dict[str, tuple[str, str]] = {
                   base=_mass("0", 'ixx="0" iyy="0" izz="0"')), _arm()),
     "I208": (_arm(arm=_mass("0"), joint_type="fixed"),
              _arm(arm=_mass("0", 'ixx="0" iyy="0" izz="0"'), joint_type="fixed")),
+    # 100 times the box's tensor for its mass.
+    "I204": (_arm(arm=_box_arm(ixx="0.385", izz="0.0208")), _arm(arm=_box_arm())),
+    "I205": (_arm(arm=_box_arm(com_z="0.9")), _arm(arm=_box_arm())),
+    # 100 kg in 0.75 litres: 133 000 kg/m^3, six times osmium.
+    "I221": (_arm(arm=_box_arm("100", ixx="0.77", izz="0.0416")), _arm(arm=_box_arm())),
 }
 # The rules whose documentation must carry a bad and a good example (the rest: to come
 # in this table, not in the page).
