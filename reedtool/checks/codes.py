@@ -193,8 +193,49 @@ def _arm(joint: str = '<axis xyz="0 1 0"/><limit lower="-1.57" upper="1.57" effo
             f'  <link name="arm">{arm}</link>\n' + extra + '</robot>\n')
 
 
+# A RotorS-style X quadrotor (1.2 kg, 0.25 m arms; the rotor constants of RotorS' firefly):
+# one (x, y, turning direction, motor number, joint type) per rotor, in PX4's quad-X order.
+_QUAD_X = (("0.177", "-0.177", "ccw", "0", "continuous"),
+           ("-0.177", "0.177", "ccw", "1", "continuous"),
+           ("0.177", "0.177", "cw", "2", "continuous"),
+           ("-0.177", "-0.177", "cw", "3", "continuous"))
+
+
+def _quad(**change: tuple[int, int, str]) -> str:
+    """The quad with rotor i's field j set to a value: change={"name": (i, j, value)}."""
+    rotors = [list(r) for r in _QUAD_X]
+    for i, j, value in change.values():
+        rotors[i][j] = value
+    out = ['<robot name="quad">\n  <link name="base_link">\n'
+           '    <inertial><mass value="1.2"/><inertia ixx="0.00964" ixy="0" ixz="0" '
+           'iyy="0.00964" iyz="0" izz="0.018"/></inertial>\n'
+           '    <collision><geometry><box size="0.3 0.3 0.08"/></geometry></collision>\n'
+           '  </link>\n']
+    for k, (x, y, spin, number, joint_type) in enumerate(rotors):
+        out.append(
+            f'  <joint name="rotor_{k}_joint" type="{joint_type}"><parent link="base_link"/>'
+            f'<child link="rotor_{k}"/>\n'
+            f'    <origin xyz="{x} {y} 0.03"/><axis xyz="0 0 1"/>'
+            + ('<limit lower="-3.14" upper="3.14" effort="1" velocity="900"/>'
+               if joint_type == "revolute" else '') + '</joint>\n'
+            f'  <link name="rotor_{k}"><inertial><mass value="0.005"/><inertia ixx="1.25e-05" '
+            'ixy="0" ixz="0" iyy="1.25e-05" iyz="0" izz="2.5e-05"/></inertial>\n'
+            '    <collision><geometry><cylinder radius="0.1" length="0.005"/></geometry>'
+            '</collision></link>\n'
+            f'  <gazebo><plugin name="rotor_{k}_motor_model" '
+            'filename="librotors_gazebo_motor_model.so">\n'
+            f'    <jointName>rotor_{k}_joint</jointName><linkName>rotor_{k}</linkName>'
+            f'<turningDirection>{spin}</turningDirection><motorNumber>{number}</motorNumber>\n'
+            '    <timeConstantUp>0.0125</timeConstantUp><timeConstantDown>0.025'
+            '</timeConstantDown><maxRotVelocity>838</maxRotVelocity>\n'
+            '    <motorConstant>8.54858e-06</motorConstant><momentConstant>0.016'
+            '</momentConstant>\n  </plugin></gazebo>\n')
+    return "".join(out) + "</robot>\n"
+
+
 def _mass(value: str, inertia: str = 'ixx="0.004" iyy="0.004" izz="0.0006"') -> str:
-    return f'<inertial><mass value="{value}"/><inertia {inertia} ixy="0" ixz="0" iyz="0"/></inertial>'
+    return (f'<inertial><mass value="{value}"/><inertia {inertia} ixy="0" ixz="0" iyz="0"/>'
+            '</inertial>')
 
 
 # code -> (bad model, good model): URDF, each a whole file.
@@ -206,9 +247,10 @@ EXAMPLES: dict[str, tuple[str, str]] = {
                         '<child link="camera"/></joint>\n'
                         '  <link name="camera">' + _ARM_INERTIAL + '</link>\n')),
     "S106": (_arm(extra='  <link name="arm">' + _ARM_INERTIAL + '</link>\n'), _arm()),
-    "S107": (_arm(joint_name="mount", extra='  <joint name="mount" type="fixed"><parent link="arm"/>'
-                                     '<child link="tool"/></joint>\n'
-                                     '  <link name="tool">' + _ARM_INERTIAL + '</link>\n'),
+    "S107": (_arm(joint_name="mount",
+                  extra='  <joint name="mount" type="fixed"><parent link="arm"/>'
+                        '<child link="tool"/></joint>\n'
+                        '  <link name="tool">' + _ARM_INERTIAL + '</link>\n'),
              _arm(extra='  <joint name="mount" type="fixed"><parent link="arm"/>'
                         '<child link="tool"/></joint>\n'
                         '  <link name="tool">' + _ARM_INERTIAL + '</link>\n')),
@@ -246,6 +288,11 @@ EXAMPLES: dict[str, tuple[str, str]] = {
     "I205": (_arm(arm=_box_arm(com_z="0.9")), _arm(arm=_box_arm())),
     # 100 kg in 0.75 litres: 133 000 kg/m^3, six times osmium.
     "I221": (_arm(arm=_box_arm("100", ixx="0.77", izz="0.0416")), _arm(arm=_box_arm())),
+    "R301": (_quad(number=(3, 3, "2")), _quad()),
+    "R302": (_quad(number=(3, 3, "4")), _quad()),
+    "R303": (_quad(spin=(2, 2, "CW")), _quad()),
+    "R304": (_quad(spin=(3, 2, "ccw")), _quad()),
+    "R313": (_quad(joint=(0, 4, "revolute")), _quad()),
 }
 # The rules whose documentation must carry a bad and a good example (the rest: to come
 # in this table, not in the page).
