@@ -2,7 +2,8 @@
 
 A rule's metadata (code, slug, default severity, one-line summary) is data; its docstring
 is its documentation (`--explain`, docs/rules.md). Codes are a family letter and three
-digits and are never reused: a retired rule keeps its number, retired.
+digits and are never reused: the code table (checks/codes.py) lists every code with its
+stack and lifecycle, and the retired ones, which cannot register again.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ import re
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Callable, Iterable
 
+from reedtool.checks.codes import CODES, RETIRED
 from reedtool.checks.finding import SEVERITIES, Issue
 
 if TYPE_CHECKING:
@@ -69,6 +71,10 @@ class Rule:
     # Judged over a whole run, not one robot (S143: a suppression no model needed); the
     # runner skips it and `check` takes what the run gathered instead of a CheckContext.
     run_level: bool = False
+    # From the code table (checks/codes.py): the flight stack whose contract the rule holds
+    # the model to ("core" for any model), and "stable" or "preview".
+    stack: str = "core"
+    lifecycle: str = "stable"
 
     @property
     def policy(self) -> str:
@@ -96,6 +102,8 @@ def rule(code: str, slug: str, severity: str, summary: str, *, clause: str,
         # Programming errors in a rule module, caught at import time by the test suite.
         if not _CODE.match(code) or code[0] not in FAMILIES:
             raise ValueError(f"bad rule code {code!r}")
+        if code in RETIRED:
+            raise ValueError(f"rule code {code} is retired ({RETIRED[code][1]}); take a new one")
         if not _SLUG.match(slug):
             raise ValueError(f"bad rule slug {slug!r}")
         if severity not in SEVERITIES:
@@ -108,7 +116,11 @@ def rule(code: str, slug: str, severity: str, summary: str, *, clause: str,
             raise ValueError(f"rule code {code} registered twice")
         if any(r.slug == slug and r.code != code for r in _RULES.values()):
             raise ValueError(f"rule slug {slug!r} registered twice")
-        _RULES[code] = Rule(code, slug, severity, summary, fn, clause, run_level)
+        # A code not yet in the table is a preview of any stack until it is entered there
+        # (tests/test_code_table.py fails until it is).
+        _slug, stack, lifecycle = CODES.get(code, (slug, "core", "preview"))
+        _RULES[code] = Rule(code, slug, severity, summary, fn, clause, run_level,
+                            stack=stack, lifecycle=lifecycle)
         return fn
 
     return register

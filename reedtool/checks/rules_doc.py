@@ -22,6 +22,7 @@ def _md(text: str) -> str:
 
 
 def render() -> str:
+    from reedtool.checks.codes import EXAMPLE_CODES, RETIRED
     from reedtool.checks.registry import FAMILIES, POLICY_CLAUSES, all_rules
 
     rules = all_rules()
@@ -45,19 +46,43 @@ def render() -> str:
         *[f"- **{key}** ({' or '.join(sevs)}): {text}." for key, (sevs, text) in
           POLICY_CLAUSES.items()],
         "",
-        "| Code | Name | Severity | Clause | Summary |",
-        "| --- | --- | --- | --- | --- |",
+        "Each rule's page has the same sections: summary, severity and clause, stack and "
+        "lifecycle (from the code table, `reedtool/checks/codes.py`), what it checks, and for "
+        f"the rules {', '.join(sorted(EXAMPLE_CODES))} a bad and a good model, each checked by "
+        "the test suite (the bad one gives the code, the good one does not).",
+        "",
+        "| Code | Name | Severity | Clause | Stack | Summary |",
+        "| --- | --- | --- | --- | --- | --- |",
     ]
     out += [f"| [{r.code}](#{r.code.lower()}-{r.slug}) | {r.slug} | {r.severity} | {r.clause} "
-            f"| {_md(r.summary)} |" for r in rules]
+            f"| {r.stack} | {_md(r.summary)} |" for r in rules]
     for letter, family_rules in groupby(rules, key=lambda r: r.code[0]):
         out += ["", f"## {FAMILIES[letter][1]} ({letter})"]
         for r in family_rules:
-            out += ["", f"### {r.code} {r.slug}", "",
-                    f"*Default severity: {r.severity}* ({r.clause}: "
-                    f"{POLICY_CLAUSES[r.clause][1]}). {_md(r.summary)}", "",
-                    _md(r.explanation)]
+            out += _rule_section(r, POLICY_CLAUSES[r.clause][1])
+    out += ["", "## Retired codes", "",
+            "A code leaves the registry only into this list and is never given out again.", ""]
+    out += [f"- **{code}** {slug}: {why}." for code, (slug, why) in sorted(RETIRED.items())]
     return "\n".join(out) + "\n"
+
+
+def _rule_section(r, clause_wording: str) -> list[str]:
+    """One rule's page, in fixed sections: summary, severity and clause, stack and
+    lifecycle, what it checks (its docstring), and a bad and a good example where the code
+    table has them (EXAMPLE_CODES)."""
+    from reedtool.checks.codes import EXAMPLES
+
+    out = ["", f"### {r.code} {r.slug}", "",
+           f"**Summary.** {_md(r.summary)}", "",
+           f"**Severity and clause.** *Default severity: {r.severity}* ({r.clause}: "
+           f"{clause_wording}).", "",
+           f"**Stack.** {r.stack}. **Lifecycle.** {r.lifecycle}.", "",
+           "**What it checks.**", "", _md(r.explanation)]
+    if r.code in EXAMPLES:
+        bad, good = EXAMPLES[r.code]
+        out += ["", f"**Bad** (gives {r.code}):", "", "```xml", bad.rstrip("\n"), "```",
+                "", f"**Good** (no {r.code}):", "", "```xml", good.rstrip("\n"), "```"]
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -62,7 +62,8 @@ def command(selectors: tuple[str, ...], family: str | None, severity: str | None
 
         doc = {**envelope(SCHEMA), "rules": [
             {"code": r.code, "slug": r.slug, "severity": r.severity, "family": r.family,
-             "summary": r.summary, "clause": r.clause, "explanation": r.explanation}
+             "summary": r.summary, "clause": r.clause, "stack": r.stack,
+             "lifecycle": r.lifecycle, "explanation": r.explanation}
             for r in rules]}
         click.echo(json.dumps(doc, indent=2, ensure_ascii=False))
         return 0

@@ -150,8 +150,8 @@ def _agreement_lines(path: Path, robot, findings, options: RunOptions, model: st
     rotors = discover_rotors(robot)
     lines = []
     for params in options.flight_params:
-        rules = [r for r in all_rules() if r.check.__module__.endswith(".flightstack_rules")
-                 and r.slug.startswith(params.kind)]
+        # The controller cross-check rules of this file's flight stack (code table metadata).
+        rules = [r for r in all_rules() if r.code.startswith("C") and r.stack == params.kind]
         ran = all(selection.enabled(r.code) for r in rules)
         quiet = not any(f.code in {r.code for r in rules} and f.severity != "info"
                         for f in findings)

@@ -1,0 +1,299 @@
+"""The code table: every rule code reedtool has ever given out, with its rule's name (slug),
+the flight stack whose contract it holds the model to, and its lifecycle.
+
+This is the catalogue's own list (as ruff keeps one): the registry takes a rule's stack from
+here, tests/test_code_table.py holds the registry equal to it, and a code in RETIRED is never
+registered again ("codes are never reused").
+
+- stack: "core" (any model), "px4" (PX4's airframe/parameter contract), "ardupilot"
+  (ArduPilot's frame classes, parameters and plugin), "rotors-lee" (RotorS'
+  lee_position_controller_node). `validate` picks the controller cross-check rules of the
+  flight stack a --airframe / --autopilot-params file belongs to by this field.
+- lifecycle: "stable" (released; behaviour changes only as a bug fix) or "preview" (new,
+  may still change). A code removed from the registry moves to RETIRED with the reason.
+
+EXAMPLES gives a bad and a good model for a subset of the rules (EXAMPLE_CODES); docs/rules.md
+shows them and tests/test_code_table.py runs each through the rules: the bad one must give
+its code, the good one must not.
+"""
+
+from __future__ import annotations
+
+STACKS = ("core", "px4", "ardupilot", "rotors-lee")
+LIFECYCLES = ("stable", "preview")
+
+# code -> (slug, stack, lifecycle)
+CODES: dict[str, tuple[str, str, str]] = {
+    "S101": ("urdf-parse-error", "core", "stable"),
+    "S102": ("non-finite-number", "core", "stable"),
+    "S103": ("legacy-xacro-tag", "core", "stable"),
+    "S104": ("single-root", "core", "stable"),
+    "S105": ("joint-link-missing", "core", "stable"),
+    "S106": ("duplicate-link-name", "core", "stable"),
+    "S107": ("duplicate-joint-name", "core", "stable"),
+    "S108": ("link-multiple-parents", "core", "stable"),
+    "S109": ("kinematic-cycle", "core", "stable"),
+    "S110": ("joint-type-invalid", "core", "stable"),
+    "S111": ("joint-limit-missing", "core", "stable"),
+    "S112": ("joint-limit-inverted", "core", "stable"),
+    "S113": ("joint-axis-zero", "core", "stable"),
+    "S114": ("gazebo-reference-missing", "core", "stable"),
+    "S115": ("mesh-unresolved", "core", "stable"),
+    "S116": ("geometry-size-invalid", "core", "stable"),
+    "S117": ("link-dropped-by-sdf", "core", "stable"),
+    "S118": ("plugin-link-merged", "core", "stable"),
+    "S119": ("xml-tolerated", "core", "stable"),
+    "S120": ("sdf-link-default-inertial", "core", "stable"),
+    "S121": ("visual-mesh-mirrored", "core", "stable"),
+    "S122": ("collision-mesh-mirrored", "core", "stable"),
+    "S123": ("sdf-element-not-in-version", "core", "stable"),
+    "S124": ("xml-declaration-late", "core", "stable"),
+    "S125": ("sdf-pose-short", "core", "stable"),
+    "S130": ("mesh-format-unsupported", "core", "stable"),
+    "S131": ("mesh-uri-escapes", "core", "stable"),
+    "S140": ("xacro-argument-unknown", "core", "stable"),
+    "S141": ("xacro-argument-unused", "core", "stable"),
+    "S142": ("suppression-code-unknown", "core", "stable"),
+    "S143": ("suppression-unused", "core", "stable"),
+    "S150": ("package-name-ambiguous", "core", "stable"),
+    "S160": ("sdf-name-double-colon", "core", "stable"),
+    "S161": ("sdf-name-collision", "core", "stable"),
+    "S162": ("sdf-name-reserved", "core", "stable"),
+    "S163": ("sdf-canonical-link-missing", "core", "stable"),
+    "S164": ("sdf-frame-attached-to-invalid", "core", "stable"),
+    "S165": ("sdf-pose-relative-to-invalid", "core", "stable"),
+    "S166": ("sdf-joint-frames-invalid", "core", "stable"),
+    "S167": ("sdf-model-without-link", "core", "stable"),
+    "S168": ("sdf-version-missing", "core", "stable"),
+    "S169": ("file-uri-absolute", "core", "stable"),
+    "S170": ("sdf-material-script-uri", "core", "stable"),
+    "S171": ("sdf-root-several-models", "core", "stable"),
+    "S190": ("remote-resource-not-checked", "core", "stable"),
+    "S191": ("sdf-classic-scoped-name", "core", "stable"),
+    "I201": ("mass-not-positive", "core", "stable"),
+    "I202": ("inertia-not-positive-definite", "core", "stable"),
+    "I203": ("inertia-triangle-inequality", "core", "stable"),
+    "I204": ("inertia-implausible-for-geometry", "core", "stable"),
+    "I205": ("com-outside-geometry", "core", "stable"),
+    "I206": ("mesh-scale-implausible", "core", "stable"),
+    "I207": ("robot-mass-not-positive", "core", "stable"),
+    "I208": ("massless-link-with-inertia", "core", "stable"),
+    "I209": ("inertia-orders-off-geometry", "core", "stable"),
+    "I210": ("mesh-unit-wrong", "core", "stable"),
+    "I220": ("mass-implausible-for-size", "core", "stable"),
+    "I221": ("link-denser-than-matter", "core", "stable"),
+    "R301": ("motor-number-duplicate", "core", "stable"),
+    "R302": ("motor-numbers-not-contiguous", "core", "stable"),
+    "R303": ("rotor-direction-invalid", "core", "stable"),
+    "R304": ("yaw-moment-imbalance", "core", "stable"),
+    "R305": ("allocation-rank-deficient", "core", "stable"),
+    "R306": ("allocation-ill-conditioned", "core", "stable"),
+    "R307": ("trim-infeasible", "core", "stable"),
+    "R308": ("thrust-to-weight-below-one", "core", "stable"),
+    "R309": ("thrust-to-weight-low", "core", "stable"),
+    "R310": ("hover-throttle-high", "core", "stable"),
+    "R311": ("rotor-axis-tilted", "core", "stable"),
+    "R312": ("rotor-count-mismatch", "core", "stable"),
+    "R313": ("rotor-joint-not-continuous", "core", "stable"),
+    "R314": ("rotor-plugin-target-missing", "core", "stable"),
+    "R315": ("rotor-link-not-joint-child", "core", "stable"),
+    "R316": ("rotor-constant-invalid", "core", "stable"),
+    "R317": ("rotor-constants-estimated", "core", "stable"),
+    "R318": ("ardupilot-spin-against-blades", "ardupilot", "stable"),
+    "R319": ("rotor-role", "core", "stable"),
+    "R320": ("rotor-tilt-pattern", "core", "stable"),
+    "R340": ("thrust-to-weight-high", "core", "stable"),
+    "R341": ("rotor-joint-axis-not-thrust-axis", "core", "stable"),
+    "R342": ("uneven-hover-trim", "core", "stable"),
+    "R343": ("size-implausible-for-mass", "core", "stable"),
+    "R350": ("spin-order-not-fault-tolerant", "core", "stable"),
+    "C401": ("controller-rotor-count", "core", "stable"),
+    "C402": ("controller-rotor-joint-unknown", "core", "stable"),
+    "C403": ("controller-rotor-order", "core", "stable"),
+    "C404": ("controller-direction-mismatch", "core", "stable"),
+    "C405": ("controller-angle-mismatch", "core", "stable"),
+    "C406": ("controller-arm-length-mismatch", "core", "stable"),
+    "C407": ("controller-force-constant-mismatch", "core", "stable"),
+    "C408": ("controller-moment-constant-mismatch", "core", "stable"),
+    "C409": ("controller-mass-mismatch", "core", "stable"),
+    "C410": ("controller-inertia-mismatch", "core", "stable"),
+    "C411": ("controller-entry-invalid", "core", "stable"),
+    "C412": ("controller-com-link-missing", "core", "stable"),
+    "C413": ("px4-rotor-count", "px4", "stable"),
+    "C414": ("px4-output-mapping", "px4", "stable"),
+    "C415": ("px4-rotor-position", "px4", "stable"),
+    "C416": ("px4-rotor-spin", "px4", "stable"),
+    "C417": ("px4-moment-ratio", "px4", "stable"),
+    "C418": ("px4-thrust-axis", "px4", "stable"),
+    "C419": ("px4-command-above-max", "px4", "stable"),
+    "C420": ("px4-idle-command", "px4", "stable"),
+    "C421": ("px4-hover-throttle", "px4", "stable"),
+    "C422": ("px4-hover-throttle-mismatch", "px4", "stable"),
+    "C423": ("px4-rotor-position-offset", "px4", "stable"),
+    "C424": ("px4-command-below-max", "px4", "stable"),
+    "C425": ("px4-param-out-of-range", "px4", "stable"),
+    "C426": ("px4-thrust-axis-offset", "px4", "stable"),
+    "C427": ("px4-thrust-axis-fixed", "px4", "stable"),
+    "C430": ("ardupilot-frame-unknown", "ardupilot", "stable"),
+    "C431": ("ardupilot-motor-count", "ardupilot", "stable"),
+    "C432": ("ardupilot-motor-position", "ardupilot", "stable"),
+    "C433": ("ardupilot-motor-spin", "ardupilot", "stable"),
+    "C434": ("ardupilot-motor-unassigned", "ardupilot", "stable"),
+    "C435": ("px4-simulator-mismatch", "px4", "stable"),
+    "C436": ("px4-classic-command-above-max", "px4", "stable"),
+    "C437": ("px4-classic-command-below-max", "px4", "stable"),
+    "C438": ("px4-classic-idle-command", "px4", "stable"),
+    "C439": ("px4-gz-bridge-unreachable", "px4", "stable"),
+    "C450": ("lee-gain-not-positive", "rotors-lee", "stable"),
+    "C451": ("lee-loop-unstable", "rotors-lee", "stable"),
+    "C452": ("lee-mass-unit-slip", "rotors-lee", "stable"),
+    "C453": ("lee-inertia-unit-slip", "rotors-lee", "stable"),
+    "C454": ("lee-loop-underdamped", "rotors-lee", "stable"),
+}
+
+# code -> (slug it had, why it is not in the registry). Never registered again.
+RETIRED: dict[str, tuple[str, str]] = {
+    "S192": ("sdf-joint-named-like-link",
+             "added on a development branch (a joint named like a link, refused by gz-sim's "
+             "libsdformat) and dropped before any release; reserved, never reused"),
+}
+
+# A two-link arm, written out in each example so that every snippet is a whole model.
+_BASE_INERTIAL = ('<inertial><mass value="2"/><inertia ixx="0.0083" ixy="0" ixz="0" '
+                  'iyy="0.0083" iyz="0" izz="0.0133"/></inertial>')
+_BASE = ('  <link name="base_link">\n'
+         '    {inertial}\n'
+         '    <collision><geometry><box size="0.2 0.2 0.1"/></geometry></collision>\n'
+         '  </link>\n')
+_ARM_INERTIAL = ('<inertial><mass value="0.5"/><inertia ixx="0.004" ixy="0" ixz="0" '
+                 'iyy="0.004" iyz="0" izz="0.0006"/></inertial>')
+
+# The arm as a 0.05 x 0.05 x 0.3 m box: its tensor is the solid box's, m (b^2 + c^2) / 12.
+_ARM_BOX = ('<collision><origin xyz="0 0 0.15"/><geometry><box size="0.05 0.05 0.3"/>'
+            '</geometry></collision>')
+
+
+def _box_arm(mass_kg: str = "0.5", ixx: str = "0.00385", izz: str = "0.000208",
+             com_z: str = "0.15") -> str:
+    return (f'<inertial><origin xyz="0 0 {com_z}"/><mass value="{mass_kg}"/><inertia '
+            f'ixx="{ixx}" ixy="0" ixz="0" iyy="{ixx}" iyz="0" izz="{izz}"/></inertial>'
+            + _ARM_BOX)
+
+
+def _arm(joint: str = '<axis xyz="0 1 0"/><limit lower="-1.57" upper="1.57" effort="10" '
+                      'velocity="2"/>',
+         arm: str = _ARM_INERTIAL, joint_type: str = "revolute", extra: str = "",
+         joint_name: str = "elbow", origin: str = "0 0 0.05",
+         base: str = _BASE_INERTIAL) -> str:
+    return ('<robot name="arm">\n' + _BASE.format(inertial=base) +
+            f'  <joint name="{joint_name}" type="{joint_type}">\n'
+            f'    <parent link="base_link"/><child link="arm"/><origin xyz="{origin}"/>\n'
+            f'    {joint}\n'
+            '  </joint>\n'
+            f'  <link name="arm">{arm}</link>\n' + extra + '</robot>\n')
+
+
+# A RotorS-style X quadrotor (1.2 kg, 0.25 m arms; the rotor constants of RotorS' firefly):
+# one (x, y, turning direction, motor number, joint type) per rotor, in PX4's quad-X order.
+_QUAD_X = (("0.177", "-0.177", "ccw", "0", "continuous"),
+           ("-0.177", "0.177", "ccw", "1", "continuous"),
+           ("0.177", "0.177", "cw", "2", "continuous"),
+           ("-0.177", "-0.177", "cw", "3", "continuous"))
+
+
+def _quad(**change: tuple[int, int, str]) -> str:
+    """The quad with rotor i's field j set to a value: change={"name": (i, j, value)}."""
+    rotors = [list(r) for r in _QUAD_X]
+    for i, j, value in change.values():
+        rotors[i][j] = value
+    out = ['<robot name="quad">\n  <link name="base_link">\n'
+           '    <inertial><mass value="1.2"/><inertia ixx="0.00964" ixy="0" ixz="0" '
+           'iyy="0.00964" iyz="0" izz="0.018"/></inertial>\n'
+           '    <collision><geometry><box size="0.3 0.3 0.08"/></geometry></collision>\n'
+           '  </link>\n']
+    for k, (x, y, spin, number, joint_type) in enumerate(rotors):
+        out.append(
+            f'  <joint name="rotor_{k}_joint" type="{joint_type}"><parent link="base_link"/>'
+            f'<child link="rotor_{k}"/>\n'
+            f'    <origin xyz="{x} {y} 0.03"/><axis xyz="0 0 1"/>'
+            + ('<limit lower="-3.14" upper="3.14" effort="1" velocity="900"/>'
+               if joint_type == "revolute" else '') + '</joint>\n'
+            f'  <link name="rotor_{k}"><inertial><mass value="0.005"/><inertia ixx="1.25e-05" '
+            'ixy="0" ixz="0" iyy="1.25e-05" iyz="0" izz="2.5e-05"/></inertial>\n'
+            '    <collision><geometry><cylinder radius="0.1" length="0.005"/></geometry>'
+            '</collision></link>\n'
+            f'  <gazebo><plugin name="rotor_{k}_motor_model" '
+            'filename="librotors_gazebo_motor_model.so">\n'
+            f'    <jointName>rotor_{k}_joint</jointName><linkName>rotor_{k}</linkName>'
+            f'<turningDirection>{spin}</turningDirection><motorNumber>{number}</motorNumber>\n'
+            '    <timeConstantUp>0.0125</timeConstantUp><timeConstantDown>0.025'
+            '</timeConstantDown><maxRotVelocity>838</maxRotVelocity>\n'
+            '    <motorConstant>8.54858e-06</motorConstant><momentConstant>0.016'
+            '</momentConstant>\n  </plugin></gazebo>\n')
+    return "".join(out) + "</robot>\n"
+
+
+def _mass(value: str, inertia: str = 'ixx="0.004" iyy="0.004" izz="0.0006"') -> str:
+    return (f'<inertial><mass value="{value}"/><inertia {inertia} ixy="0" ixz="0" iyz="0"/>'
+            '</inertial>')
+
+
+# code -> (bad model, good model): URDF, each a whole file.
+EXAMPLES: dict[str, tuple[str, str]] = {
+    "S101": (_arm(arm=_mass("half")), _arm(arm=_mass("0.5"))),
+    "S102": (_arm(origin="0 nan 0.05"), _arm()),
+    "S104": (_arm(extra='  <link name="camera">' + _ARM_INERTIAL + '</link>\n'),
+             _arm(extra='  <joint name="camera_mount" type="fixed"><parent link="arm"/>'
+                        '<child link="camera"/></joint>\n'
+                        '  <link name="camera">' + _ARM_INERTIAL + '</link>\n')),
+    "S106": (_arm(extra='  <link name="arm">' + _ARM_INERTIAL + '</link>\n'), _arm()),
+    "S107": (_arm(joint_name="mount",
+                  extra='  <joint name="mount" type="fixed"><parent link="arm"/>'
+                        '<child link="tool"/></joint>\n'
+                        '  <link name="tool">' + _ARM_INERTIAL + '</link>\n'),
+             _arm(extra='  <joint name="mount" type="fixed"><parent link="arm"/>'
+                        '<child link="tool"/></joint>\n'
+                        '  <link name="tool">' + _ARM_INERTIAL + '</link>\n')),
+    "S110": (_arm(joint_type="hinge"), _arm()),
+    "S111": (_arm(joint='<axis xyz="0 1 0"/>'), _arm()),
+    "S112": (_arm(joint='<axis xyz="0 1 0"/><limit lower="1.57" upper="-1.57" effort="10" '
+                        'velocity="2"/>'), _arm()),
+    "S113": (_arm(joint='<axis xyz="0 0 0"/><limit lower="-1.57" upper="1.57" effort="10" '
+                        'velocity="2"/>'), _arm()),
+    "I201": (_arm(arm=_mass("0")), _arm(arm=_mass("0.5"))),
+    "I202": (_arm(arm=_mass("0.5", 'ixx="0.004" iyy="0" izz="0.0006"')), _arm()),
+    "I203": (_arm(arm=_mass("0.5", 'ixx="0.004" iyy="0.001" izz="0.0006"')), _arm()),
+    "S105": (_arm().replace('<child link="arm"/>', '<child link="forearm"/>'), _arm()),
+    "S108": (_arm(extra='  <joint name="arm_again" type="fixed"><parent link="base_link"/>'
+                        '<child link="arm"/></joint>\n'), _arm()),
+    "S109": (_arm(extra='  <joint name="back" type="fixed"><parent link="arm"/>'
+                        '<child link="base_link"/></joint>\n'), _arm()),
+    "S114": (_arm(extra='  <gazebo reference="arm_link"><material>Gazebo/Orange</material>'
+                        '</gazebo>\n'),
+             _arm(extra='  <gazebo reference="arm"><material>Gazebo/Orange</material>'
+                        '</gazebo>\n')),
+    "S116": (_arm(arm=_ARM_INERTIAL + '<visual><geometry><box size="0.05 0 0.3"/></geometry>'
+                                      '</visual>'),
+             _arm(arm=_ARM_INERTIAL + '<visual><geometry><box size="0.05 0.05 0.3"/>'
+                                      '</geometry></visual>')),
+    "S117": (_arm(arm='<collision><geometry><box size="0.05 0.05 0.3"/></geometry></collision>'),
+             _arm(arm=_ARM_INERTIAL + '<collision><geometry><box size="0.05 0.05 0.3"/>'
+                                      '</geometry></collision>')),
+    "I207": (_arm(arm=_mass("0", 'ixx="0" iyy="0" izz="0"'), joint_type="fixed",
+                  base=_mass("0", 'ixx="0" iyy="0" izz="0"')), _arm()),
+    "I208": (_arm(arm=_mass("0"), joint_type="fixed"),
+             _arm(arm=_mass("0", 'ixx="0" iyy="0" izz="0"'), joint_type="fixed")),
+    # 100 times the box's tensor for its mass.
+    "I204": (_arm(arm=_box_arm(ixx="0.385", izz="0.0208")), _arm(arm=_box_arm())),
+    "I205": (_arm(arm=_box_arm(com_z="0.9")), _arm(arm=_box_arm())),
+    # 100 kg in 0.75 litres: 133 000 kg/m^3, six times osmium.
+    "I221": (_arm(arm=_box_arm("100", ixx="0.77", izz="0.0416")), _arm(arm=_box_arm())),
+    "R301": (_quad(number=(3, 3, "2")), _quad()),
+    "R302": (_quad(number=(3, 3, "4")), _quad()),
+    "R303": (_quad(spin=(2, 2, "CW")), _quad()),
+    "R304": (_quad(spin=(3, 2, "ccw")), _quad()),
+    "R313": (_quad(joint=(0, 4, "revolute")), _quad()),
+}
+# The rules whose documentation must carry a bad and a good example (the rest: to come
+# in this table, not in the page).
+EXAMPLE_CODES = frozenset(EXAMPLES)
