@@ -22,7 +22,6 @@ format (docs/ci.md):
 
 from __future__ import annotations
 
-import json
 import os
 import re
 from collections import Counter
@@ -95,6 +94,8 @@ class Baseline:
 
 
 def read_baseline(path: Path) -> Baseline:
+    import json  # imported here: a run without a baseline file never parses JSON
+
     from reedtool.io.fileio import read_bytes
 
     try:
@@ -123,6 +124,8 @@ def read_baseline(path: Path) -> Baseline:
 def baseline_text(results, path: Path) -> tuple[str, int]:
     """The baseline document recording every finding of `results` (ModelResults), keyed
     relative to `path`'s directory; and how many findings it records."""
+    import json
+
     from reedtool import __version__
     from reedtool.checks.runner import INTERNAL_ERROR
 

@@ -7,7 +7,6 @@ These rules look at `CheckContext.arguments` (reedtool.io.xacro_args.ArgumentUse
 
 from __future__ import annotations
 
-from difflib import get_close_matches
 from typing import Iterator
 
 from reedtool.checks.context import CheckContext
@@ -23,6 +22,8 @@ def _unknown_arguments(ctx: CheckContext):
     for name in sorted(use.given):
         if name in use.declared:
             continue
+        from difflib import get_close_matches  # here: only an unknown argument needs it
+
         close = get_close_matches(name, sorted(use.declared), n=1, cutoff=0.6)
         yield name, (close[0] if close else None), use.given[name], use.origins.get(name)
 

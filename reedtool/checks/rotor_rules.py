@@ -612,8 +612,6 @@ def rotor_plugin_target_missing(ctx: CheckContext) -> Iterator[Issue]:
     Severity (error, refused): the plugin finds no joint or link and the rotor never
     turns.
     """
-    import difflib
-
     from reedtool.physics.rotors import resolve_name
 
     for rotor in _rotors(ctx):
@@ -626,6 +624,8 @@ def rotor_plugin_target_missing(ctx: CheckContext) -> Iterator[Issue]:
                 yield Issue(f"motor plugin '{rotor.plugin.name}' has no <jointName>", rotor.loc,
                             rotor.name, hint="add <jointName> naming the rotor's joint")
             elif name is not None and name not in table:
+                import difflib  # here: only a wrong name needs it, not every validate
+
                 close = difflib.get_close_matches(name, list(table), n=1)
                 yield Issue(f"motor plugin '{rotor.plugin.name}' <{tag}> '{name}' does not exist",
                             rotor.param_loc(tag), rotor.name,

@@ -236,11 +236,11 @@ def joint_type_invalid(ctx: CheckContext) -> Iterator[Issue]:
 
     Severity (error, refused): the parser does not know the type.
     """
-    import difflib
-
     types = SDF_JOINT_TYPES if ctx.robot.source_format == "sdf" else JOINT_TYPES
     for joint in ctx.robot.joints:
         if joint.type not in types:
+            import difflib  # here: only a wrong type needs it, not every validate
+
             close = difflib.get_close_matches(joint.type, types, n=1)
             hint = f"did you mean '{close[0]}'?" if close else f"use one of {', '.join(types)}"
             what = f"type '{joint.type}'" if joint.type else "no type="

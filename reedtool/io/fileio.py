@@ -15,9 +15,7 @@ import errno
 import math
 import os
 import re
-import shutil
 import stat
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -313,6 +311,9 @@ def _fsync_dir(directory: Path) -> None:
 
 def _stage(path: Path, data: bytes, created: list[Path]) -> str:
     """Write `data` to a temporary file beside `path` (the real file); returns its name."""
+    import shutil
+    import tempfile  # imported here: only a write needs them, and validate writes nothing
+
     _make_parent(path, created)
     try:
         fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name[:64]}.", suffix=".tmp",
@@ -357,6 +358,8 @@ def free_backup_name(path: Path) -> Path:
 
 def _make_backup(path: Path) -> Path:
     """Keep the current `path` under a free backup name, never replacing an older backup."""
+    import shutil
+
     for _ in range(1000):
         backup = free_backup_name(path)
         try:

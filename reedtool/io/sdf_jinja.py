@@ -18,8 +18,6 @@ kept as `urdf_line`, the line of the expansion).
 from __future__ import annotations
 
 import dataclasses
-import difflib
-import json
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -70,6 +68,8 @@ def _context(env_dir: Path) -> dict:
     context = {"np": np, "rospack": None, "ros_version": 0, **JINJA_GEN_DEFAULTS}
     overrides = env_dir / OVERRIDES
     if overrides.is_file():
+        import json
+
         from reedtool.io.fileio import read_text_file
 
         try:
@@ -135,6 +135,8 @@ def _template_keys(template: list[str]) -> list[str]:
 def _line_map(template: list[str], rendered: list[str]) -> list[int]:
     """Rendered line -> template line. Lines a loop repeats are matched again against the
     template before them (the loop's body); a macro's lines map to its call."""
+    import difflib  # imported here: only a rendered template needs it, not every validate
+
     t_norm = _template_keys(template)
     r_norm = [_normal(line) for line in rendered]
     matcher = difflib.SequenceMatcher(None, t_norm, r_norm, autojunk=False)
@@ -155,6 +157,8 @@ def _line_map(template: list[str], rendered: list[str]) -> list[int]:
 def _repeats(t_norm: list[str], r_norm: list[str], j1: int, j2: int, out: list[int]) -> None:
     """Rendered lines j1..j2 that repeat template text (a loop's later passes), matched
     pass by pass: each round aligns what is left with the template once."""
+    import difflib
+
     start = j1
     while start < j2:
         again = difflib.SequenceMatcher(None, t_norm, r_norm[start:j2], autojunk=False)

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import ast
 import contextlib
-import difflib
 import errno
 import functools
 import io
@@ -429,6 +428,8 @@ def _symbol_names(symbols) -> list[str]:
 
 
 def _did_you_mean(word: str, choices: Sequence[str]) -> str | None:
+    import difflib  # imported here: only an error message needs it
+
     close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.6)
     return f"did you mean '{close[0]}'?" if close else None
 
