@@ -39,7 +39,7 @@ import numpy as np
 from reedtool.checks.context import CheckContext
 from reedtool.checks.finding import Issue
 from reedtool.checks.registry import rule
-from reedtool.checks.rotor_rules import _physics_ready
+from reedtool.checks.rotor_rules import physics_ready
 
 if TYPE_CHECKING:
     from reedtool.flightstack.ardupilot import ArduPilotParams
@@ -616,7 +616,7 @@ def px4_command_below_max(ctx: CheckContext) -> Iterator[Issue]:
 
 def _hover_speeds(ctx: CheckContext) -> dict[int, float] | None:
     """id(rotor) -> hover speed [rad/s] from the static trim, or None."""
-    if not _physics_ready(ctx):
+    if not physics_ready(ctx):
         return None
     trim = ctx.trim
     if not trim.feasible:

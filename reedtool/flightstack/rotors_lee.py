@@ -23,7 +23,7 @@ import numpy as np
 from reedtool.errors import ReedtoolError
 from reedtool.flightstack.controller_tables import (
     ControllerTable,
-    _find_vehicle_mapping,
+    find_vehicle_mapping,
     parse_controller_yaml,
 )
 from reedtool.model import SourceLoc
@@ -128,7 +128,7 @@ def _has_key(text: str, path: Path, key: str) -> bool:
                             file=path, line=mark.line + 1 if mark else None,
                             hint="fix the YAML syntax at that position") from exc
     if key == "rotor_configuration":
-        return _find_vehicle_mapping(root) is not None
+        return find_vehicle_mapping(root) is not None
     return _find_mapping_with(root, key) is not None
 
 

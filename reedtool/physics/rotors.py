@@ -30,18 +30,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from reedtool.io.fileio import MAX_MAGNITUDE
-from reedtool.model import Plugin, Robot, SourceLoc, XmlNode
+from reedtool.model import Plugin, Robot, SourceLoc, XmlNode, motor_plugin_family
 from reedtool.physics.kinematics import link_poses
 
-# Plugin library (see Plugin.library) -> rotor kind.
-MOTOR_PLUGINS = {
-    "rotors_gazebo_motor_model": "rotors",
-    "gazebo_motor_model": "px4",
-    "gz-sim-multicopter-motor-model-system": "gz",
-    "ignition-gazebo-multicopter-motor-model-system": "gz",
-}
-MOTOR_PLUGIN_NAMES = {"gz::sim::systems::MulticopterMotorModel": "gz",
-                      "ignition::gazebo::systems::MulticopterMotorModel": "gz"}
 ARDUPILOT_PLUGINS = {"ArduPilotPlugin"}        # libArduPilotPlugin.so (classic) and gz
 LIFT_DRAG_PLUGINS = {"LiftDragPlugin", "gz-sim-lift-drag-system",
                      "ignition-gazebo-lift-drag-system"}
@@ -147,7 +138,8 @@ class RotorCountDeclaration:
 
 
 def motor_plugin_kind(plugin: Plugin) -> str | None:
-    return MOTOR_PLUGINS.get(plugin.library) or MOTOR_PLUGIN_NAMES.get(plugin.name or "")
+    """The rotor family of a motor-model plugin (model.MOTOR_PLUGINS), else None."""
+    return motor_plugin_family(plugin.filename, plugin.name)
 
 
 def is_ardupilot_plugin(plugin: Plugin) -> bool:

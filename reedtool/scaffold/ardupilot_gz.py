@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from reedtool.errors import ReedtoolError
-from reedtool.scaffold.gz_port import Element, GzPort, _num
+from reedtool.scaffold.gz_port import Element, GzPort, float_text
 
 ARDUPILOT_PLUGIN = ("ArduPilotPlugin", "ArduPilotPlugin")
 LIFT_DRAG = ("gz-sim-lift-drag-system", "gz::sim::systems::LiftDrag")
@@ -71,7 +71,7 @@ def _unit(v) -> np.ndarray:
 
 
 def _vec(v) -> str:
-    return " ".join(_num(x) for x in v)
+    return " ".join(float_text(x) for x in v)
 
 
 def frame_match(rotors: list[ApRotor]) -> tuple[int, int, dict[int, int]]:
@@ -106,11 +106,11 @@ def blades(rotor: ApRotor, multiplier_sign: int) -> list[Element]:
         # Where the blade moves when the joint turns the way the multiplier drives it.
         forward = multiplier_sign * _unit(np.cross(axis, cp))
         plugin = Element("plugin", {"filename": LIFT_DRAG[0], "name": LIFT_DRAG[1]})
-        for tag, value in (("a0", _num(BLADE_A0_RAD)), ("alpha_stall", _num(BLADE_ALPHA_STALL_RAD)),
-                           ("cla", _num(BLADE_CLA)), ("cda", _num(cda)), ("cma", "0"),
-                           ("cla_stall", _num(BLADE_CLA_STALL)), ("cda_stall", "0"),
-                           ("cma_stall", "0"), ("area", _num(area)),
-                           ("air_density", _num(AIR_DENSITY_KG_M3)), ("cp", _vec(cp)),
+        for tag, value in (("a0", float_text(BLADE_A0_RAD)), ("alpha_stall", float_text(BLADE_ALPHA_STALL_RAD)),
+                           ("cla", float_text(BLADE_CLA)), ("cda", float_text(cda)), ("cma", "0"),
+                           ("cla_stall", float_text(BLADE_CLA_STALL)), ("cda_stall", "0"),
+                           ("cma_stall", "0"), ("area", float_text(area)),
+                           ("air_density", float_text(AIR_DENSITY_KG_M3)), ("cp", _vec(cp)),
                            ("forward", _vec(forward)), ("upward", _vec(thrust)),
                            ("link_name", rotor.link)):
             plugin.add(tag, value)
@@ -128,12 +128,12 @@ def control(rotor: ApRotor) -> tuple[Element, int]:
     p_gain = rotor.inertia_axis_kg_m2 / rotor.time_constant_s
     node = Element("control", {"channel": str(rotor.channel)})
     for tag, value in (("jointName", rotor.joint), ("useForce", "1"),
-                       ("multiplier", _num(sign * rotor.max_rot_velocity_rad_s)),
+                       ("multiplier", float_text(sign * rotor.max_rot_velocity_rad_s)),
                        ("offset", "0"), ("servo_min", "1100"), ("servo_max", "1900"),
-                       ("type", "VELOCITY"), ("p_gain", _num(p_gain)), ("i_gain", "0"),
+                       ("type", "VELOCITY"), ("p_gain", float_text(p_gain)), ("i_gain", "0"),
                        ("d_gain", "0"), ("i_max", "0"), ("i_min", "0"),
-                       ("cmd_max", _num(p_gain * rotor.max_rot_velocity_rad_s)),
-                       ("cmd_min", _num(-p_gain * rotor.max_rot_velocity_rad_s)),
+                       ("cmd_max", float_text(p_gain * rotor.max_rot_velocity_rad_s)),
+                       ("cmd_min", float_text(-p_gain * rotor.max_rot_velocity_rad_s)),
                        ("controlVelocitySlowdownSim", "1")):
         node.add(tag, value)
     return node, sign
