@@ -160,6 +160,20 @@ def find_vehicle_mapping(node, depth: int = 0):
     return None
 
 
+def compose_yaml(text: str, file: Path | str):
+    """The YAML node tree of `text` (nodes keep their lines); malformed YAML is one error
+    naming the file and the position."""
+    import yaml
+
+    try:
+        return yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        raise ReedtoolError(f"malformed YAML: {getattr(exc, 'problem', None) or exc}", file=file,
+                            line=mark.line + 1 if mark else None,
+                            hint="fix the YAML syntax at that position") from exc
+
+
 def parse_controller_yaml(text: str, file: Path | str) -> ControllerTable:
     """A RotorS vehicle parameter YAML as a ControllerTable with a line for every value."""
     import yaml
@@ -169,13 +183,7 @@ def parse_controller_yaml(text: str, file: Path | str) -> ControllerTable:
     def loc(node) -> SourceLoc:
         return SourceLoc(file, node.start_mark.line + 1)
 
-    try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        raise ReedtoolError(f"malformed YAML: {getattr(exc, 'problem', None) or exc}", file=file,
-                            line=mark.line + 1 if mark else None,
-                            hint="fix the YAML syntax at that position") from exc
+    root = compose_yaml(text, file)
     vehicle = find_vehicle_mapping(root)
     if vehicle is None:
         raise ReedtoolError("no rotor_configuration found; expected a RotorS vehicle parameter "

@@ -23,6 +23,7 @@ import numpy as np
 from reedtool.errors import ReedtoolError
 from reedtool.flightstack.controller_tables import (
     ControllerTable,
+    compose_yaml,
     find_vehicle_mapping,
     parse_controller_yaml,
 )
@@ -118,15 +119,7 @@ def load_lee_parameters(paths) -> LeeParameters:
 
 
 def _has_key(text: str, path: Path, key: str) -> bool:
-    import yaml
-
-    try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        raise ReedtoolError(f"malformed YAML: {getattr(exc, 'problem', None) or exc}",
-                            file=path, line=mark.line + 1 if mark else None,
-                            hint="fix the YAML syntax at that position") from exc
+    root = compose_yaml(text, path)
     if key == "rotor_configuration":
         return find_vehicle_mapping(root) is not None
     return _find_mapping_with(root, key) is not None
