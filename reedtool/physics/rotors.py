@@ -207,6 +207,16 @@ def resolve_name(name: str | None, table) -> str | None:
     return matches[0] if len(matches) == 1 else None
 
 
+def inertia_about_joint_kg_m2(inertial, axis) -> float:
+    """A rotor link's moment of inertia about its joint axis through the link origin (the
+    COM tensor plus the parallel-axis term), or NaN where `axis` is no direction."""
+    axis = _unit(np.asarray(axis, dtype=float))
+    r = np.asarray(inertial.com_m, dtype=float)
+    I_link = inertial.inertia_in_link_axes() + inertial.mass_kg * (
+        float(r @ r) * np.eye(3) - np.outer(r, r))
+    return float(axis @ I_link @ axis) if np.all(np.isfinite(axis)) else math.nan
+
+
 def _unit(v: np.ndarray) -> np.ndarray:
     norm = float(np.linalg.norm(v))
     return v / norm if np.all(np.isfinite(v)) and norm > 0 else np.full(3, math.nan)
@@ -605,13 +615,7 @@ def ardupilot_time_constant(robot: Robot, rotor: Rotor) -> DerivedTimeConstant:
     if joint is None or link is None or link.inertial is None:
         return DerivedTimeConstant(math.nan, "the rotor joint or its link's <inertial> is "
                                              "missing")
-    axis = _unit(np.asarray(joint.axis, dtype=float))
-    inertial = link.inertial
-    r = np.asarray(inertial.com_m, dtype=float)
-    # About the joint axis through the link origin: the COM tensor plus the parallel axis.
-    I_link = inertial.inertia_in_link_axes() + inertial.mass_kg * (
-        float(r @ r) * np.eye(3) - np.outer(r, r))
-    I_axis = float(axis @ I_link @ axis) if np.all(np.isfinite(axis)) else math.nan
+    I_axis = inertia_about_joint_kg_m2(link.inertial, joint.axis)
     if not (math.isfinite(I_axis) and I_axis > 0):
         return DerivedTimeConstant(math.nan, "the rotor link has no positive moment of "
                                              "inertia about its joint axis")

@@ -176,23 +176,12 @@ def _prop_radius_m(link) -> float:
     return DEFAULT_PROP_RADIUS_M
 
 
-def _inertia_about_joint(link, axis) -> float:
-    """As physics.rotors.ardupilot_time_constant computes it: about the joint axis through
-    the link origin."""
-    inertial = link.inertial
-    r = np.asarray(inertial.com_m, dtype=float)
-    I_link = inertial.inertia_in_link_axes() + inertial.mass_kg * (
-        float(r @ r) * np.eye(3) - np.outer(r, r))
-    a = _unit(axis)
-    return float(a @ I_link @ a)
-
-
 def ardupilot_port(robot, port: GzPort) -> tuple[list[Element], str]:
     """migrate --autopilot ardupilot: the plugins to add to the port and the .parm text.
     Each velocity motor plugin of the source becomes an ArduPilot rotor (port.ardupilot_rotors)."""
     from reedtool.flightstack.ardupilot import parm_text
     from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
-    from reedtool.physics.rotors import discover_rotors
+    from reedtool.physics.rotors import discover_rotors, inertia_about_joint_kg_m2
 
     props = whole_robot_pinocchio(robot)
     by_plugin = {id(r.plugin): r for r in discover_rotors(robot)}
@@ -220,7 +209,8 @@ def ardupilot_port(robot, port: GzPort) -> tuple[list[Element], str]:
             motor_constant=rotor.motor_constant, moment_constant=rotor.moment_constant,
             max_rot_velocity_rad_s=rotor.max_rot_velocity_rad_s,
             prop_radius_m=_prop_radius_m(link),
-            inertia_axis_kg_m2=_inertia_about_joint(link, joint.axis), time_constant_s=tau))
+            inertia_axis_kg_m2=inertia_about_joint_kg_m2(link.inertial, joint.axis),
+            time_constant_s=tau))
         rows[rotor.joint] = row
     frame_class, frame_type, outputs = frame_match(rotors)
     plugins, controls = ardupilot_elements(rotors, _imu_name(port))
