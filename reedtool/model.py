@@ -207,6 +207,34 @@ class XmlNode:
             yield from child.iter()
 
 
+def library_name(filename: str | None) -> str:
+    """A plugin's library file name without directory, 'lib' prefix or '.so' suffix."""
+    base = (filename or "").rsplit("/", 1)[-1]
+    if base.startswith("lib"):
+        base = base[3:]
+    if base.endswith(".so"):
+        base = base[:-3]
+    return base
+
+
+# Motor-model plugins, the one table every stage reads (rotor discovery, migrate's port,
+# which model of an SDF world is the vehicle): library (see `library_name`) -> rotor family.
+MOTOR_PLUGINS = {
+    "rotors_gazebo_motor_model": "rotors",
+    "gazebo_motor_model": "px4",
+    "gz-sim-multicopter-motor-model-system": "gz",
+    "ignition-gazebo-multicopter-motor-model-system": "gz",
+}
+MOTOR_PLUGIN_NAMES = {"gz::sim::systems::MulticopterMotorModel": "gz",
+                      "ignition::gazebo::systems::MulticopterMotorModel": "gz"}
+
+
+def motor_plugin_family(filename: str | None, name: str | None) -> str | None:
+    """'rotors', 'px4' or 'gz' for a motor-model plugin (by its filename, or a gz system's
+    class name), else None."""
+    return MOTOR_PLUGINS.get(library_name(filename)) or MOTOR_PLUGIN_NAMES.get(name or "")
+
+
 @dataclass
 class Plugin:
     name: str | None
@@ -224,12 +252,7 @@ class Plugin:
     @property
     def library(self) -> str:
         """Library file name without directory, 'lib' prefix or '.so' suffix."""
-        base = (self.filename or "").rsplit("/", 1)[-1]
-        if base.startswith("lib"):
-            base = base[3:]
-        if base.endswith(".so"):
-            base = base[:-3]
-        return base
+        return library_name(self.filename)
 
 
 @dataclass

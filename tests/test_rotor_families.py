@@ -458,3 +458,16 @@ def test_ardupilot_rotor_spun_about_another_axis_is_r341_not_r318(tmp_path):
     found = [(f.code, f.subject) for f in run_checks(load_robot(path))
              if f.code in ("R318", "R341")]
     assert found == [("R341", "rotor_2_joint")]
+
+
+def test_migrate_ports_exactly_the_motor_plugins_discovery_reads():
+    """One table of motor plugins: the Classic motor models migrate ports are those rotor
+    discovery reads as RotorS / PX4 classic rotors (librotors_gazebo_motor_model.so,
+    libgazebo_motor_model.so), and the gz system it writes is one discovery reads as gz."""
+    from reedtool.model import motor_plugin_family
+    from reedtool.scaffold.gz_port import MOTOR_SYSTEM, PLUGIN_FAMILIES
+
+    (motor,) = [f for f in PLUGIN_FAMILIES if f.action == "motor"]
+    assert {lib: motor_plugin_family(f"lib{lib}.so", None) for lib in motor.libraries} == \
+        {"rotors_gazebo_motor_model": "rotors", "gazebo_motor_model": "px4"}
+    assert motor_plugin_family(*MOTOR_SYSTEM) == "gz"

@@ -181,6 +181,26 @@ def test_world_picks_the_non_static_model(tmp_path):
     assert robot.name == "drone" and [l.name for l in robot.links] == ["body"]
 
 
+@pytest.mark.parametrize("motor", [
+    '<plugin name="m0" filename="libgazebo_motor_model.so"/>',            # PX4 classic
+    '<plugin name="m0" filename="librotors_gazebo_motor_model.so"/>',     # RotorS
+    '<plugin filename="gz-sim-multicopter-motor-model-system" '
+    'name="gz::sim::systems::MulticopterMotorModel"/>',                  # gz-sim
+])
+def test_world_picks_the_model_whose_plugin_rotor_discovery_reads(tmp_path, motor):
+    """The vehicle of a world is the model with a motor plugin as rotor discovery reads
+    one (one table, model.MOTOR_PLUGINS): a plugin merely named like a motor model (here a
+    walker's logger) does not make a second vehicle, which would refuse the world."""
+    text = _sdf(f"""<world name="w">
+      <model name="walker"><link name="torso"><inertial><mass>3</mass></inertial></link>
+        <plugin name="walker_motor_model" filename="libwalker_motor_model_logger.so"/></model>
+      <model name="drone"><link name="body"><inertial><mass>2</mass></inertial></link>
+        {motor}</model>
+    </world>""")
+    robot = parse_sdf(text, tmp_path / "w.sdf")
+    assert robot.name == "drone"
+
+
 @pytest.mark.parametrize("text, fragment", [
     (_sdf('<world name="w"><include><uri>https://fuel/X3</uri></include></world>'), "<include>"),
     (_sdf('<world name="w"/>'), "no <model>"),

@@ -5,11 +5,7 @@ See docs/fault-tolerance.md.
 
 from __future__ import annotations
 
-import math
-
-
-def _finite(value: float) -> float | None:
-    return float(value) if math.isfinite(value) else None
+from reedtool.io.json_values import finite_or_none
 
 
 def analyse(rotors, mass_kg: float, com_m, efficiency=None, degrade: float = 0.0) -> dict:
@@ -32,9 +28,9 @@ def analyse(rotors, mass_kg: float, com_m, efficiency=None, degrade: float = 0.0
         return {"acai": float(a.acai), "rank": a.rank, "controllable": a.controllable,
                 "acai_without_yaw": float(a.acai_without_yaw),
                 "controllable_without_yaw": a.controllable_without_yaw,
-                "min_thrust_to_weight": _finite(a.min_thrust_scale * thrust_to_weight),
+                "min_thrust_to_weight": finite_or_none(a.min_thrust_scale * thrust_to_weight),
                 "min_thrust_to_weight_without_yaw":
-                    _finite(a.min_thrust_scale_without_yaw * thrust_to_weight)}
+                    finite_or_none(a.min_thrust_scale_without_yaw * thrust_to_weight)}
 
     intact, failed = failure_cases(B, K, weight_N, eta, failed_efficiency=degrade)
     failures = []

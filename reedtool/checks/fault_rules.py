@@ -15,7 +15,7 @@ import numpy as np
 from reedtool.checks.context import CheckContext
 from reedtool.checks.finding import Issue
 from reedtool.checks.registry import rule
-from reedtool.checks.rotor_rules import _physics_ready, _rotors
+from reedtool.checks.rotor_rules import all_rotors, physics_ready
 from reedtool.physics.allocation import allocation_matrix
 from reedtool.physics.authority import full_control_after_failures_many
 from reedtool.physics.trim import STANDARD_GRAVITY_M_S2
@@ -76,8 +76,8 @@ def spin_order_not_fault_tolerant(ctx: CheckContext) -> Iterator[Issue]:
     Severity (info, explains): a spin order is a choice; it says which one would survive
     a motor failure.
     """
-    rotors = _rotors(ctx)
-    if not MIN_ROTORS <= len(rotors) <= MAX_ROTORS_SEARCHED or not _physics_ready(ctx):
+    rotors = all_rotors(ctx)
+    if not MIN_ROTORS <= len(rotors) <= MAX_ROTORS_SEARCHED or not physics_ready(ctx):
         return
     if not all(r.max_thrust_N > 0 for r in rotors):
         return

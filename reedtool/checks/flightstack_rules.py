@@ -39,7 +39,7 @@ import numpy as np
 from reedtool.checks.context import CheckContext
 from reedtool.checks.finding import Issue
 from reedtool.checks.registry import rule
-from reedtool.checks.rotor_rules import _physics_ready
+from reedtool.checks.rotor_rules import physics_ready
 
 if TYPE_CHECKING:
     from reedtool.flightstack.ardupilot import ArduPilotParams
@@ -616,7 +616,7 @@ def px4_command_below_max(ctx: CheckContext) -> Iterator[Issue]:
 
 def _hover_speeds(ctx: CheckContext) -> dict[int, float] | None:
     """id(rotor) -> hover speed [rad/s] from the static trim, or None."""
-    if not _physics_ready(ctx):
+    if not physics_ready(ctx):
         return None
     trim = ctx.trim
     if not trim.feasible:
@@ -858,8 +858,13 @@ def px4_classic_command_above_max(ctx: CheckContext) -> Iterator[Issue]:
                     f"maxRotVelocity {limit:g} of {_rotor_label(rotor)}: the top "
                     f"{100 * lost:.0f} % of PX4's output does nothing", channel.loc,
                     f"channel {channel.position}",
-                    hint=f"input_scaling {(limit - channel.zero_armed) / (1 + channel.offset):g} "
-                         f"makes u = 1 reach maxRotVelocity")
+                    hint=_full_scale_hint(channel, limit))
+
+
+def _full_scale_hint(channel, limit_rad_s: float) -> str:
+    """The input_scaling at which PX4's full output (u = 1) commands maxRotVelocity."""
+    scaling = (limit_rad_s - channel.zero_armed) / (1 + channel.offset)
+    return f"input_scaling {scaling:g} makes u = 1 reach maxRotVelocity"
 
 
 @rule("C437", "px4-classic-command-below-max", "warning",
@@ -881,8 +886,7 @@ def px4_classic_command_below_max(ctx: CheckContext) -> Iterator[Issue]:
                     f"maxRotVelocity {limit:g} of {_rotor_label(rotor)}: PX4 reaches "
                     f"{100 * (high / limit) ** 2:.0f} % of the rotor's thrust", channel.loc,
                     f"channel {channel.position}",
-                    hint=f"input_scaling {(limit - channel.zero_armed) / (1 + channel.offset):g} "
-                         f"makes u = 1 reach maxRotVelocity")
+                    hint=_full_scale_hint(channel, limit))
 
 
 @rule("C438", "px4-classic-idle-command", "error",

@@ -43,6 +43,16 @@ def _lee_tables(ctx: CheckContext) -> list:
     return [t for t in ctx.controller_tables if getattr(t, "lee_gains", None) is not None]
 
 
+def _flyable_inertia(ctx: CheckContext) -> np.ndarray | None:
+    """The whole robot's inertia (kg*m^2) where the loops can be judged on it: mass and
+    finite, positive principal moments; else None (other rules report why)."""
+    whole = ctx.whole_robot
+    J = np.asarray(whole.inertia_kg_m2, dtype=float)
+    if whole.mass_kg <= 0 or not np.all(np.isfinite(J)) or np.any(np.diag(J) <= 0):
+        return None
+    return J
+
+
 def _motor_lag_s(ctx: CheckContext) -> float:
     """The slowest rotor's mean of its spin-up and spin-down time constants (the torque
     lags the speed command about hover with that time constant, linearised)."""
@@ -109,8 +119,8 @@ def lee_loop_unstable(ctx: CheckContext) -> Iterator[Issue]:
     )
 
     whole = ctx.whole_robot
-    J = np.asarray(whole.inertia_kg_m2, dtype=float)
-    if whole.mass_kg <= 0 or not np.all(np.isfinite(J)) or np.any(np.diag(J) <= 0):
+    J = _flyable_inertia(ctx)
+    if J is None:
         return
     lag_s = _motor_lag_s(ctx)
     for table in _lee_tables(ctx):
@@ -242,8 +252,8 @@ def lee_loop_underdamped(ctx: CheckContext) -> Iterator[Issue]:
     how long it takes to settle.
     """
     whole = ctx.whole_robot
-    J = np.asarray(whole.inertia_kg_m2, dtype=float)
-    if whole.mass_kg <= 0 or not np.all(np.isfinite(J)) or np.any(np.diag(J) <= 0):
+    J = _flyable_inertia(ctx)
+    if J is None:
         return
     for table in _lee_tables(ctx):
         gains = table.lee_gains

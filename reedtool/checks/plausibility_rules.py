@@ -18,7 +18,7 @@ import numpy as np
 from reedtool.checks.context import CheckContext
 from reedtool.checks.finding import Issue
 from reedtool.checks.registry import rule
-from reedtool.checks.rotor_rules import MAX_CONDITION_NUMBER, _normalised_allocation, _physics_ready
+from reedtool.checks.rotor_rules import MAX_CONDITION_NUMBER, normalised_allocation, physics_ready
 
 if TYPE_CHECKING:
     from reedtool.physics.rotors import Rotor
@@ -123,7 +123,7 @@ def thrust_to_weight_high(ctx: CheckContext) -> Iterator[Issue]:
 
     Severity (warning): the model loads and flies; only its numbers are implausible.
     """
-    if not _physics_ready(ctx):
+    if not physics_ready(ctx):
         return
     trim = ctx.trim
     if not math.isfinite(trim.thrust_to_weight) or trim.thrust_to_weight <= THRUST_TO_WEIGHT_HIGH:
@@ -153,7 +153,7 @@ def mass_implausible_for_size(ctx: CheckContext) -> Iterator[Issue]:
 
     Severity (warning): the model flies, like a vehicle of another size.
     """
-    if not _physics_ready(ctx) or not _lift(ctx):
+    if not physics_ready(ctx) or not _lift(ctx):
         return
     whole = ctx.whole_robot
     span = _span_m(ctx)
@@ -228,9 +228,9 @@ def uneven_hover_trim(ctx: CheckContext) -> Iterator[Issue]:
 
     Severity (warning, suspicious): it hovers, with less margin on one side.
     """
-    if not _physics_ready(ctx):
+    if not physics_ready(ctx):
         return
-    if float(np.linalg.cond(_normalised_allocation(ctx))) > MAX_CONDITION_NUMBER:
+    if float(np.linalg.cond(normalised_allocation(ctx))) > MAX_CONDITION_NUMBER:
         return
     rotors, trim = ctx.rotors, ctx.trim
     lift = _lift(ctx)
@@ -359,7 +359,7 @@ def size_implausible_for_mass(ctx: CheckContext) -> Iterator[Issue]:
     Severity (warning, suspicious): the model loads and may hover in simulation; no real
     vehicle has these proportions.
     """
-    if not _physics_ready(ctx) or not _lift(ctx):
+    if not physics_ready(ctx) or not _lift(ctx):
         return
     whole = ctx.whole_robot
     arm_m = _span_m(ctx)

@@ -46,7 +46,7 @@ def _fmt(value: float) -> str:
     return f"{value:.4g}"
 
 
-def _rotors(ctx: CheckContext) -> list["Rotor"]:
+def all_rotors(ctx: CheckContext) -> list["Rotor"]:
     """Every rotor (for the wiring rules)."""
     return ctx.rotors if ctx.tree_ok else []
 
@@ -67,7 +67,7 @@ def _constants_ok(rotor: "Rotor") -> bool:
             and math.isfinite(rotor.moment_constant) and rotor.moment_constant >= 0)
 
 
-def _physics_ready(ctx: CheckContext) -> bool:
+def physics_ready(ctx: CheckContext) -> bool:
     """Every rotor placed, turning a known way, with usable constants; the robot has mass;
     no rotor carried by an actuated joint (its zero pose is not the flight pose: R319)."""
     rotors = _lift(ctx)
@@ -119,7 +119,7 @@ def motor_number_duplicate(ctx: CheckContext) -> Iterator[Issue]:
     nothing.
     """
     seen: dict[int, "Rotor"] = {}
-    for rotor in _rotors(ctx):
+    for rotor in all_rotors(ctx):
         number = rotor.motor_number
         if number is None:
             continue
@@ -154,7 +154,7 @@ def motor_numbers_not_contiguous(ctx: CheckContext) -> Iterator[Issue]:
     from reedtool.physics.rotors import command_vector, controller_command_vector
 
     # ArduPilot channels are servo outputs mapped by SERVOn_FUNCTION: any channel is fine.
-    rotors = [r for r in _rotors(ctx) if r.kind != "ardupilot"]
+    rotors = [r for r in all_rotors(ctx) if r.kind != "ardupilot"]
     if not rotors:
         return
     vector = command_vector(ctx.robot) or controller_command_vector(rotors)
@@ -193,7 +193,7 @@ def rotor_direction_invalid(ctx: CheckContext) -> Iterator[Issue]:
     Severity (error, refused): the motor plugin refuses the direction and the rotor
     never turns.
     """
-    for rotor in _rotors(ctx):
+    for rotor in all_rotors(ctx):
         if rotor.kind == "ardupilot":
             multiplier = _number_or_nan(rotor.param("multiplier") or "1")
             if not (math.isfinite(multiplier) and multiplier != 0):
@@ -259,7 +259,7 @@ def _equal_speed_yaw(ctx: CheckContext, signs: np.ndarray) -> tuple[float, float
 
 
 def _yaw_imbalance(ctx: CheckContext):
-    if not _physics_ready(ctx):
+    if not physics_ready(ctx):
         return None
     rotors = _lift(ctx)
     signs = np.array([r.turning_sign for r in rotors], dtype=float)
@@ -284,7 +284,7 @@ def _best_flip(ctx: CheckContext, rotors) -> int | None:
 
 # ----------------------------------------------------------------- allocation
 
-def _normalised_allocation(ctx: CheckContext, signs: np.ndarray | None = None) -> np.ndarray:
+def normalised_allocation(ctx: CheckContext, signs: np.ndarray | None = None) -> np.ndarray:
     """The allocation matrix with each row scaled to unit norm (unit-free conditioning)."""
     A = ctx.allocation.copy()
     if signs is not None:
@@ -297,7 +297,7 @@ def _normalised_allocation(ctx: CheckContext, signs: np.ndarray | None = None) -
 
 
 def _rank(ctx: CheckContext, signs: np.ndarray | None = None) -> int:
-    A = _normalised_allocation(ctx, signs)
+    A = normalised_allocation(ctx, signs)
     singular = np.linalg.svd(A, compute_uv=False)
     return int(np.sum(singular > RANK_TOL * max(singular.max(initial=0), 1e-300)))
 
@@ -316,14 +316,14 @@ def allocation_rank_deficient(ctx: CheckContext) -> Iterator[Issue]:
 
     Severity (error, cannot-fly): some axis cannot be controlled.
     """
-    if not _physics_ready(ctx):
+    if not physics_ready(ctx):
         return
     if ctx.omnidirectional:
         yield from _wrench_rank_deficient(ctx)
         return
     if _rank(ctx) == 4:
         return
-    A = _normalised_allocation(ctx)
+    A = normalised_allocation(ctx)
     u, s, _vt = np.linalg.svd(A)
     rank = _rank(ctx)
     coupled = set()
@@ -370,9 +370,9 @@ def allocation_ill_conditioned(ctx: CheckContext) -> Iterator[Issue]:
     Severity (warning, suspicious): every axis is controllable, with little authority on
     one.
     """
-    if not _physics_ready(ctx) or ctx.omnidirectional or _rank(ctx) < 4:
+    if not physics_ready(ctx) or ctx.omnidirectional or _rank(ctx) < 4:
         return
-    cond = float(np.linalg.cond(_normalised_allocation(ctx)))
+    cond = float(np.linalg.cond(normalised_allocation(ctx)))
     if cond > MAX_CONDITION_NUMBER:
         yield Issue(f"allocation matrix condition number {cond:.3g} > {MAX_CONDITION_NUMBER:g} "
                     "(rows scaled to unit norm)", _lift(ctx)[0].loc, "rotors",
@@ -394,7 +394,7 @@ def trim_infeasible(ctx: CheckContext) -> Iterator[Issue]:
 
     Severity (error, cannot-fly): the vehicle cannot hover level.
     """
-    if not _physics_ready(ctx):
+    if not physics_ready(ctx):
         return
     if not ctx.omnidirectional and (_rank(ctx) < 4 or _yaw_imbalance(ctx) is not None):
         return
@@ -411,7 +411,7 @@ def trim_infeasible(ctx: CheckContext) -> Iterator[Issue]:
 
 
 def _weight_and_trim(ctx: CheckContext):
-    if not _physics_ready(ctx):
+    if not physics_ready(ctx):
         return None
     trim = ctx.trim
     if not math.isfinite(trim.thrust_to_weight):
@@ -587,7 +587,7 @@ def rotor_joint_not_continuous(ctx: CheckContext) -> Iterator[Issue]:
 
     Severity (error, cannot-fly): the rotor stops at the limit.
     """
-    for rotor in _rotors(ctx):
+    for rotor in all_rotors(ctx):
         joint = ctx.robot.joint_map.get(rotor.joint or "")
         if joint is not None and joint.type == "revolute" and joint.limit is not None:
             if rotor.kind == "ardupilot":
@@ -614,7 +614,7 @@ def rotor_plugin_target_missing(ctx: CheckContext) -> Iterator[Issue]:
     """
     from reedtool.physics.rotors import resolve_name
 
-    for rotor in _rotors(ctx):
+    for rotor in all_rotors(ctx):
         for tag, name, table in (("jointName", rotor.param("jointName"), ctx.robot.joint_map),
                                  ("linkName", rotor.param("linkName"), ctx.robot.link_map)):
             if rotor.kind == "ardupilot" and name is not None \
@@ -642,7 +642,7 @@ def rotor_link_not_joint_child(ctx: CheckContext) -> Iterator[Issue]:
     Severity (error, cannot-fly): thrust is applied to another body than the one that
     spins.
     """
-    for rotor in _rotors(ctx):
+    for rotor in all_rotors(ctx):
         joint = ctx.robot.joint_map.get(rotor.joint or "")
         link = rotor.param("linkName")
         if joint is not None and link is not None and link in ctx.robot.link_map \
@@ -664,7 +664,7 @@ def rotor_constant_invalid(ctx: CheckContext) -> Iterator[Issue]:
 
     Severity (error, cannot-fly): the rotor gives no thrust, or pulls down.
     """
-    for rotor in filter(_written, _rotors(ctx)):
+    for rotor in filter(_written, all_rotors(ctx)):
         for attr, tag, unit in CONSTANTS:
             value = getattr(rotor, attr)
             raw = rotor.param(tag)
@@ -744,7 +744,7 @@ def rotor_constants_estimated(ctx: CheckContext) -> Iterator[Issue]:
     Severity (info, explains): it says how numbers the model does not write were
     estimated.
     """
-    for rotor in _rotors(ctx):
+    for rotor in all_rotors(ctx):
         if rotor.kind != "ardupilot":
             continue
         if rotor.constants_estimated and math.isfinite(rotor.motor_constant):
@@ -775,7 +775,7 @@ def ardupilot_spin_against_blades(ctx: CheckContext) -> Iterator[Issue]:
 
     Severity (error, cannot-fly): the rotor pushes the wrong way.
     """
-    for rotor in _rotors(ctx):
+    for rotor in all_rotors(ctx):
         if rotor.kind != "ardupilot" or rotor.blade_turning_sign == 0 or rotor.turning_sign == 0:
             continue
         angle = joint_axis_angle_deg(ctx, rotor)
@@ -805,7 +805,7 @@ def rotor_role(ctx: CheckContext) -> Iterator[Issue]:
 
     Severity (info, explains): it says which rotors the hover rules leave out, and why.
     """
-    for rotor in _rotors(ctx):
+    for rotor in all_rotors(ctx):
         if rotor.role == "propulsion":
             axis = rotor.axis / np.linalg.norm(rotor.axis)
             yield Issue(f"rotor '{rotor.name}' is propulsion (thrust axis "

@@ -244,11 +244,11 @@ def file_uri_absolute(ctx: CheckContext) -> Iterator[Issue]:
     Severity (warning, suspicious): the model loads here; elsewhere it does not.
     """
     from reedtool.io.meshes import machine_path, uri_problem
-    from reedtool.checks.structure import _mesh_shapes
+    from reedtool.checks.structure import mesh_shapes
 
     hint = ("copy the file into the package and name it package://PKG/... or "
             "model://NAME/..., or by a path relative to the model file")
-    for link, kind, shape, mesh in _mesh_shapes(ctx):
+    for link, kind, shape, mesh in mesh_shapes(ctx):
         if machine_path(mesh.uri) and not uri_problem(mesh.uri, mesh.path):
             yield Issue(f"link '{link.name}' {kind} mesh '{mesh.uri}' is named by its "
                         "absolute path", shape.loc, link.name, hint=hint)

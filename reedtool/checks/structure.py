@@ -320,7 +320,7 @@ def gazebo_reference_missing(ctx: CheckContext) -> Iterator[Issue]:
                         hint=_closest_hint(block.reference, names))
 
 
-def _mesh_shapes(ctx: CheckContext) -> Iterator[tuple]:
+def mesh_shapes(ctx: CheckContext) -> Iterator[tuple]:
     """(link, kind, shape, mesh) for every mesh reference, each shape once.
 
     Shapes are compared by identity: two visuals naming the same mesh file are two shapes.
@@ -356,7 +356,7 @@ def mesh_unresolved(ctx: CheckContext) -> Iterator[Issue]:
     """
     from reedtool.io.resources import is_remote_uri
 
-    for link, kind, shape, mesh in _mesh_shapes(ctx):
+    for link, kind, shape, mesh in mesh_shapes(ctx):
         if _refused(ctx, mesh) or is_remote_uri(mesh.uri):
             continue        # a web URI Gazebo fetches: S190 says it was not checked
         if mesh.path is None:
@@ -392,7 +392,7 @@ def remote_resource_not_checked(ctx: CheckContext) -> Iterator[Issue]:
 
     yield from _reader_issues(ctx, "remote-uri")
     seen = set()
-    for link, kind, shape, mesh in _mesh_shapes(ctx):
+    for link, kind, shape, mesh in mesh_shapes(ctx):
         if is_remote_uri(mesh.uri) and mesh.uri not in seen:
             seen.add(mesh.uri)
             yield Issue(f"link '{link.name}' {kind} mesh '{mesh.uri}' {REMOTE_NOT_CHECKED}",
@@ -512,7 +512,7 @@ def mesh_format_unsupported(ctx: CheckContext) -> Iterator[Issue]:
     """
     from reedtool.io.meshes import format_problem, uri_problem
 
-    for link, kind, shape, mesh in _mesh_shapes(ctx):
+    for link, kind, shape, mesh in mesh_shapes(ctx):
         if uri_problem(mesh.uri, mesh.path):
             continue   # S131
         problem = format_problem(mesh.uri, ctx.simulator)
@@ -536,7 +536,7 @@ def mesh_uri_escapes(ctx: CheckContext) -> Iterator[Issue]:
     """
     from reedtool.io.meshes import uri_problem
 
-    for link, kind, shape, mesh in _mesh_shapes(ctx):
+    for link, kind, shape, mesh in mesh_shapes(ctx):
         problem = uri_problem(mesh.uri, mesh.path)
         if problem:
             yield Issue(f"link '{link.name}' {kind} mesh '{mesh.uri}': {problem}",

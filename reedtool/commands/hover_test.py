@@ -27,6 +27,7 @@ from reedtool.commands.params import (
     validation_options,
 )
 from reedtool.errors import ReedtoolError
+from reedtool.io.json_values import finite_tree
 
 SPREAD_HELP = "Half-width of the uniform perturbation"
 # A COM shifted by a metre is another vehicle, not a perturbation of this one.
@@ -290,7 +291,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
 
         document = {**envelope(SCHEMA), **report,
                     "validation": validation_json(verdict.refusing, verdict.reported, False)}
-        click.echo(json.dumps(_finite(document), indent=2, allow_nan=False))
+        click.echo(json.dumps(finite_tree(document), indent=2, allow_nan=False))
     else:
         click.echo(render_text(report))
     return 0 if report["passed"] else 1
@@ -451,14 +452,3 @@ def _num(value, spec: str) -> str:
 
 def _pct(value) -> str:
     return f"{100 * value:.1f}%" if value is not None and math.isfinite(value) else "n/a"
-
-
-def _finite(value):
-    """JSON has no NaN or infinity: those become null (e.g. the speeds of an invalid trim)."""
-    if isinstance(value, dict):
-        return {k: _finite(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_finite(v) for v in value]
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value

@@ -11,6 +11,7 @@ import numpy as np
 
 from reedtool.commands.params import model_inputs, one_model_request, validation_options
 from reedtool.errors import ReedtoolError
+from reedtool.io.json_values import finite_or_none
 
 
 def _vec(v, fmt: str = ".6g") -> str:
@@ -37,10 +38,6 @@ def _props_json(props) -> dict | None:
     if props.from_hull:
         out["from_hull"] = True
     return out
-
-
-def _finite_or_none(value):
-    return None if value is None or not np.isfinite(value) else value
 
 
 # Model-level findings `inertia` shares with `validate`: what makes the geometry it compares
@@ -125,8 +122,8 @@ def format_json(model: Path, robot, comparisons, whole, own, findings=()) -> str
             "severity": c.severity,
             "message": c.message, "geometry": c.geometry,
             "declared": _props_json(c.declared), "derived": _props_json(c.derived),
-            "inertia_rel_diff": _finite_or_none(c.inertia_rel_diff),
-            "trace_ratio": _finite_or_none(c.trace_ratio),
+            "inertia_rel_diff": finite_or_none(c.inertia_rel_diff),
+            "trace_ratio": finite_or_none(c.trace_ratio),
             "com_offset_m": c.com_offset_m,
         } for c in comparisons],
         "whole_robot": {**_props_json(whole), "source": "pinocchio"},

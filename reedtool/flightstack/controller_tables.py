@@ -143,7 +143,7 @@ def load_controller_yaml(path: Path | str) -> ControllerTable:
     return parse_controller_yaml(read_text_file(path, what="controller file"), path)
 
 
-def _find_vehicle_mapping(node, depth: int = 0):
+def find_vehicle_mapping(node, depth: int = 0):
     """The mapping holding `rotor_configuration`: top level, or under a node namespace
     (`node: {ros__parameters: {...}}` in ROS 2 parameter files)."""
     import yaml
@@ -154,10 +154,24 @@ def _find_vehicle_mapping(node, depth: int = 0):
     if "rotor_configuration" in keys:
         return node
     for _key, value in node.value:
-        found = _find_vehicle_mapping(value, depth + 1)
+        found = find_vehicle_mapping(value, depth + 1)
         if found is not None:
             return found
     return None
+
+
+def compose_yaml(text: str, file: Path | str):
+    """The YAML node tree of `text` (nodes keep their lines); malformed YAML is one error
+    naming the file and the position."""
+    import yaml
+
+    try:
+        return yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        raise ReedtoolError(f"malformed YAML: {getattr(exc, 'problem', None) or exc}", file=file,
+                            line=mark.line + 1 if mark else None,
+                            hint="fix the YAML syntax at that position") from exc
 
 
 def parse_controller_yaml(text: str, file: Path | str) -> ControllerTable:
@@ -169,14 +183,8 @@ def parse_controller_yaml(text: str, file: Path | str) -> ControllerTable:
     def loc(node) -> SourceLoc:
         return SourceLoc(file, node.start_mark.line + 1)
 
-    try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        raise ReedtoolError(f"malformed YAML: {getattr(exc, 'problem', None) or exc}", file=file,
-                            line=mark.line + 1 if mark else None,
-                            hint="fix the YAML syntax at that position") from exc
-    vehicle = _find_vehicle_mapping(root)
+    root = compose_yaml(text, file)
+    vehicle = find_vehicle_mapping(root)
     if vehicle is None:
         raise ReedtoolError("no rotor_configuration found; expected a RotorS vehicle parameter "
                             "file (mass, inertia, rotor_configuration)", file=file,

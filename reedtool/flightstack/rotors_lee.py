@@ -23,7 +23,8 @@ import numpy as np
 from reedtool.errors import ReedtoolError
 from reedtool.flightstack.controller_tables import (
     ControllerTable,
-    _find_vehicle_mapping,
+    compose_yaml,
+    find_vehicle_mapping,
     parse_controller_yaml,
 )
 from reedtool.model import SourceLoc
@@ -79,12 +80,7 @@ def load_lee_parameters(paths) -> LeeParameters:
     from reedtool.io.fileio import read_text_file
 
     paths = [Path(p) for p in paths]
-    texts = []
-    for path in paths:
-        if not path.exists() and not path.is_symlink():
-            raise ReedtoolError("controller file not found", file=path,
-                                hint="check the --controller path")
-        texts.append((path, read_text_file(path, what="controller file")))
+    texts = [(path, _read_controller_file(path)) for path in paths]
     notes = []
     if not any(_has_key(text, path, "rotor_configuration") for path, text in texts):
         sibling = _vehicle_beside(paths)
@@ -117,18 +113,20 @@ def load_lee_parameters(paths) -> LeeParameters:
     return LeeParameters(gains, vehicle, [str(p) for p in paths], notes)
 
 
-def _has_key(text: str, path: Path, key: str) -> bool:
-    import yaml
+def _read_controller_file(path: Path) -> str:
+    """The text of a --controller file; a missing one is one error naming it."""
+    from reedtool.io.fileio import read_text_file
 
-    try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        raise ReedtoolError(f"malformed YAML: {getattr(exc, 'problem', None) or exc}",
-                            file=path, line=mark.line + 1 if mark else None,
-                            hint="fix the YAML syntax at that position") from exc
+    if not path.exists() and not path.is_symlink():
+        raise ReedtoolError("controller file not found", file=path,
+                            hint="check the --controller path")
+    return read_text_file(path, what="controller file")
+
+
+def _has_key(text: str, path: Path, key: str) -> bool:
+    root = compose_yaml(text, path)
     if key == "rotor_configuration":
-        return _find_vehicle_mapping(root) is not None
+        return find_vehicle_mapping(root) is not None
     return _find_mapping_with(root, key) is not None
 
 
@@ -284,15 +282,11 @@ def load_controller_files(paths) -> list[ControllerTable]:
     beside them on the command line (the last one) or found beside them, and their gains
     ride on that table (checked by C450-C451)."""
     from reedtool.flightstack.controller_tables import load_controller_yaml
-    from reedtool.io.fileio import read_text_file
 
     paths = [Path(p) for p in paths]
     vehicle_files, gain_files = [], []
     for path in paths:
-        if not path.exists() and not path.is_symlink():
-            raise ReedtoolError("controller file not found", file=path,
-                                hint="check the --controller path")
-        text = read_text_file(path, what="controller file")
+        text = _read_controller_file(path)
         has_gains = any(_has_key(text, path, key) for key in GAIN_KEYS)
         if has_gains and not _has_key(text, path, "rotor_configuration"):
             gain_files.append(path)

@@ -67,20 +67,21 @@ def _parse_numbers(text: str, dtype) -> np.ndarray:
         return np.array(text.split(), dtype=dtype)
 
 
-def _floats(node, source) -> np.ndarray:
+def _numbers(node, source, dtype, what: str) -> np.ndarray:
+    """The element's numbers; a text that is not numbers is one error naming its line."""
     try:
-        return _parse_numbers(node.text or "", np.float64)
+        return _parse_numbers(node.text or "", dtype)
     except ValueError as exc:
-        raise ReedtoolError(f"bad number in <{_local(node.tag)}>", file=source,
+        raise ReedtoolError(f"bad {what} in <{_local(node.tag)}>", file=source,
                             line=node.sourceline, hint=HINT) from exc
+
+
+def _floats(node, source) -> np.ndarray:
+    return _numbers(node, source, np.float64, "number")
 
 
 def _ints(node, source) -> np.ndarray:
-    try:
-        return _parse_numbers(node.text or "", np.int64)
-    except ValueError as exc:
-        raise ReedtoolError(f"bad index in <{_local(node.tag)}>", file=source,
-                            line=node.sourceline, hint=HINT) from exc
+    return _numbers(node, source, np.int64, "index")
 
 
 _IDENTITY = np.eye(4)

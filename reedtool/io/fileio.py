@@ -269,7 +269,8 @@ def check_writable(path: Path, force: bool, *, in_place: bool = False,
                             hint="pass --force to replace it")
 
 
-def _umask() -> int:
+def current_umask() -> int:
+    """The process's umask (os.umask can only be read by setting it, so it is set back)."""
     mask = os.umask(0)
     os.umask(mask)
     return mask
@@ -329,7 +330,7 @@ def _stage(path: Path, data: bytes, created: list[Path]) -> str:
             shutil.copymode(path, tmp_name)
         else:
             # mkstemp makes the file 0600; a new file gets the mode any other tool gives it.
-            os.chmod(tmp_name, 0o666 & ~_umask())
+            os.chmod(tmp_name, 0o666 & ~current_umask())
     except OSError as exc:
         Path(tmp_name).unlink(missing_ok=True)
         raise write_error(exc, path) from exc

@@ -192,6 +192,20 @@ SYSTEM_DIRS = ("/etc", "/proc", "/sys", "/dev", "/boot", "/bin", "/sbin", "/usr/
                "/usr/sbin")
 
 
+def _package_relative(text: str) -> tuple[bool, str | None]:
+    """(whether `text` is a `package://` or `model://` path, the path within the package
+    when it climbs out of it with `..` or starts at `/`, else None)."""
+    import posixpath
+
+    for scheme in ("package://", "model://"):
+        if text.startswith(scheme):
+            _name, _, rel = text[len(scheme):].partition("/")
+            normal = posixpath.normpath(rel) if rel else ""
+            climbs = normal == ".." or normal.startswith("../") or rel.startswith("/")
+            return True, rel if climbs else None
+    return False, None
+
+
 def uri_problem(uri: str, path: Path | None = None) -> str | None:
     """Why a mesh reference must not be followed, or None.
 
@@ -203,12 +217,9 @@ def uri_problem(uri: str, path: Path | None = None) -> str | None:
     from urllib.parse import unquote, urlparse
 
     text = unquote(uri.strip())
-    for scheme in ("package://", "model://"):
-        if text.startswith(scheme):
-            _name, _, rel = text[len(scheme):].partition("/")
-            normal = posixpath.normpath(rel) if rel else ""
-            if normal == ".." or normal.startswith("../") or rel.startswith("/"):
-                return f"the path climbs out of its package ('{rel}')"
+    _package_path, climbing = _package_relative(text)
+    if climbing is not None:
+        return f"the path climbs out of its package ('{climbing}')"
     if text.startswith("file://"):
         text = urlparse(text).path
     candidates = [posixpath.normpath(text)] if text.startswith("/") else []
@@ -275,19 +286,16 @@ def outside_reason(uri: str, path: Path | None, referencing_file: str | Path,
     climb out of it with `..`; any other reference (absolute, `file://`, relative) is
     inside when the file lies in the package or model directory of the file naming it,
     else in `default_root` (the model directory the user gave)."""
-    import posixpath
     from urllib.parse import unquote
 
     if path is None:
         return None
     text = unquote(uri.strip())
-    for scheme in ("package://", "model://"):
-        if text.startswith(scheme):
-            _name, _, rel = text[len(scheme):].partition("/")
-            normal = posixpath.normpath(rel) if rel else ""
-            if normal == ".." or normal.startswith("../") or rel.startswith("/"):
-                return f"'{uri}' climbs out of its package"
-            return None
+    package_path, climbing = _package_relative(text)
+    if climbing is not None:
+        return f"'{uri}' climbs out of its package"
+    if package_path:
+        return None
     root = package_root(referencing_file) or Path(default_root).resolve()
     real = Path(path).resolve()
     if real == root or root in real.parents:

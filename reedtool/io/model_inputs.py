@@ -67,15 +67,25 @@ class Target:
     checked_for: str | None = None   # the named part this model is checked for (display)
 
 
+def _xml_root(path: Path):
+    """The file's root element (comments dropped, no entities, no network), or None where
+    it is not readable XML: the loader reports that, with its line."""
+    from lxml import etree
+
+    try:
+        return etree.parse(str(path), etree.XMLParser(remove_comments=True,
+                                                      resolve_entities=False,
+                                                      no_network=True)).getroot()
+    except (etree.XMLSyntaxError, OSError):
+        return None
+
+
 def _root_and_children(path: Path) -> tuple[str | None, list[str]]:
     """The root tag and its element children's tags (prefix kept), without expanding."""
     from lxml import etree
 
-    try:
-        root = etree.parse(str(path), etree.XMLParser(remove_comments=True,
-                                                     resolve_entities=False,
-                                                     no_network=True)).getroot()
-    except (etree.XMLSyntaxError, OSError):
+    root = _xml_root(path)
+    if root is None:
         return None, []
 
     def tag(el) -> str:
@@ -110,15 +120,10 @@ def is_scene_world(path: Path) -> bool:
     `<include>` (the launch file spawns the robot into it, as `new-package` writes them).
     Found in a directory it is the stage, not a model; named on its own it is still read
     (and says it has no model)."""
-    from lxml import etree
-
     if path.suffix.lower() not in (".sdf", ".world"):
         return False
-    try:
-        root = etree.parse(str(path), etree.XMLParser(remove_comments=True,
-                                                     resolve_entities=False,
-                                                     no_network=True)).getroot()
-    except (etree.XMLSyntaxError, OSError):
+    root = _xml_root(path)
+    if root is None:
         return False     # unreadable: let the loader report it
     worlds = root.findall("world")
     if root.tag != "sdf" or root.find("model") is not None or not worlds:

@@ -96,6 +96,7 @@ from reedtool.model import (
     Visual,
     XmlNode,
     inertia_tensor,
+    motor_plugin_family,
 )
 
 MODEL_FRAME = "__model__"
@@ -211,9 +212,8 @@ def _is_static(model: etree._Element) -> bool:
 
 
 def _has_motor_plugin(model: etree._Element) -> bool:
-    return any(any(key in (p.get("name") or "") + (p.get("filename") or "")
-                   for key in ("MulticopterMotorModel", "multicopter-motor-model", "motor_model"))
-               for p in model.iter("plugin"))
+    """A motor-model plugin as rotor discovery reads it (model.MOTOR_PLUGINS)."""
+    return any(motor_plugin_family(p.get("filename"), p.get("name")) for p in model.iter("plugin"))
 
 
 def _candidate_models(root: etree._Element, file: Path,

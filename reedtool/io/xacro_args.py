@@ -35,11 +35,11 @@ def known_arguments(path: Path, mappings: Mapping[str, str] | None = None,
     include of the tree could be followed (when not, a name may be missing)."""
     from reedtool.io.legacy_xacro import include_specs
     from reedtool.io.packages import PackageResolver
-    from reedtool.io.xacro_expand import _static_include_resolver, include_texts
+    from reedtool.io.xacro_expand import include_texts, static_include_resolver
 
     mappings = dict(mappings or {})
     texts = include_texts(Path(path), mappings, package_paths)
-    resolve = _static_include_resolver(PackageResolver(package_paths, model_path=Path(path)),
+    resolve = static_include_resolver(PackageResolver(package_paths, model_path=Path(path)),
                                        mappings)
     names: set[str] = set()
     complete = bool(texts)

@@ -676,7 +676,7 @@ def _xacro_message(exc: BaseException, inner: BaseException) -> str:
 
 # ----------------------------------------------------------------- api
 
-def _static_include_resolver(resolver: PackageResolver, mappings: dict[str, str]):
+def static_include_resolver(resolver: PackageResolver, mappings: dict[str, str]):
     """Evaluate an include filename without running xacro, for the legacy pre-scan."""
     def substitute(match: re.Match) -> str:
         command, _, arg = match.group(1).strip().partition(" ")
@@ -704,7 +704,7 @@ def include_texts(path: Path, mappings: dict[str, str] | None = None,
                   package_paths: Sequence[Path] = ()) -> dict[Path, str]:
     """`path` and the files it includes statically, with their text (no legacy scan)."""
     resolver = PackageResolver(package_paths, model_path=path)
-    return follow_includes(Path(path), _static_include_resolver(resolver, dict(mappings or {})))
+    return follow_includes(Path(path), static_include_resolver(resolver, dict(mappings or {})))
 
 
 def include_cycle(path: Path, mappings: dict[str, str] | None = None,
@@ -716,7 +716,7 @@ def include_cycle(path: Path, mappings: dict[str, str] | None = None,
     """
     from reedtool.io.legacy_xacro import include_specs
 
-    resolve = _static_include_resolver(PackageResolver(package_paths, model_path=path),
+    resolve = static_include_resolver(PackageResolver(package_paths, model_path=path),
                                        dict(mappings or {}))
     start = Path(path).resolve()
     pending, seen = [[start]], {start}
@@ -743,7 +743,7 @@ def scan_legacy(path: Path, mappings: dict[str, str] | None = None,
                 package_paths: Sequence[Path] = ()) -> LegacyScan:
     """Legacy xacro tags in `path` and the files it includes (see reedtool.io.legacy_xacro)."""
     resolver = PackageResolver(package_paths, model_path=path)
-    return scan_tree(Path(path), _static_include_resolver(resolver, dict(mappings or {})),
+    return scan_tree(Path(path), static_include_resolver(resolver, dict(mappings or {})),
                      display=display_path)
 
 
@@ -761,7 +761,7 @@ def expand_xacro(path: Path, mappings: dict[str, str] | None = None,
     check_xml_depth(read_bytes(path, what="xacro file"), path)   # before any recursive walk
     mappings = {str(k): str(v) for k, v in (mappings or {}).items()}
     resolver = PackageResolver(package_paths, model_path=path)
-    legacy = scan_tree(path, _static_include_resolver(resolver, mappings), display=display_path)
+    legacy = scan_tree(path, static_include_resolver(resolver, mappings), display=display_path)
     st = _Tracker(resolver, legacy, time_budget_s)
 
     captured = io.StringIO()

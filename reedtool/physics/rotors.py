@@ -30,18 +30,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from reedtool.io.fileio import MAX_MAGNITUDE
-from reedtool.model import Plugin, Robot, SourceLoc, XmlNode
+from reedtool.model import Plugin, Robot, SourceLoc, XmlNode, motor_plugin_family
 from reedtool.physics.kinematics import link_poses
 
-# Plugin library (see Plugin.library) -> rotor kind.
-MOTOR_PLUGINS = {
-    "rotors_gazebo_motor_model": "rotors",
-    "gazebo_motor_model": "px4",
-    "gz-sim-multicopter-motor-model-system": "gz",
-    "ignition-gazebo-multicopter-motor-model-system": "gz",
-}
-MOTOR_PLUGIN_NAMES = {"gz::sim::systems::MulticopterMotorModel": "gz",
-                      "ignition::gazebo::systems::MulticopterMotorModel": "gz"}
 ARDUPILOT_PLUGINS = {"ArduPilotPlugin"}        # libArduPilotPlugin.so (classic) and gz
 LIFT_DRAG_PLUGINS = {"LiftDragPlugin", "gz-sim-lift-drag-system",
                      "ignition-gazebo-lift-drag-system"}
@@ -147,7 +138,8 @@ class RotorCountDeclaration:
 
 
 def motor_plugin_kind(plugin: Plugin) -> str | None:
-    return MOTOR_PLUGINS.get(plugin.library) or MOTOR_PLUGIN_NAMES.get(plugin.name or "")
+    """The rotor family of a motor-model plugin (model.MOTOR_PLUGINS), else None."""
+    return motor_plugin_family(plugin.filename, plugin.name)
 
 
 def is_ardupilot_plugin(plugin: Plugin) -> bool:
@@ -213,6 +205,16 @@ def resolve_name(name: str | None, table) -> str | None:
             return candidate
     matches = [key for key in table if key.endswith("::" + name)]
     return matches[0] if len(matches) == 1 else None
+
+
+def inertia_about_joint_kg_m2(inertial, axis) -> float:
+    """A rotor link's moment of inertia about its joint axis through the link origin (the
+    COM tensor plus the parallel-axis term), or NaN where `axis` is no direction."""
+    axis = _unit(np.asarray(axis, dtype=float))
+    r = np.asarray(inertial.com_m, dtype=float)
+    I_link = inertial.inertia_in_link_axes() + inertial.mass_kg * (
+        float(r @ r) * np.eye(3) - np.outer(r, r))
+    return float(axis @ I_link @ axis) if np.all(np.isfinite(axis)) else math.nan
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
@@ -613,13 +615,7 @@ def ardupilot_time_constant(robot: Robot, rotor: Rotor) -> DerivedTimeConstant:
     if joint is None or link is None or link.inertial is None:
         return DerivedTimeConstant(math.nan, "the rotor joint or its link's <inertial> is "
                                              "missing")
-    axis = _unit(np.asarray(joint.axis, dtype=float))
-    inertial = link.inertial
-    r = np.asarray(inertial.com_m, dtype=float)
-    # About the joint axis through the link origin: the COM tensor plus the parallel axis.
-    I_link = inertial.inertia_in_link_axes() + inertial.mass_kg * (
-        float(r @ r) * np.eye(3) - np.outer(r, r))
-    I_axis = float(axis @ I_link @ axis) if np.all(np.isfinite(axis)) else math.nan
+    I_axis = inertia_about_joint_kg_m2(link.inertial, joint.axis)
     if not (math.isfinite(I_axis) and I_axis > 0):
         return DerivedTimeConstant(math.nan, "the rotor link has no positive moment of "
                                              "inertia about its joint axis")

@@ -19,6 +19,8 @@ from typing import Sequence
 
 import numpy as np
 
+from reedtool.io.json_values import finite_or_none
+
 STANDARD_GRAVITY_M_S2 = 9.80665
 
 # A rotor closer than this fraction of its maximum thrust to 0 or to the maximum counts
@@ -90,7 +92,7 @@ class TrimResult:
             "torque_authority_N_m": dict(zip(("roll", "pitch", "yaw"),
                                              (float(v) for v in self.torque_authority_N_m))),
             "allocation_rank": self.rank,
-            "allocation_condition_number": _finite_or_none(self.condition_number),
+            "allocation_condition_number": finite_or_none(self.condition_number),
         }
 
 
@@ -346,10 +348,6 @@ def _empty(cause: TrimCause, message: str, n: int, weight_N: float,
     return TrimResult(False, cause, message, nan, nan.copy(), nan.copy(), 0.0, float("nan"),
                       np.full(4, np.nan), np.zeros(3), np.zeros((4, n)), 0, float("inf"),
                       weight_N, names)
-
-
-def _finite_or_none(value: float) -> float | None:
-    return value if np.isfinite(value) else None
 
 
 def _span(values, spec: str) -> str:

@@ -295,11 +295,8 @@ def _place_arm_labels(ax, arms: list) -> None:
     shown: set[str] = set()
     for number, start, end, text in arms:
         for fraction in (0.5, 0.65, 0.8, 0.35, 0.9):
-            label = ax.text(start[0] + fraction * (end[0] - start[0]),
-                            start[1] + fraction * (end[1] - start[1]), text,
-                            fontsize=7, color="#333333", ha="center", va="center", zorder=6,
-                            bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none",
-                                  "alpha": 0.8}, gid=f"armlen-{number}")
+            label = _arm_label(ax, start[0] + fraction * (end[0] - start[0]),
+                               start[1] + fraction * (end[1] - start[1]), text, number)
             box = extent(label)
             if not any(box.overlaps(other) for other in taken):
                 break
@@ -307,13 +304,18 @@ def _place_arm_labels(ax, arms: list) -> None:
         else:
             if text in shown:
                 continue
-            label = ax.text((start[0] + end[0]) / 2, (start[1] + end[1]) / 2, text,
-                            fontsize=7, color="#333333", ha="center", va="center", zorder=6,
-                            bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none",
-                                  "alpha": 0.8}, gid=f"armlen-{number}")
+            label = _arm_label(ax, (start[0] + end[0]) / 2, (start[1] + end[1]) / 2, text,
+                               number)
             box = extent(label)
         taken.append(box)
         shown.add(text)
+
+
+def _arm_label(ax, x: float, y: float, text: str, number: int):
+    """An arm's length label at (x, y) on the page, boxed so the arm does not cross it."""
+    return ax.text(x, y, text, fontsize=7, color="#333333", ha="center", va="center", zorder=6,
+                   bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none",
+                         "alpha": 0.8}, gid=f"armlen-{number}")
 
 
 def _spin_arrow(ax, X: float, Y: float, r: float, sign: int, colour: str, number: int) -> None:

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from reedtool.errors import ReedtoolError
-from reedtool.scaffold.gz_port import Element, GzPort, _num
+from reedtool.scaffold.gz_port import Element, GzPort, float_text
 
 ARDUPILOT_PLUGIN = ("ArduPilotPlugin", "ArduPilotPlugin")
 LIFT_DRAG = ("gz-sim-lift-drag-system", "gz::sim::systems::LiftDrag")
@@ -71,7 +71,7 @@ def _unit(v) -> np.ndarray:
 
 
 def _vec(v) -> str:
-    return " ".join(_num(x) for x in v)
+    return " ".join(float_text(x) for x in v)
 
 
 def frame_match(rotors: list[ApRotor]) -> tuple[int, int, dict[int, int]]:
@@ -106,11 +106,11 @@ def blades(rotor: ApRotor, multiplier_sign: int) -> list[Element]:
         # Where the blade moves when the joint turns the way the multiplier drives it.
         forward = multiplier_sign * _unit(np.cross(axis, cp))
         plugin = Element("plugin", {"filename": LIFT_DRAG[0], "name": LIFT_DRAG[1]})
-        for tag, value in (("a0", _num(BLADE_A0_RAD)), ("alpha_stall", _num(BLADE_ALPHA_STALL_RAD)),
-                           ("cla", _num(BLADE_CLA)), ("cda", _num(cda)), ("cma", "0"),
-                           ("cla_stall", _num(BLADE_CLA_STALL)), ("cda_stall", "0"),
-                           ("cma_stall", "0"), ("area", _num(area)),
-                           ("air_density", _num(AIR_DENSITY_KG_M3)), ("cp", _vec(cp)),
+        for tag, value in (("a0", float_text(BLADE_A0_RAD)), ("alpha_stall", float_text(BLADE_ALPHA_STALL_RAD)),
+                           ("cla", float_text(BLADE_CLA)), ("cda", float_text(cda)), ("cma", "0"),
+                           ("cla_stall", float_text(BLADE_CLA_STALL)), ("cda_stall", "0"),
+                           ("cma_stall", "0"), ("area", float_text(area)),
+                           ("air_density", float_text(AIR_DENSITY_KG_M3)), ("cp", _vec(cp)),
                            ("forward", _vec(forward)), ("upward", _vec(thrust)),
                            ("link_name", rotor.link)):
             plugin.add(tag, value)
@@ -128,12 +128,12 @@ def control(rotor: ApRotor) -> tuple[Element, int]:
     p_gain = rotor.inertia_axis_kg_m2 / rotor.time_constant_s
     node = Element("control", {"channel": str(rotor.channel)})
     for tag, value in (("jointName", rotor.joint), ("useForce", "1"),
-                       ("multiplier", _num(sign * rotor.max_rot_velocity_rad_s)),
+                       ("multiplier", float_text(sign * rotor.max_rot_velocity_rad_s)),
                        ("offset", "0"), ("servo_min", "1100"), ("servo_max", "1900"),
-                       ("type", "VELOCITY"), ("p_gain", _num(p_gain)), ("i_gain", "0"),
+                       ("type", "VELOCITY"), ("p_gain", float_text(p_gain)), ("i_gain", "0"),
                        ("d_gain", "0"), ("i_max", "0"), ("i_min", "0"),
-                       ("cmd_max", _num(p_gain * rotor.max_rot_velocity_rad_s)),
-                       ("cmd_min", _num(-p_gain * rotor.max_rot_velocity_rad_s)),
+                       ("cmd_max", float_text(p_gain * rotor.max_rot_velocity_rad_s)),
+                       ("cmd_min", float_text(-p_gain * rotor.max_rot_velocity_rad_s)),
                        ("controlVelocitySlowdownSim", "1")):
         node.add(tag, value)
     return node, sign
@@ -176,23 +176,12 @@ def _prop_radius_m(link) -> float:
     return DEFAULT_PROP_RADIUS_M
 
 
-def _inertia_about_joint(link, axis) -> float:
-    """As physics.rotors.ardupilot_time_constant computes it: about the joint axis through
-    the link origin."""
-    inertial = link.inertial
-    r = np.asarray(inertial.com_m, dtype=float)
-    I_link = inertial.inertia_in_link_axes() + inertial.mass_kg * (
-        float(r @ r) * np.eye(3) - np.outer(r, r))
-    a = _unit(axis)
-    return float(a @ I_link @ a)
-
-
 def ardupilot_port(robot, port: GzPort) -> tuple[list[Element], str]:
     """migrate --autopilot ardupilot: the plugins to add to the port and the .parm text.
     Each velocity motor plugin of the source becomes an ArduPilot rotor (port.ardupilot_rotors)."""
     from reedtool.flightstack.ardupilot import parm_text
     from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
-    from reedtool.physics.rotors import discover_rotors
+    from reedtool.physics.rotors import discover_rotors, inertia_about_joint_kg_m2
 
     props = whole_robot_pinocchio(robot)
     by_plugin = {id(r.plugin): r for r in discover_rotors(robot)}
@@ -220,7 +209,8 @@ def ardupilot_port(robot, port: GzPort) -> tuple[list[Element], str]:
             motor_constant=rotor.motor_constant, moment_constant=rotor.moment_constant,
             max_rot_velocity_rad_s=rotor.max_rot_velocity_rad_s,
             prop_radius_m=_prop_radius_m(link),
-            inertia_axis_kg_m2=_inertia_about_joint(link, joint.axis), time_constant_s=tau))
+            inertia_axis_kg_m2=inertia_about_joint_kg_m2(link.inertial, joint.axis),
+            time_constant_s=tau))
         rows[rotor.joint] = row
     frame_class, frame_type, outputs = frame_match(rotors)
     plugins, controls = ardupilot_elements(rotors, _imu_name(port))

@@ -154,13 +154,13 @@ def autopilot_context(spec, autopilot: str | None) -> dict:
             MAGNETIC_FIELD_T,
             PX4_SENSORS,
             SPHERICAL_COORDINATES,
-            _px4_sensor,
+            px4_sensor_element,
         )
         from reedtool.scaffold.sdf_writer import elements_text
 
         sensors = []
         for sensor in PX4_SENSORS:
-            body = [c for c in _px4_sensor(sensor).children
+            body = [c for c in px4_sensor_element(sensor).children
                     if c.tag not in ("always_on", "update_rate")]
             sensors.append({"name": sensor.name, "type": sensor.type,
                             "update_rate_hz": sensor.update_rate_hz,

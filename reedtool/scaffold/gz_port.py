@@ -28,12 +28,25 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from reedtool.model import Collision, Inertial, Plugin, Robot, SourceLoc, Visual, XmlNode
+from reedtool.model import (
+    MOTOR_PLUGINS,
+    Collision,
+    Inertial,
+    Plugin,
+    Robot,
+    SourceLoc,
+    Visual,
+    XmlNode,
+)
 from reedtool.scaffold.gz_sensors import SENSOR_KINDS, sensor_kind, sensor_plugin_why, split_name
 
 # ------------------------------------------------------------- mapping table
 
 MOTOR_SYSTEM = ("gz-sim-multicopter-motor-model-system", "gz::sim::systems::MulticopterMotorModel")
+# The Classic motor models the port turns into MOTOR_SYSTEM: model.MOTOR_PLUGINS, the table
+# rotor discovery reads, less the gz systems themselves.
+CLASSIC_MOTOR_LIBRARIES = tuple(library for library, family in MOTOR_PLUGINS.items()
+                                if family != "gz")
 JOINT_POSITION_SYSTEM = ("gz-sim-joint-position-controller-system",
                          "gz::sim::systems::JointPositionController")
 JOINT_STATE_SYSTEM = ("gz-sim-joint-state-publisher-system", "gz::sim::systems::JointStatePublisher")
@@ -76,7 +89,7 @@ class Family:
 
 
 PLUGIN_FAMILIES: tuple[Family, ...] = (
-    Family("motor-model", ("rotors_gazebo_motor_model", "gazebo_motor_model"), "motor",
+    Family("motor-model", CLASSIC_MOTOR_LIBRARIES, "motor",
            "gz-sim-multicopter-motor-model-system (velocity) or "
            "gz-sim-joint-position-controller-system (position servo)",
            "the same motor model in gz-sim; motorNumber becomes actuator_number, every "
@@ -337,9 +350,9 @@ def _structure(robot: Robot):
     def link_row(link, parent) -> None:
         carried = {}
         if link.inertial is not None:
-            carried["mass"] = _num(link.inertial.mass_kg)
+            carried["mass"] = float_text(link.inertial.mass_kg)
             I = link.inertial.inertia_kg_m2
-            carried.update({key: _num(I[i, j]) for key, (i, j) in (
+            carried.update({key: float_text(I[i, j]) for key, (i, j) in (
                 ("ixx", (0, 0)), ("ixy", (0, 1)), ("ixz", (0, 2)), ("iyy", (1, 1)),
                 ("iyz", (1, 2)), ("izz", (2, 2)))})
         rows.append(PortRow(link.loc, f"link {link.name}", "mapped", f"link {link.name}",
@@ -381,8 +394,8 @@ def _structure(robot: Robot):
                                     f"joint {joint.name} ({sdf_type})",
                                     f"{survivor} -> {child.name}; the joint frame at the child "
                                     "link, as URDF has it",
-                                    {"pose": _pose_text(T_survivor_child),
-                                     "axis": " ".join(_num(v) for v in joint.axis)},
+                                    {"pose": pose_text(T_survivor_child),
+                                     "axis": " ".join(float_text(v) for v in joint.axis)},
                                     target_key=("joint", joint.name)))
                 limit = joint.limit
                 joints.append(PortJoint(
@@ -439,14 +452,15 @@ def _resolve_link(name: str | None, fold, by_name) -> tuple[str | None, np.ndarr
     return fold[key]
 
 
-def _pose_text(T: np.ndarray) -> str:
+def pose_text(T: np.ndarray) -> str:
+    """A 4x4 transform as SDF `<pose>` text: x y z roll pitch yaw, each as `float_text`."""
     from reedtool.frames import matrix_to_rpy
 
     values = [*T[:3, 3], *matrix_to_rpy(T[:3, :3])]
-    return " ".join(_num(v) for v in values)
+    return " ".join(float_text(v) for v in values)
 
 
-def _num(value: float) -> str:
+def float_text(value: float) -> str:
     """Shortest text that reads back as the same float; -0 written as 0."""
     value = float(value)
     return "0" if value == 0 else repr(value)
@@ -531,7 +545,7 @@ def _split_sensor(port: GzPort, node: XmlNode, kind, link: str, T: np.ndarray,
         own = _copy(camera, skip={"pose"})
         own.attrib.pop("name", None)
         sensor.children.append(own)
-        sensor.children.insert(0, Element("pose", {}, _pose_text(T_link_sensor @ T_of(camera))))
+        sensor.children.insert(0, Element("pose", {}, pose_text(T_link_sensor @ T_of(camera))))
         _place_sensor(sensor, T)
         port_link.sensors.append(sensor)
         port.rows.append(PortRow(camera.loc, f"{label} <camera name="
@@ -599,7 +613,7 @@ def _place_sensor(sensor: Element, T_link_sensor: np.ndarray) -> None:
         values = (values + [0.0] * 6)[:6]
         T = T_link_sensor @ make_T(rpy_to_matrix(values[3:]), values[:3])
         sensor.children.remove(pose)
-    sensor.children.insert(0, Element("pose", {}, _pose_text(T)))
+    sensor.children.insert(0, Element("pose", {}, pose_text(T)))
 
 
 def _gz_plugin(system: tuple[str, str], name: str | None = None) -> Element:
@@ -723,7 +737,7 @@ def _imu(port: GzPort, robot, plugin, family, fold, by_name) -> None:
     sensor = Element("sensor", {"name": plugin.name or "imu", "type": "imu"})
     _place_sensor(sensor, T)
     sensor.add("always_on", "true")
-    sensor.add("update_rate", _num(IMU_RATE_HZ))
+    sensor.add("update_rate", float_text(IMU_RATE_HZ))
     topic = plugin.param("imuTopic") or plugin.param("topicName") or "imu"
     sensor.add("topic", f"/{port.namespace}/{topic.lstrip('/')}")
     carried = {}
@@ -739,7 +753,7 @@ def _imu(port: GzPort, robot, plugin, family, fold, by_name) -> None:
         for axis in "xyz":
             noise = group.add(axis).add("noise", type="gaussian")
             # RotorS' discrete white noise: sigma = density / sqrt(dt).
-            noise.add("stddev", _num(float(numbers["NoiseDensity"]) * math.sqrt(IMU_RATE_HZ)))
+            noise.add("stddev", float_text(float(numbers["NoiseDensity"]) * math.sqrt(IMU_RATE_HZ)))
             if numbers["TurnOnBiasSigma"] is not None:
                 noise.add("bias_stddev", numbers["TurnOnBiasSigma"])
             if numbers["RandomWalk"] is not None:

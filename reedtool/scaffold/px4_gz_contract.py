@@ -40,7 +40,7 @@ from reedtool.scaffold.gz_port import (
     Element,
     GzPort,
     PortRow,
-    _pose_text,
+    pose_text,
 )
 
 ROOT_LINK = "base_link"
@@ -166,7 +166,8 @@ def _rename_root(port: GzPort, contract: Px4Contract) -> None:
     contract.renamed_root = old
 
 
-def _px4_sensor(spec: Px4Sensor) -> Element:
+def px4_sensor_element(spec: Px4Sensor) -> Element:
+    """The SDF `<sensor>` a PX4 gz sensor spec asks for (type, rate, noise per axis)."""
     sensor = Element("sensor", {"name": spec.name, "type": spec.type})
     sensor.add("always_on", "1")
     sensor.add("update_rate", spec.update_rate_hz)
@@ -188,7 +189,7 @@ def _place_sensors(port: GzPort, contract: Px4Contract) -> None:
         found = [(link, s) for link in port.links for s in link.sensors
                  if s.attrib.get("type") == spec.type]
         if not found:
-            sensor = _px4_sensor(spec)
+            sensor = px4_sensor_element(spec)
             root.sensors.append(sensor)
             contract.rows.append(PortRow(
                 root_loc, f"(no {spec.type} sensor in the source)", "mapped",
@@ -210,7 +211,7 @@ def _place_sensors(port: GzPort, contract: Px4Contract) -> None:
             if pose_el is not None:
                 sensor.children.remove(pose_el)
             if not np.allclose(T_root_sensor, np.eye(4), rtol=0, atol=0):
-                sensor.children.insert(0, Element("pose", {}, _pose_text(T_root_sensor)))
+                sensor.children.insert(0, Element("pose", {}, pose_text(T_root_sensor)))
             sensor.attrib["name"] = spec.name
             port.moved_sensors[old_name] = (spec.name, root.name)
             topic = sensor.find("topic")

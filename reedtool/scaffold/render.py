@@ -28,7 +28,7 @@ from pathlib import Path, PurePosixPath
 from typing import Mapping
 
 from reedtool.errors import ReedtoolError, os_error
-from reedtool.io.fileio import free_backup_name
+from reedtool.io.fileio import current_umask, free_backup_name
 
 TEMPLATE_SUFFIX = ".j2"
 
@@ -163,12 +163,9 @@ def staged_tree(target: Path, files: list[RenderedFile], *, force: bool = False)
                     dest.unlink()
                 dest.write_bytes(item.data)
                 os.chmod(dest, item.mode)
-            os.chmod(staging, 0o777 & ~_umask())
+            os.chmod(staging, 0o777 & ~current_umask())
         except OSError as exc:
-            error = os_error(exc, target, action="write package")
-            error.hint = f"{error.hint}; nothing was changed" if error.hint else \
-                "nothing was changed"
-            raise error from exc
+            raise _unchanged(exc, target) from exc
         yield staged
         try:
             if replacing:
@@ -183,10 +180,7 @@ def staged_tree(target: Path, files: list[RenderedFile], *, force: bool = False)
                 os.rename(staging, target)     # POSIX rename also replaces an empty directory
             swapped = True
         except OSError as exc:
-            error = os_error(exc, target, action="write package")
-            error.hint = f"{error.hint}; nothing was changed" if error.hint else \
-                "nothing was changed"
-            raise error from exc
+            raise _unchanged(exc, target) from exc
     finally:
         if staging.exists():
             shutil.rmtree(staging, ignore_errors=True)
@@ -198,7 +192,8 @@ def staged_tree(target: Path, files: list[RenderedFile], *, force: bool = False)
                     break
 
 
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
+def _unchanged(exc: OSError, target: Path) -> ReedtoolError:
+    """The write's error, saying the package on disk was left as it was."""
+    error = os_error(exc, target, action="write package")
+    error.hint = f"{error.hint}; nothing was changed" if error.hint else "nothing was changed"
+    return error

@@ -20,7 +20,7 @@ import numpy as np
 from lxml import etree
 
 from reedtool.io.limits import sdf_limit_text
-from reedtool.scaffold.gz_port import Element, GzPort, PortRow, _num, _pose_text
+from reedtool.scaffold.gz_port import Element, GzPort, PortRow, float_text, pose_text
 
 SDF_VERSION = "1.9"
 
@@ -37,12 +37,13 @@ class PortFiles:
     lines: dict            # id(Element) or ('link' | 'joint', name) -> its line in model.sdf
 
 
-def _to_xml(element: Element, parent=None):
+def to_xml(element: Element, parent=None):
+    """The lxml tree of a port `Element` (under `parent` when given), for both writers."""
     node = etree.Element(element.tag, element.attrib) if parent is None else \
         etree.SubElement(parent, element.tag, element.attrib)
     node.text = element.text
     for child in element.children:
-        _to_xml(child, node)
+        to_xml(child, node)
     return node
 
 
@@ -70,12 +71,12 @@ def _inertial(parent, inertials) -> None:
         T_link_com[:3, 3] = total.com_m
         inertia, mass = total.inertia_kg_m2, total.mass_kg
     node = _sub(parent, "inertial")
-    _sub(node, "pose", _pose_text(T_link_com))
-    _sub(node, "mass", _num(mass))
+    _sub(node, "pose", pose_text(T_link_com))
+    _sub(node, "mass", float_text(mass))
     tensor = _sub(node, "inertia")
     for key, (i, j) in (("ixx", (0, 0)), ("ixy", (0, 1)), ("ixz", (0, 2)), ("iyy", (1, 1)),
                         ("iyz", (1, 2)), ("izz", (2, 2))):
-        _sub(tensor, key, _num(inertia[i, j]))
+        _sub(tensor, key, float_text(inertia[i, j]))
 
 
 def _geometry(parent, geometry, mesh_uris: dict[str, str]) -> None:
@@ -83,18 +84,18 @@ def _geometry(parent, geometry, mesh_uris: dict[str, str]) -> None:
 
     node = _sub(parent, "geometry")
     if isinstance(geometry, Box):
-        _sub(_sub(node, "box"), "size", " ".join(_num(v) for v in geometry.size_m))
+        _sub(_sub(node, "box"), "size", " ".join(float_text(v) for v in geometry.size_m))
     elif isinstance(geometry, Cylinder):
         cylinder = _sub(node, "cylinder")
-        _sub(cylinder, "radius", _num(geometry.radius_m))
-        _sub(cylinder, "length", _num(geometry.length_m))
+        _sub(cylinder, "radius", float_text(geometry.radius_m))
+        _sub(cylinder, "length", float_text(geometry.length_m))
     elif isinstance(geometry, Sphere):
-        _sub(_sub(node, "sphere"), "radius", _num(geometry.radius_m))
+        _sub(_sub(node, "sphere"), "radius", float_text(geometry.radius_m))
     elif isinstance(geometry, Mesh):
         mesh = _sub(node, "mesh")
         _sub(mesh, "uri", mesh_uris[geometry.uri])
         if not np.array_equal(geometry.scale, np.ones(3)):
-            _sub(mesh, "scale", " ".join(_num(v) for v in geometry.scale))
+            _sub(mesh, "scale", " ".join(float_text(v) for v in geometry.scale))
 
 
 def _reference_in_place(uri: str, path: Path, target_dir) -> str:
@@ -178,7 +179,7 @@ class _Scopes:
             node = _sub(parent_node, "model", name=local_name(scope, parent))
             T_parent_scope = np.linalg.inv(self.T_model_scope[parent]) @ T_model_first
             if not np.array_equal(T_parent_scope, np.eye(4)):
-                _sub(node, "pose", _pose_text(T_parent_scope))
+                _sub(node, "pose", pose_text(T_parent_scope))
             self.nodes[scope] = node
             self.T_model_scope[scope] = T_model_first
         return self.nodes[scope]
@@ -252,12 +253,12 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
         node = _sub(parent_node, "link", name=local_name(link.name, scope))
         nodes[("link", link.name)] = node
         if link.parent is not None and scope_of(link.parent) == scope:
-            _sub(node, "pose", _pose_text(link.T_parent_link),
+            _sub(node, "pose", pose_text(link.T_parent_link),
                  relative_to=local_name(link.parent, scope))
         elif link.parent is not None or scope:
             T = scopes.pose_in_scope(scope, link.name)
             if not np.array_equal(T, np.eye(4)):
-                _sub(node, "pose", _pose_text(T))
+                _sub(node, "pose", pose_text(T))
         _inertial(node, link.inertials)
         for kind, shapes in (("collision", link.collisions), ("visual", link.visuals)):
             names: set[str] = set()
@@ -269,10 +270,10 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
                 names.add(name)
                 element = _sub(node, kind, name=name)
                 if not np.array_equal(T_link_geom, np.eye(4)):
-                    _sub(element, "pose", _pose_text(T_link_geom))
+                    _sub(element, "pose", pose_text(T_link_geom))
                 _geometry(element, shape.geometry, mesh_uris)
         for sensor in link.sensors:
-            written.append((sensor, _to_xml(sensor, node)))
+            written.append((sensor, to_xml(sensor, node)))
     for frame in port.frames:
         # A frame lives in its own nested model when that model is written and holds the
         # link it is attached to; else in the link's scope under a flat name.
@@ -284,7 +285,7 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
             name = local_name(frame.name, scope)
         attached = local_name(frame.attached_to, scope)
         node = _sub(scopes.nodes[scope], "frame", name=name, attached_to=attached)
-        _sub(node, "pose", _pose_text(frame.T_link_frame), relative_to=attached)
+        _sub(node, "pose", pose_text(frame.T_link_frame), relative_to=attached)
     for joint in port.joints:
         scope = scope_of(joint.name)
         if scope in scopes.nodes and _within(joint.parent, scope) and _within(joint.child, scope):
@@ -303,10 +304,10 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
         if moved:
             # The joint frame where the source put it (the axis line passes there); the
             # axis stays in the child link frame, as the plan holds it.
-            _sub(node, "pose", _pose_text(joint.T_child_jointframe), relative_to=child)
+            _sub(node, "pose", pose_text(joint.T_child_jointframe), relative_to=child)
         if joint.type != "fixed":
             axis = _sub(node, "axis")
-            _sub(axis, "xyz", " ".join(_num(v) for v in joint.axis),
+            _sub(axis, "xyz", " ".join(float_text(v) for v in joint.axis),
                  **({"expressed_in": child} if moved else {}))
             limit = _sub(axis, "limit")
             values = (None, None, None, None) if joint.limit is None else joint.limit
@@ -318,7 +319,7 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
                     _sub(limit, tag, text)
     for plugin in [*port.plugins, *extra_plugins]:
         scope = _plugin_scope(plugin, scopes.nodes)
-        written.append((plugin, _to_xml(_unscoped(plugin, scope) if scope else plugin,
+        written.append((plugin, to_xml(_unscoped(plugin, scope) if scope else plugin,
                                         scopes.nodes[scope])))
     scoped = [el.get("name") for el in root.iter() if isinstance(el.tag, str)
               and el.tag != "plugin" and SCOPE in (el.get("name") or "")]
@@ -367,9 +368,9 @@ def world_sdf(port: GzPort) -> bytes:
         where = _sub(world, "spherical_coordinates")
         _sub(where, "surface_model", "EARTH_WGS84")
         _sub(where, "world_frame_orientation", "ENU")
-        _sub(where, "latitude_deg", _num(latitude))
-        _sub(where, "longitude_deg", _num(longitude))
-        _sub(where, "elevation", _num(elevation))
+        _sub(where, "latitude_deg", float_text(latitude))
+        _sub(where, "longitude_deg", float_text(longitude))
+        _sub(where, "elevation", float_text(elevation))
         _sub(where, "heading_deg", "0")
     light = _sub(world, "light", type="directional", name="sun")
     _sub(light, "cast_shadows", "true")
@@ -437,7 +438,7 @@ def elements_text(elements: list[Element], indent: int = 0) -> str:
     """Elements as indented XML text (for a template to place inside a <gazebo> block)."""
     out = []
     for element in elements:
-        node = _to_xml(element)
+        node = to_xml(element)
         etree.indent(node, space="  ", level=indent // 2)
         out.append(" " * indent + etree.tostring(node, encoding="unicode").rstrip())
     return "\n".join(out)

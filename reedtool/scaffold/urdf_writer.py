@@ -14,15 +14,15 @@ from __future__ import annotations
 import numpy as np
 from lxml import etree
 
-from reedtool.scaffold.gz_port import Element, GzPort, _num
-from reedtool.scaffold.sdf_writer import _to_xml
+from reedtool.scaffold.gz_port import Element, GzPort, float_text
+from reedtool.scaffold.sdf_writer import to_xml
 
 
 def _origin(parent, T: np.ndarray) -> None:
     from reedtool.frames import matrix_to_rpy
 
-    etree.SubElement(parent, "origin", xyz=" ".join(_num(v) for v in T[:3, 3]),
-                     rpy=" ".join(_num(v) for v in matrix_to_rpy(T[:3, :3])))
+    etree.SubElement(parent, "origin", xyz=" ".join(float_text(v) for v in T[:3, 3]),
+                     rpy=" ".join(float_text(v) for v in matrix_to_rpy(T[:3, :3])))
 
 
 def _geometry(parent, geometry, mesh_uri) -> bool:
@@ -30,15 +30,15 @@ def _geometry(parent, geometry, mesh_uri) -> bool:
 
     node = etree.SubElement(parent, "geometry")
     if isinstance(geometry, Box):
-        etree.SubElement(node, "box", size=" ".join(_num(v) for v in geometry.size_m))
+        etree.SubElement(node, "box", size=" ".join(float_text(v) for v in geometry.size_m))
     elif isinstance(geometry, Cylinder):
-        etree.SubElement(node, "cylinder", radius=_num(geometry.radius_m),
-                         length=_num(geometry.length_m))
+        etree.SubElement(node, "cylinder", radius=float_text(geometry.radius_m),
+                         length=float_text(geometry.length_m))
     elif isinstance(geometry, Sphere):
-        etree.SubElement(node, "sphere", radius=_num(geometry.radius_m))
+        etree.SubElement(node, "sphere", radius=float_text(geometry.radius_m))
     elif isinstance(geometry, Mesh):
         etree.SubElement(node, "mesh", filename=mesh_uri(geometry.uri),
-                         scale=" ".join(_num(v) for v in geometry.scale))
+                         scale=" ".join(float_text(v) for v in geometry.scale))
     else:
         return False
     return True
@@ -66,11 +66,11 @@ def ros2_urdf(robot, port: GzPort, mesh_uris: dict[str, str],
         if link.inertial is not None:
             inertial = etree.SubElement(node, "inertial")
             _origin(inertial, link.inertial.T_link_com)
-            etree.SubElement(inertial, "mass", value=_num(link.inertial.mass_kg))
+            etree.SubElement(inertial, "mass", value=float_text(link.inertial.mass_kg))
             I = link.inertial.inertia_kg_m2
-            etree.SubElement(inertial, "inertia", ixx=_num(I[0, 0]), ixy=_num(I[0, 1]),
-                             ixz=_num(I[0, 2]), iyy=_num(I[1, 1]), iyz=_num(I[1, 2]),
-                             izz=_num(I[2, 2]))
+            etree.SubElement(inertial, "inertia", ixx=float_text(I[0, 0]), ixy=float_text(I[0, 1]),
+                             ixz=float_text(I[0, 2]), iyy=float_text(I[1, 1]), iyz=float_text(I[1, 2]),
+                             izz=float_text(I[2, 2]))
         for kind, shapes in (("visual", link.visuals), ("collision", link.collisions)):
             for shape in shapes:
                 if shape.geometry is None:
@@ -85,20 +85,20 @@ def ros2_urdf(robot, port: GzPort, mesh_uris: dict[str, str],
         etree.SubElement(node, "parent", link=joint.parent)
         etree.SubElement(node, "child", link=joint.child)
         if joint.type != "fixed":
-            etree.SubElement(node, "axis", xyz=" ".join(_num(v) for v in joint.axis))
+            etree.SubElement(node, "axis", xyz=" ".join(float_text(v) for v in joint.axis))
         if joint.limit is not None and joint.type in ("revolute", "prismatic"):
             limit = joint.limit
-            attrs = {key: _num(value) for key, value in (
+            attrs = {key: float_text(value) for key, value in (
                 ("lower", limit.lower), ("upper", limit.upper), ("effort", limit.effort),
                 ("velocity", limit.velocity)) if value is not None}
             etree.SubElement(node, "limit", attrs)
     gazebo = etree.SubElement(root, "gazebo")
     for plugin in [*port.plugins, *extra_plugins]:
-        _to_xml(plugin, gazebo)
+        to_xml(plugin, gazebo)
     for link in port.links:
         if link.sensors:
             block = etree.SubElement(root, "gazebo", reference=link.name)
             for sensor in link.sensors:
-                _to_xml(sensor, block)
+                to_xml(sensor, block)
     etree.indent(root, space="  ")
     return etree.tostring(root, xml_declaration=True, encoding="utf-8", pretty_print=True)

@@ -18,6 +18,7 @@ from typing import Callable
 
 import numpy as np
 
+from reedtool.io.json_values import finite_or_none
 from reedtool.sim import STATUS_CODES, STATUS_FROM_CODE, ExitStatus, HoverConfig
 from reedtool.sim.controller import (
     ControllerDesign,
@@ -566,7 +567,7 @@ def robustness_batch(params: VehicleParams, n_vehicles: int, config: HoverConfig
             "motor_constant_scale": [float(v) for v in perturbation.motor_scale[:, i]],
             "max_position_error_m": float(outcome.max_position_error_m[i]),
             "max_attitude_error_deg": float(outcome.max_attitude_error_deg[i]),
-            "settle_time_s": _finite_or_none(float(outcome.settle_time_s[i])),
+            "settle_time_s": finite_or_none(float(outcome.settle_time_s[i])),
         })
     return BatchReport(n_vehicles, int(passed.sum()), counts, worst, spreads, seed, engine,
                        _envelope(outcome.position_error_m, config)
@@ -585,7 +586,3 @@ def _envelope(position_error_m: np.ndarray, config: HoverConfig) -> dict[str, np
         for q in (5, 50, 95):
             out[f"p{q}"] = np.nanpercentile(position_error_m, q, axis=1)
     return out
-
-
-def _finite_or_none(value: float) -> float | None:
-    return value if math.isfinite(value) else None

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from reedtool.io.json_values import finite_or_none
 from reedtool.sim import ExitStatus, HoverConfig
 from reedtool.sim.batch import describe, hover_speeds
 from reedtool.sim.controller import (ControllerDesign, ControllerGains,
@@ -57,7 +58,7 @@ class HoverRun:
             "passed": self.passed,
             "message": self.message,
             "end_time_s": self.end_time_s,
-            "settle_time_s": _finite_or_none(self.settle_time_s),
+            "settle_time_s": finite_or_none(self.settle_time_s),
             "max_position_error_m": self.max_position_error_m,
             "max_attitude_error_deg": self.max_attitude_error_deg,
             "final_position_error_m": self.final_position_error_m,
@@ -176,7 +177,3 @@ def sample_series(rec: list[tuple], rotor_names: tuple[str, ...]) -> dict[str, n
     for i, name in enumerate(rotor_names):
         out[f"omega_{name}_rad_s"] = data[:, 11 + i]
     return out
-
-
-def _finite_or_none(value: float) -> float | None:
-    return value if math.isfinite(value) else None
