@@ -238,6 +238,29 @@ def _mass(value: str, inertia: str = 'ixx="0.004" iyy="0.004" izz="0.0006"') -> 
             '</inertial>')
 
 
+def _quad_mass(mass_kg: str) -> str:
+    """The quad with another base mass (thrust at full speed stays 24.0 N)."""
+    return _quad().replace('<mass value="1.2"/>', f'<mass value="{mass_kg}"/>', 1)
+
+
+def _quad_extra(extra: str) -> str:
+    """The quad with more elements before </robot>."""
+    return _quad().replace('</robot>\n', extra + '</robot>\n')
+
+
+# RotorS' MAVLink interface, forwarding `rotorCount` motor commands.
+_MAVLINK = ('  <gazebo><plugin name="mavlink_interface" '
+            'filename="librotors_gazebo_mavlink_interface.so">'
+            '<rotorCount>{count}</rotorCount></plugin></gazebo>\n')
+# An IMU on a link attached by a fixed joint (merged into base_link unless preserved).
+_IMU = ('  <joint name="imu_joint" type="fixed"><parent link="base_link"/>'
+        '<child link="imu_link"/></joint>\n'
+        '  <link name="imu_link"><inertial><mass value="0.015"/><inertia ixx="1e-05" ixy="0" '
+        'ixz="0" iyy="1e-05" iyz="0" izz="1e-05"/></inertial></link>\n'
+        '  <gazebo><plugin name="imu" filename="librotors_gazebo_imu_plugin.so">'
+        '<linkName>imu_link</linkName></plugin></gazebo>\n')
+
+
 # code -> (bad model, good model): URDF, each a whole file.
 EXAMPLES: dict[str, tuple[str, str]] = {
     "S101": (_arm(arm=_mass("half")), _arm(arm=_mass("0.5"))),
@@ -293,6 +316,36 @@ EXAMPLES: dict[str, tuple[str, str]] = {
     "R303": (_quad(spin=(2, 2, "CW")), _quad()),
     "R304": (_quad(spin=(3, 2, "ccw")), _quad()),
     "R313": (_quad(joint=(0, 4, "revolute")), _quad()),
+    # Both right rotors turn cw, both left ccw: yaw torque is roll torque.
+    "R305": (_quad(front_right=(0, 2, "cw"), front_left=(2, 2, "ccw")), _quad()),
+    # The back rotors moved forward of the COM: the front ones would have to push down.
+    "R307": (_quad(back_left=(1, 0, "0.3"), back_right=(3, 0, "0.3")), _quad()),
+    # 24.0 N of thrust at full speed: 3 kg (29.4 N) stays down, 2 kg (19.6 N) hovers at 90 %.
+    "R308": (_quad_mass("3"), _quad()),
+    "R309": (_quad_mass("2"), _quad()),
+    "R310": (_quad_mass("2"), _quad()),
+    "R311": (_quad().replace('<origin xyz="0.177 -0.177 0.03"/>',
+                             '<origin xyz="0.177 -0.177 0.03" rpy="0.2 0 0"/>'), _quad()),
+    "R312": (_quad_extra(_MAVLINK.format(count=6)), _quad_extra(_MAVLINK.format(count=4))),
+    "R314": (_quad().replace('<jointName>rotor_0_joint<', '<jointName>rotor0_joint<'), _quad()),
+    "R315": (_quad().replace('<linkName>rotor_0<', '<linkName>base_link<'), _quad()),
+    "R316": (_quad().replace('<motorConstant>8.54858e-06<', '<motorConstant>0<', 1), _quad()),
+    # maxRotVelocity 8000 rad/s (gz-sim's test quadrotor): thrust-to-weight 186.
+    "R340": (_quad().replace('<maxRotVelocity>838<', '<maxRotVelocity>8000<'), _quad()),
+    "R341": (_quad().replace('<axis xyz="0 0 1"/>', '<axis xyz="1 0 0"/>', 1), _quad()),
+    # Back arms 0.3 m instead of 0.177 m: the COM sits ahead of the rotors' centroid.
+    "R342": (_quad(back_left=(1, 0, "-0.3"), back_right=(3, 0, "-0.3")), _quad()),
+    # Yaw radius of gyration sqrt(0.5 / 1.2) = 0.65 m, outside the 0.25 m rotor circle.
+    "I220": (_quad().replace('ixx="0.00964" ixy="0" ixz="0" iyy="0.00964" iyz="0" izz="0.018"',
+                             'ixx="0.3" ixy="0" ixz="0" iyy="0.3" iyz="0" izz="0.5"'), _quad()),
+    # 1.0 kg·m² placeholders on the arm: 380x its box's trace; the robot's pitch inertia 36x.
+    "I209": (_arm(arm=_box_arm(ixx="1", izz="1")), _arm(arm=_box_arm())),
+    "S118": (_quad_extra(_IMU),
+             _quad_extra(_IMU + '  <gazebo reference="imu_joint"><preserveFixedJoint>true'
+                                '</preserveFixedJoint></gazebo>\n')),
+    "S119": (_arm(extra='  <!-- arm -- 0.3 m -->\n'), _arm(extra='  <!-- arm: 0.3 m -->\n')),
+    "S124": ('<!-- generated -->\n<?xml version="1.0"?>\n' + _arm(),
+             '<?xml version="1.0"?>\n<!-- generated -->\n' + _arm()),
 }
 # The rules whose documentation must carry a bad and a good example (the rest: to come
 # in this table, not in the page).
