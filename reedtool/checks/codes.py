@@ -346,6 +346,13 @@ EXAMPLES: dict[str, tuple[str, str]] = {
     "S119": (_arm(extra='  <!-- arm -- 0.3 m -->\n'), _arm(extra='  <!-- arm: 0.3 m -->\n')),
     "S124": ('<!-- generated -->\n<?xml version="1.0"?>\n' + _arm(),
              '<?xml version="1.0"?>\n<!-- generated -->\n' + _arm()),
+    # R305's spin order with one arm 27 mm shorter: rank 4, condition number 50.
+    "R306": (_quad(front_right=(0, 2, "cw"), front_left=(2, 2, "ccw"),
+                   back_right=(3, 1, "-0.15")), _quad()),
+    # Arms of 25 m (cm read as m): 1.22 kg on a 50 m frame, 0.006 N/m² of footprint.
+    "R343": (_quad(**{f"r{i}{j}": (i, j, v.replace("0.177", "17.7"))
+                      for i, rotor in enumerate(_QUAD_X) for j, v in enumerate(rotor[:2])}),
+             _quad()),
 }
 # The rules whose documentation must carry a bad and a good example (the rest: to come
 # in this table, not in the page).
