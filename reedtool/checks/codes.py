@@ -19,6 +19,8 @@ its code, the good one must not.
 
 from __future__ import annotations
 
+import re
+
 STACKS = ("core", "px4", "ardupilot", "rotors-lee")
 LIFECYCLES = ("stable", "preview")
 
@@ -261,7 +263,37 @@ _IMU = ('  <joint name="imu_joint" type="fixed"><parent link="base_link"/>'
         '<linkName>imu_link</linkName></plugin></gazebo>\n')
 
 
-# code -> (bad model, good model): URDF, each a whole file.
+# The same two-link arm as an SDF 1.9 model (Gazebo's own format).
+_SDF_INERTIAL = ('<inertial><mass>{mass_kg}</mass><inertia><ixx>{i}</ixx><iyy>{i}</iyy>'
+                 '<izz>{i}</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>')
+
+
+def _sdf(arm_name: str = "arm", arm_pose: str = "<pose>0 0 0.05 0 0 0</pose>",
+         arm_inertial: str = _SDF_INERTIAL.format(mass_kg="0.5", i="0.004"),
+         child: str = "", model_attr: str = "", version: str = ' version="1.9"',
+         extra: str = "", after: str = "") -> str:
+    return ('<?xml version="1.0"?>\n'
+            f'<sdf{version}>\n  <model name="arm"{model_attr}>\n'
+            '    <link name="base_link">\n'
+            '      ' + _SDF_INERTIAL.format(mass_kg="2", i="0.0083") + '\n'
+            '      <collision name="collision"><geometry><box><size>0.2 0.2 0.1</size></box>'
+            '</geometry></collision>\n'
+            '    </link>\n'
+            f'    <link name="{arm_name}">\n      {arm_pose}\n      {arm_inertial}\n    </link>\n'
+            '    <joint name="elbow" type="revolute"><parent>base_link</parent>'
+            f'<child>{child or arm_name}</child>\n'
+            '      <axis><xyz>0 1 0</xyz><limit><lower>-1.57</lower><upper>1.57</upper></limit>'
+            '</axis>\n'
+            '    </joint>\n' + extra + '  </model>\n' + after + '</sdf>\n')
+
+
+def example_format(text: str) -> str:
+    """"sdf" for an example whose root element is <sdf>, "urdf" otherwise: the file suffix
+    the loader and libsdformat read it by, and the label the rules page gives it."""
+    return "sdf" if re.search(r"^\s*<sdf[\s>]", text, re.MULTILINE) else "urdf"
+
+
+# code -> (bad model, good model): URDF or SDF (example_format), each a whole file.
 EXAMPLES: dict[str, tuple[str, str]] = {
     "S101": (_arm(arm=_mass("half")), _arm(arm=_mass("0.5"))),
     "S102": (_arm(origin="0 nan 0.05"), _arm()),
@@ -353,6 +385,16 @@ EXAMPLES: dict[str, tuple[str, str]] = {
     "R343": (_quad(**{f"r{i}{j}": (i, j, v.replace("0.177", "17.7"))
                       for i, rotor in enumerate(_QUAD_X) for j, v in enumerate(rotor[:2])}),
              _quad()),
+    "S120": (_sdf(arm_inertial=""), _sdf()),
+    "S125": (_sdf(arm_pose="<pose>0 0 0.05</pose>"), _sdf()),
+    "S160": (_sdf(arm_name="arm::link"), _sdf()),
+    "S163": (_sdf(model_attr=' canonical_link="body"'),
+             _sdf(model_attr=' canonical_link="base_link"')),
+    "S165": (_sdf(arm_pose='<pose relative_to="elbow_frame">0 0 0.05 0 0 0</pose>'), _sdf()),
+    "S167": (_sdf(extra='    <model name="camera"><pose>0 0 0.1 0 0 0</pose></model>\n'),
+             _sdf()),
+    "S168": (_sdf(version=""), _sdf()),
+    "S171": (_sdf(after='  <model name="arm_2"><link name="base_link"/></model>\n'), _sdf()),
 }
 # The rules whose documentation must carry a bad and a good example (the rest: to come
 # in this table, not in the page).
