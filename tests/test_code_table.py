@@ -102,6 +102,10 @@ def test_good_examples_load_in_the_consumer(code, tmp_path):
     assert sdformat_oracle.libsdformat_error(path) is None
 
 
+def rule_clause(code: str) -> str:
+    return next(r.clause for r in all_rules() if r.code == code)
+
+
 @pytest.mark.parametrize("code", sorted(c for c in EXAMPLE_CODES
                                         if example_format(EXAMPLES[c][0]) == "sdf"
                                         and rule_clause(c) == "refused"))
@@ -113,7 +117,3 @@ def test_bad_sdf_examples_of_refusal_rules_are_refused_by_the_consumer(code, tmp
     path = tmp_path / "bad.sdf"
     path.write_text(EXAMPLES[code][0], encoding="utf-8")
     assert sdformat_oracle.libsdformat_error(path) is not None
-
-
-def rule_clause(code: str) -> str:
-    return next(r.clause for r in all_rules() if r.code == code)
