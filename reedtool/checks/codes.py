@@ -266,10 +266,13 @@ _IMU = ('  <joint name="imu_joint" type="fixed"><parent link="base_link"/>'
 # The same two-link arm as an SDF 1.9 model (Gazebo's own format).
 _SDF_INERTIAL = ('<inertial><mass>{mass_kg}</mass><inertia><ixx>{i}</ixx><iyy>{i}</iyy>'
                  '<izz>{i}</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>')
+_SDF_ARM_INERTIAL = _SDF_INERTIAL.format(mass_kg="0.5", i="0.004")
+_SDF_BOX_VISUAL = ('<visual name="{name}"><geometry><box><size>0.05 0.05 0.3</size></box>'
+                   '</geometry></visual>')
 
 
 def _sdf(arm_name: str = "arm", arm_pose: str = "<pose>0 0 0.05 0 0 0</pose>",
-         arm_inertial: str = _SDF_INERTIAL.format(mass_kg="0.5", i="0.004"),
+         arm_body: str = _SDF_ARM_INERTIAL,
          child: str = "", model_attr: str = "", version: str = ' version="1.9"',
          extra: str = "", after: str = "") -> str:
     return ('<?xml version="1.0"?>\n'
@@ -279,7 +282,8 @@ def _sdf(arm_name: str = "arm", arm_pose: str = "<pose>0 0 0.05 0 0 0</pose>",
             '      <collision name="collision"><geometry><box><size>0.2 0.2 0.1</size></box>'
             '</geometry></collision>\n'
             '    </link>\n'
-            f'    <link name="{arm_name}">\n      {arm_pose}\n      {arm_inertial}\n    </link>\n'
+            f'    <link name="{arm_name}">\n      {arm_pose}\n'
+            f'      {arm_body}\n    </link>\n'
             '    <joint name="elbow" type="revolute"><parent>base_link</parent>'
             f'<child>{child or arm_name}</child>\n'
             '      <axis><xyz>0 1 0</xyz><limit><lower>-1.57</lower><upper>1.57</upper></limit>'
@@ -385,7 +389,7 @@ EXAMPLES: dict[str, tuple[str, str]] = {
     "R343": (_quad(**{f"r{i}{j}": (i, j, v.replace("0.177", "17.7"))
                       for i, rotor in enumerate(_QUAD_X) for j, v in enumerate(rotor[:2])}),
              _quad()),
-    "S120": (_sdf(arm_inertial=""), _sdf()),
+    "S120": (_sdf(arm_body=""), _sdf()),
     "S125": (_sdf(arm_pose="<pose>0 0 0.05</pose>"), _sdf()),
     "S160": (_sdf(arm_name="arm::link"), _sdf()),
     "S163": (_sdf(model_attr=' canonical_link="body"'),
@@ -395,6 +399,14 @@ EXAMPLES: dict[str, tuple[str, str]] = {
              _sdf()),
     "S168": (_sdf(version=""), _sdf()),
     "S171": (_sdf(after='  <model name="arm_2"><link name="base_link"/></model>\n'), _sdf()),
+    "S161": (_sdf(arm_body=_SDF_ARM_INERTIAL + _SDF_BOX_VISUAL.format(name="visual") * 2),
+             _sdf(arm_body=_SDF_ARM_INERTIAL + _SDF_BOX_VISUAL.format(name="visual")
+                  + _SDF_BOX_VISUAL.format(name="visual_tip"))),
+    "S162": (_sdf(extra='    <frame name="world" attached_to="arm"/>\n'),
+             _sdf(extra='    <frame name="arm_tip" attached_to="arm"/>\n')),
+    "S164": (_sdf(extra='    <frame name="arm_tip" attached_to="forearm"/>\n'),
+             _sdf(extra='    <frame name="arm_tip" attached_to="arm"/>\n')),
+    "S166": (_sdf(child="base_link"), _sdf()),
 }
 # The rules whose documentation must carry a bad and a good example (the rest: to come
 # in this table, not in the page).
