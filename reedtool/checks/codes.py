@@ -290,6 +290,15 @@ def _sdf(arm_name: str = "arm", arm_pose: str = "<pose>0 0 0.05 0 0 0</pose>",
             '</axis>\n'
             '    </joint>\n' + extra + '  </model>\n' + after + '</sdf>\n')
 
+# A gz-sim system: the model is for gz-sim (whose libsdformat DOM loads its materials).
+_GZ_SYSTEM = ('    <plugin filename="gz-sim-joint-state-publisher-system" '
+              'name="gz::sim::systems::JointStatePublisher"/>\n')
+
+
+def _sdf_arm_visual(material: str) -> str:
+    return _SDF_ARM_INERTIAL + _SDF_BOX_VISUAL.format(name="visual").replace(
+        "</visual>", f"<material>{material}</material></visual>")
+
 
 def example_format(text: str) -> str:
     """"sdf" for an example whose root element is <sdf>, "urdf" otherwise: the file suffix
@@ -407,6 +416,18 @@ EXAMPLES: dict[str, tuple[str, str]] = {
     "S164": (_sdf(extra='    <frame name="arm_tip" attached_to="forearm"/>\n'),
              _sdf(extra='    <frame name="arm_tip" attached_to="arm"/>\n')),
     "S166": (_sdf(child="base_link"), _sdf()),
+    # Gazebo classic's OGRE script name, in a model with a gz-sim system.
+    "S170": (_sdf(arm_body=_sdf_arm_visual("<script><name>Gazebo/Orange</name></script>"),
+                  extra=_GZ_SYSTEM),
+             _sdf(arm_body=_sdf_arm_visual("<ambient>1 0.5 0 1</ambient>"
+                                           "<diffuse>1 0.5 0 1</diffuse>"), extra=_GZ_SYSTEM)),
+    # Removed in SDF 1.7; 1.7+ writes the frame as expressed_in.
+    "S123": (_sdf().replace("<xyz>0 1 0</xyz>", "<xyz>0 1 0</xyz><use_parent_model_frame>true"
+                                                "</use_parent_model_frame>"),
+             _sdf().replace("<xyz>0 1 0</xyz>", '<xyz expressed_in="__model__">0 1 0</xyz>')),
+    "S191": (_sdf(version=' version="1.6"').replace("<parent>base_link</parent>",
+                                                    "<parent>arm::base_link</parent>"),
+             _sdf(version=' version="1.6"')),
 }
 # The rules whose documentation must carry a bad and a good example (the rest: to come
 # in this table, not in the page).
