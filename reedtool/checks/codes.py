@@ -205,7 +205,12 @@ _QUAD_X = (("0.177", "-0.177", "ccw", "0", "continuous"),
 
 def _quad(**change: tuple[int, int, str]) -> str:
     """The quad with rotor i's field j set to a value: change={"name": (i, j, value)}."""
-    rotors = [list(r) for r in _QUAD_X]
+    return _multirotor(_QUAD_X, **change)
+
+
+def _multirotor(table: tuple[tuple[str, ...], ...], **change: tuple[int, int, str]) -> str:
+    """The 1.2 kg RotorS-style vehicle with the rotors of `table` (as _QUAD_X), changed."""
+    rotors = [list(r) for r in table]
     for i, j, value in change.values():
         rotors[i][j] = value
     out = ['<robot name="quad">\n  <link name="base_link">\n'
@@ -238,6 +243,23 @@ def _quad(**change: tuple[int, int, str]) -> str:
 def _mass(value: str, inertia: str = 'ixx="0.004" iyy="0.004" izz="0.0006"') -> str:
     return (f'<inertial><mass value="{value}"/><inertia {inertia} ixy="0" ixz="0" iyz="0"/>'
             '</inertial>')
+
+def _quad_rpy(*rpy: str) -> str:
+    """The quad with rotor i's joint origin rotated by rpy[i]."""
+    out = _quad()
+    for (x, y, *_), angles in zip(_QUAD_X, rpy):
+        out = out.replace(f'<origin xyz="{x} {y} 0.03"/>',
+                          f'<origin xyz="{x} {y} 0.03" rpy="{angles}"/>')
+    return out
+
+
+def _hexa(spins: str) -> str:
+    """A hexacopter, rotors every 60° on a 0.25 m circle from the nose, counterclockwise
+    seen from above, turning as `spins` says ("P": ccw, "N": cw)."""
+    xy = (("0.25", "0"), ("0.125", "0.2165"), ("-0.125", "0.2165"), ("-0.25", "0"),
+          ("-0.125", "-0.2165"), ("0.125", "-0.2165"))
+    return _multirotor(tuple((x, y, "ccw" if spin == "P" else "cw", str(k), "continuous")
+                             for k, ((x, y), spin) in enumerate(zip(xy, spins))))
 
 
 def _quad_mass(mass_kg: str) -> str:
@@ -428,6 +450,12 @@ EXAMPLES: dict[str, tuple[str, str]] = {
     "S191": (_sdf(version=' version="1.6"').replace("<parent>base_link</parent>",
                                                     "<parent>arm::base_link</parent>"),
              _sdf(version=' version="1.6"')),
+    # Each rotor rolled 5° about its arm, alternating with its turning direction (the
+    # AscTec Neo's pattern).
+    "R320": (_quad_rpy("0.087 0 -0.785", "0.087 0 2.356", "-0.087 0 0.785", "-0.087 0 -2.356"),
+             _quad()),
+    # Alternating spins lose full control with any rotor; Du et al.'s PPNNPN keeps it.
+    "R350": (_hexa("PNPNPN"), _hexa("PPNNPN")),
 }
 # The rules whose documentation must carry a bad and a good example (the rest: to come
 # in this table, not in the page).
