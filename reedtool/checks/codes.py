@@ -261,6 +261,11 @@ def _hexa(spins: str) -> str:
     return _multirotor(tuple((x, y, "ccw" if spin == "P" else "cw", str(k), "continuous")
                              for k, ((x, y), spin) in enumerate(zip(xy, spins))))
 
+def _tilted_quad(comment: str = "") -> str:
+    """The quad with rotor 0 rolled 0.1 rad (5.7°), `comment` on the line before."""
+    return _quad().replace('    <origin xyz="0.177 -0.177 0.03"/>',
+                           comment + '    <origin xyz="0.177 -0.177 0.03" rpy="0.1 0 0"/>')
+
 
 def _quad_mass(mass_kg: str) -> str:
     """The quad with another base mass (thrust at full speed stays 24.0 N)."""
@@ -391,8 +396,7 @@ EXAMPLES: dict[str, tuple[str, str]] = {
     "R308": (_quad_mass("3"), _quad()),
     "R309": (_quad_mass("2"), _quad()),
     "R310": (_quad_mass("2"), _quad()),
-    "R311": (_quad().replace('<origin xyz="0.177 -0.177 0.03"/>',
-                             '<origin xyz="0.177 -0.177 0.03" rpy="0.2 0 0"/>'), _quad()),
+    "R311": (_tilted_quad(), _quad()),
     "R312": (_quad_extra(_MAVLINK.format(count=6)), _quad_extra(_MAVLINK.format(count=4))),
     "R314": (_quad().replace('<jointName>rotor_0_joint<', '<jointName>rotor0_joint<'), _quad()),
     "R315": (_quad().replace('<linkName>rotor_0<', '<linkName>base_link<'), _quad()),
@@ -456,6 +460,10 @@ EXAMPLES: dict[str, tuple[str, str]] = {
              _quad()),
     # Alternating spins lose full control with any rotor; Du et al.'s PPNNPN keeps it.
     "R350": (_hexa("PNPNPN"), _hexa("PPNNPN")),
+    # I2O4-style typo (a letter l for a one); the good comment silences the deliberate tilt's
+    # R311 in `validate` (inline suppressions apply after the rules ran).
+    "S142": (_tilted_quad("    <!-- reedtool: ignore[R31l] -->\n"),
+             _tilted_quad("    <!-- reedtool: ignore[R311] -->\n")),
 }
 # The rules whose documentation must carry a bad and a good example (the rest: to come
 # in this table, not in the page).
