@@ -464,6 +464,10 @@ EXAMPLES: dict[str, tuple[str, str]] = {
     # R311 in `validate` (inline suppressions apply after the rules ran).
     "S142": (_tilted_quad("    <!-- reedtool: ignore[R31l] -->\n"),
              _tilted_quad("    <!-- reedtool: ignore[R311] -->\n")),
+    # A VTOL's pusher behind the quad: its thrust axis pitched 90° to body +x.
+    "R319": (_multirotor(_QUAD_X + (("-0.3", "0", "ccw", "4", "continuous"),)).replace(
+                 '<origin xyz="-0.3 0 0.03"/>', '<origin xyz="-0.3 0 0.03" rpy="0 1.5708 0"/>'),
+             _quad()),
 }
 # The rules whose documentation must carry a bad and a good example (the rest: to come
 # in this table, not in the page).
