@@ -392,7 +392,8 @@ EXAMPLES: dict[str, tuple[str, str]] = {
     "R305": (_quad(front_right=(0, 2, "cw"), front_left=(2, 2, "ccw")), _quad()),
     # The back rotors moved forward of the COM: the front ones would have to push down.
     "R307": (_quad(back_left=(1, 0, "0.3"), back_right=(3, 0, "0.3")), _quad()),
-    # 24.0 N of thrust at full speed: 3 kg (29.4 N) stays down, 2 kg (19.6 N) hovers at 90 %.
+    # 24.0 N of thrust at full speed: a 3 kg base (29.6 N in all) stays down; a 2 kg one
+    # (19.8 N) hovers at 91 % speed.
     "R308": (_quad_mass("3"), _quad()),
     "R309": (_quad_mass("2"), _quad()),
     "R310": (_quad_mass("2"), _quad()),
@@ -401,15 +402,16 @@ EXAMPLES: dict[str, tuple[str, str]] = {
     "R314": (_quad().replace('<jointName>rotor_0_joint<', '<jointName>rotor0_joint<'), _quad()),
     "R315": (_quad().replace('<linkName>rotor_0<', '<linkName>base_link<'), _quad()),
     "R316": (_quad().replace('<motorConstant>8.54858e-06<', '<motorConstant>0<', 1), _quad()),
-    # maxRotVelocity 8000 rad/s (gz-sim's test quadrotor): thrust-to-weight 186.
+    # maxRotVelocity 8000 rad/s (gz-sim's test quadrotor): thrust-to-weight 183.
     "R340": (_quad().replace('<maxRotVelocity>838<', '<maxRotVelocity>8000<'), _quad()),
     "R341": (_quad().replace('<axis xyz="0 0 1"/>', '<axis xyz="1 0 0"/>', 1), _quad()),
-    # Back arms 0.3 m instead of 0.177 m: the COM sits ahead of the rotors' centroid.
+    # Back rotors 0.3 m behind the COM instead of 0.177 m: the COM sits ahead of the rotors'
+    # centroid.
     "R342": (_quad(back_left=(1, 0, "-0.3"), back_right=(3, 0, "-0.3")), _quad()),
-    # Yaw radius of gyration sqrt(0.5 / 1.2) = 0.65 m, outside the 0.25 m rotor circle.
+    # Yaw radius of gyration sqrt(0.5 / 1.22) = 0.64 m, 2.6x the 0.25 m rotor distance.
     "I220": (_quad().replace('ixx="0.00964" ixy="0" ixz="0" iyy="0.00964" iyz="0" izz="0.018"',
                              'ixx="0.3" ixy="0" ixz="0" iyy="0.3" iyz="0" izz="0.5"'), _quad()),
-    # 1.0 kg·m² placeholders on the arm: 380x its box's trace; the robot's pitch inertia 36x.
+    # 1.0 kg·m² placeholders on the arm: 380x its box's trace; the robot's yaw inertia 75x.
     "I209": (_arm(arm=_box_arm(ixx="1", izz="1")), _arm(arm=_box_arm())),
     "S118": (_quad_extra(_IMU),
              _quad_extra(_IMU + '  <gazebo reference="imu_joint"><preserveFixedJoint>true'
@@ -417,7 +419,8 @@ EXAMPLES: dict[str, tuple[str, str]] = {
     "S119": (_arm(extra='  <!-- arm -- 0.3 m -->\n'), _arm(extra='  <!-- arm: 0.3 m -->\n')),
     "S124": ('<!-- generated -->\n<?xml version="1.0"?>\n' + _arm(),
              '<?xml version="1.0"?>\n<!-- generated -->\n' + _arm()),
-    # R305's spin order with one arm 27 mm shorter: rank 4, condition number 50.
+    # R305's spin order with one rotor moved 27 mm towards the x axis: rank 4, condition
+    # number 50.
     "R306": (_quad(front_right=(0, 2, "cw"), front_left=(2, 2, "ccw"),
                    back_right=(3, 1, "-0.15")), _quad()),
     # Arms of 25 m (cm read as m): 1.22 kg on a 50 m frame, 0.006 N/m² of footprint.
