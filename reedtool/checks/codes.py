@@ -326,6 +326,47 @@ def _sdf_arm_visual(material: str) -> str:
     return _SDF_ARM_INERTIAL + _SDF_BOX_VISUAL.format(name="visual").replace(
         "</visual>", f"<material>{material}</material></visual>")
 
+# ardupilot_gazebo's iris as SDF 1.9, flattened: per rotor (x, y, turning sign: +1 ccw).
+_IRIS_ROTORS = (("0.13", "-0.22", 1), ("-0.13", "0.2", 1), ("0.13", "0.22", -1),
+                ("-0.13", "-0.2", -1))
+
+
+def _ardupilot_quad(flipped_channel: int = -1) -> str:
+    """Two LiftDrag blades per rotor (lift when moving along <forward>) and an
+    ArduPilotPlugin channel per rotor whose <multiplier> sign is the spin direction;
+    `flipped_channel`'s multiplier has the wrong sign."""
+    out = ['<?xml version="1.0"?>\n<sdf version="1.9">\n  <model name="iris">\n'
+           '    <link name="base_link">\n'
+           '      <inertial><mass>1.5</mass><inertia><ixx>0.029125</ixx><iyy>0.029125</iyy>'
+           '<izz>0.055225</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>\n'
+           '      <collision name="collision"><geometry><box><size>0.47 0.47 0.11</size></box>'
+           '</geometry></collision>\n    </link>\n']
+    controls = []
+    for k, (x, y, sign) in enumerate(_IRIS_ROTORS):
+        out.append(
+            f'    <link name="rotor_{k}">\n      <pose>{x} {y} 0.023 0 0 0</pose>\n'
+            '      <inertial><mass>0.025</mass><inertia><ixx>9.75e-06</ixx>'
+            '<iyy>0.000166704</iyy><izz>0.000167604</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz>'
+            '</inertia></inertial>\n    </link>\n'
+            f'    <joint name="rotor_{k}_joint" type="revolute"><parent>base_link</parent>'
+            f'<child>rotor_{k}</child>\n'
+            '      <axis><xyz>0 0 1</xyz><limit><lower>-1e+16</lower><upper>1e+16</upper>'
+            '</limit></axis>\n    </joint>\n')
+        for blade, cp_x in ((1, 1), (2, -1)):
+            out.append(
+                f'    <plugin name="rotor_{k}_blade_{blade}" filename="libLiftDragPlugin">'
+                '<a0>0.3</a0><cla>4.25</cla><cda>0.1</cda><area>0.002</area>'
+                f'<air_density>1.2041</air_density><cp>{0.084 * cp_x:g} 0 0</cp>'
+                f'<forward>0 {sign * cp_x} 0</forward><upward>0 0 1</upward>'
+                f'<link_name>rotor_{k}</link_name></plugin>\n')
+        multiplier = 838 * sign * (-1 if k == flipped_channel else 1)
+        controls.append(f'      <control channel="{k}"><type>VELOCITY</type>'
+                        f'<jointName>rotor_{k}_joint</jointName>'
+                        f'<multiplier>{multiplier}</multiplier></control>\n')
+    out.append('    <plugin name="arducopter_plugin" filename="libArduPilotPlugin">\n'
+               + "".join(controls) + '    </plugin>\n  </model>\n</sdf>\n')
+    return "".join(out)
+
 
 def example_format(text: str) -> str:
     """"sdf" for an example whose root element is <sdf>, "urdf" otherwise: the file suffix
@@ -471,6 +512,8 @@ EXAMPLES: dict[str, tuple[str, str]] = {
     "R319": (_multirotor(_QUAD_X + (("-0.3", "0", "ccw", "4", "continuous"),)).replace(
                  '<origin xyz="-0.3 0 0.03"/>', '<origin xyz="-0.3 0 0.03" rpy="0 1.5708 0"/>'),
              _quad()),
+    # Channel 0's control block copied from a cw rotor onto a ccw one.
+    "R318": (_ardupilot_quad(flipped_channel=0), _ardupilot_quad()),
 }
 # The rules whose documentation must carry a bad and a good example (the rest: to come
 # in this table, not in the page).
