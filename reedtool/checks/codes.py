@@ -12,9 +12,11 @@ registered again ("codes are never reused").
 - lifecycle: "stable" (released; behaviour changes only as a bug fix) or "preview" (new,
   may still change). A code removed from the registry moves to RETIRED with the reason.
 
-EXAMPLES gives a bad and a good model for a subset of the rules (EXAMPLE_CODES); docs/rules.md
-shows them and tests/test_code_table.py runs each through the rules: the bad one must give
-its code, the good one must not.
+EXAMPLES gives a bad and a good model for a subset of the rules (EXAMPLE_CODES), each a whole
+URDF or SDF 1.9 file (example_format tells which); docs/rules.md shows them and
+tests/test_code_table.py runs each through the rules: the bad one must give its code, the good
+one must not and must load in libsdformat, and a bad SDF one of a "refused" rule must be
+refused by it.
 """
 
 from __future__ import annotations
