@@ -8,7 +8,8 @@ from __future__ import annotations
 import pytest
 
 from reedtool.checks import registry
-from reedtool.checks.codes import CODES, EXAMPLE_CODES, EXAMPLES, LIFECYCLES, RETIRED, STACKS
+from reedtool.checks.codes import (CODES, EXAMPLE_CODES, EXAMPLES, LIFECYCLES, RETIRED, STACKS,
+                                   example_format)
 from reedtool.checks.registry import all_rules, rule
 from reedtool.checks.runner import Selection, run_checks
 from reedtool.io.loader import load_robot
@@ -68,7 +69,7 @@ def test_documented_examples_do_what_they_say(code, tmp_path):
     bad, good = EXAMPLES[code]
     found = {}
     for kind, text in (("bad", bad), ("good", good)):
-        path = tmp_path / f"{kind}.urdf"
+        path = tmp_path / f"{kind}.{example_format(text)}"
         path.write_text(text, encoding="utf-8")
         found[kind] = {f.code for f in run_checks(load_robot(path), Selection())}
     assert code in found["bad"]
@@ -91,9 +92,28 @@ def test_rules_json_carries_stack_and_lifecycle(capsys):
 @pytest.mark.parametrize("code", sorted(EXAMPLE_CODES))
 def test_good_examples_load_in_the_consumer(code, tmp_path):
     """The independent reference: the page's good model is one Drake's parser (libsdformat's
-    URDF reading) loads without an error, so "good" is not only reedtool's own verdict."""
+    URDF reading, or its SDF reading) loads without an error, so "good" is not only
+    reedtool's own verdict."""
     import sdformat_oracle
 
-    path = tmp_path / "good.urdf"
-    path.write_text(EXAMPLES[code][1], encoding="utf-8")
+    good = EXAMPLES[code][1]
+    path = tmp_path / f"good.{example_format(good)}"
+    path.write_text(good, encoding="utf-8")
     assert sdformat_oracle.libsdformat_error(path) is None
+
+
+def rule_clause(code: str) -> str:
+    return next(r.clause for r in all_rules() if r.code == code)
+
+
+@pytest.mark.parametrize("code", sorted(c for c in EXAMPLE_CODES
+                                        if example_format(EXAMPLES[c][0]) == "sdf"
+                                        and rule_clause(c) == "refused"))
+def test_bad_sdf_examples_of_refusal_rules_are_refused_by_the_consumer(code, tmp_path):
+    """A rule whose clause says libsdformat refuses the model is held to that: its bad SDF
+    example does not load in libsdformat (through Drake)."""
+    import sdformat_oracle
+
+    path = tmp_path / "bad.sdf"
+    path.write_text(EXAMPLES[code][0], encoding="utf-8")
+    assert sdformat_oracle.libsdformat_error(path) is not None

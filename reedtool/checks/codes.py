@@ -12,12 +12,16 @@ registered again ("codes are never reused").
 - lifecycle: "stable" (released; behaviour changes only as a bug fix) or "preview" (new,
   may still change). A code removed from the registry moves to RETIRED with the reason.
 
-EXAMPLES gives a bad and a good model for a subset of the rules (EXAMPLE_CODES); docs/rules.md
-shows them and tests/test_code_table.py runs each through the rules: the bad one must give
-its code, the good one must not.
+EXAMPLES gives a bad and a good model for a subset of the rules (EXAMPLE_CODES), each a whole
+URDF or SDF 1.9 file (example_format tells which); docs/rules.md shows them and
+tests/test_code_table.py runs each through the rules: the bad one must give its code, the good
+one must not and must load in libsdformat, and a bad SDF one of a "refused" rule must be
+refused by it.
 """
 
 from __future__ import annotations
+
+import re
 
 STACKS = ("core", "px4", "ardupilot", "rotors-lee")
 LIFECYCLES = ("stable", "preview")
@@ -203,7 +207,12 @@ _QUAD_X = (("0.177", "-0.177", "ccw", "0", "continuous"),
 
 def _quad(**change: tuple[int, int, str]) -> str:
     """The quad with rotor i's field j set to a value: change={"name": (i, j, value)}."""
-    rotors = [list(r) for r in _QUAD_X]
+    return _multirotor(_QUAD_X, **change)
+
+
+def _multirotor(table: tuple[tuple[str, ...], ...], **change: tuple[int, int, str]) -> str:
+    """The 1.2 kg RotorS-style vehicle with the rotors of `table` (as _QUAD_X), changed."""
+    rotors = [list(r) for r in table]
     for i, j, value in change.values():
         rotors[i][j] = value
     out = ['<robot name="quad">\n  <link name="base_link">\n'
@@ -237,8 +246,137 @@ def _mass(value: str, inertia: str = 'ixx="0.004" iyy="0.004" izz="0.0006"') -> 
     return (f'<inertial><mass value="{value}"/><inertia {inertia} ixy="0" ixz="0" iyz="0"/>'
             '</inertial>')
 
+def _quad_rpy(*rpy: str) -> str:
+    """The quad with rotor i's joint origin rotated by rpy[i]."""
+    out = _quad()
+    for (x, y, *_), angles in zip(_QUAD_X, rpy):
+        out = out.replace(f'<origin xyz="{x} {y} 0.03"/>',
+                          f'<origin xyz="{x} {y} 0.03" rpy="{angles}"/>')
+    return out
 
-# code -> (bad model, good model): URDF, each a whole file.
+
+def _hexa(spins: str) -> str:
+    """A hexacopter, rotors every 60° on a 0.25 m circle from the nose, counterclockwise
+    seen from above, turning as `spins` says ("P": ccw, "N": cw)."""
+    xy = (("0.25", "0"), ("0.125", "0.2165"), ("-0.125", "0.2165"), ("-0.25", "0"),
+          ("-0.125", "-0.2165"), ("0.125", "-0.2165"))
+    return _multirotor(tuple((x, y, "ccw" if spin == "P" else "cw", str(k), "continuous")
+                             for k, ((x, y), spin) in enumerate(zip(xy, spins))))
+
+def _tilted_quad(comment: str = "") -> str:
+    """The quad with rotor 0 rolled 0.1 rad (5.7°), `comment` on the line before."""
+    return _quad().replace('    <origin xyz="0.177 -0.177 0.03"/>',
+                           comment + '    <origin xyz="0.177 -0.177 0.03" rpy="0.1 0 0"/>')
+
+
+def _quad_mass(mass_kg: str) -> str:
+    """The quad with another base mass (thrust at full speed stays 24.0 N)."""
+    return _quad().replace('<mass value="1.2"/>', f'<mass value="{mass_kg}"/>', 1)
+
+
+def _quad_extra(extra: str) -> str:
+    """The quad with more elements before </robot>."""
+    return _quad().replace('</robot>\n', extra + '</robot>\n')
+
+
+# RotorS' MAVLink interface, forwarding `rotorCount` motor commands.
+_MAVLINK = ('  <gazebo><plugin name="mavlink_interface" '
+            'filename="librotors_gazebo_mavlink_interface.so">'
+            '<rotorCount>{count}</rotorCount></plugin></gazebo>\n')
+# An IMU on a link attached by a fixed joint (merged into base_link unless preserved).
+_IMU = ('  <joint name="imu_joint" type="fixed"><parent link="base_link"/>'
+        '<child link="imu_link"/></joint>\n'
+        '  <link name="imu_link"><inertial><mass value="0.015"/><inertia ixx="1e-05" ixy="0" '
+        'ixz="0" iyy="1e-05" iyz="0" izz="1e-05"/></inertial></link>\n'
+        '  <gazebo><plugin name="imu" filename="librotors_gazebo_imu_plugin.so">'
+        '<linkName>imu_link</linkName></plugin></gazebo>\n')
+
+
+# The same two-link arm as an SDF 1.9 model (Gazebo's own format).
+_SDF_INERTIAL = ('<inertial><mass>{mass_kg}</mass><inertia><ixx>{i}</ixx><iyy>{i}</iyy>'
+                 '<izz>{i}</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>')
+_SDF_ARM_INERTIAL = _SDF_INERTIAL.format(mass_kg="0.5", i="0.004")
+_SDF_BOX_VISUAL = ('<visual name="{name}"><geometry><box><size>0.05 0.05 0.3</size></box>'
+                   '</geometry></visual>')
+
+
+def _sdf(arm_name: str = "arm", arm_pose: str = "<pose>0 0 0.05 0 0 0</pose>",
+         arm_body: str = _SDF_ARM_INERTIAL,
+         child: str = "", model_attr: str = "", version: str = ' version="1.9"',
+         extra: str = "", after: str = "") -> str:
+    return ('<?xml version="1.0"?>\n'
+            f'<sdf{version}>\n  <model name="arm"{model_attr}>\n'
+            '    <link name="base_link">\n'
+            '      ' + _SDF_INERTIAL.format(mass_kg="2", i="0.0083") + '\n'
+            '      <collision name="collision"><geometry><box><size>0.2 0.2 0.1</size></box>'
+            '</geometry></collision>\n'
+            '    </link>\n'
+            f'    <link name="{arm_name}">\n      {arm_pose}\n'
+            f'      {arm_body}\n    </link>\n'
+            '    <joint name="elbow" type="revolute"><parent>base_link</parent>'
+            f'<child>{child or arm_name}</child>\n'
+            '      <axis><xyz>0 1 0</xyz><limit><lower>-1.57</lower><upper>1.57</upper></limit>'
+            '</axis>\n'
+            '    </joint>\n' + extra + '  </model>\n' + after + '</sdf>\n')
+
+# A gz-sim system: the model is for gz-sim (whose libsdformat DOM loads its materials).
+_GZ_SYSTEM = ('    <plugin filename="gz-sim-joint-state-publisher-system" '
+              'name="gz::sim::systems::JointStatePublisher"/>\n')
+
+
+def _sdf_arm_visual(material: str) -> str:
+    return _SDF_ARM_INERTIAL + _SDF_BOX_VISUAL.format(name="visual").replace(
+        "</visual>", f"<material>{material}</material></visual>")
+
+# ardupilot_gazebo's iris as SDF 1.9, flattened: per rotor (x, y, turning sign: +1 ccw).
+_IRIS_ROTORS = (("0.13", "-0.22", 1), ("-0.13", "0.2", 1), ("0.13", "0.22", -1),
+                ("-0.13", "-0.2", -1))
+
+
+def _ardupilot_quad(flipped_channel: int = -1) -> str:
+    """Two LiftDrag blades per rotor (lift when moving along <forward>) and an
+    ArduPilotPlugin channel per rotor whose <multiplier> sign is the spin direction;
+    `flipped_channel`'s multiplier has the wrong sign."""
+    out = ['<?xml version="1.0"?>\n<sdf version="1.9">\n  <model name="iris">\n'
+           '    <link name="base_link">\n'
+           '      <inertial><mass>1.5</mass><inertia><ixx>0.029125</ixx><iyy>0.029125</iyy>'
+           '<izz>0.055225</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>\n'
+           '      <collision name="collision"><geometry><box><size>0.47 0.47 0.11</size></box>'
+           '</geometry></collision>\n    </link>\n']
+    controls = []
+    for k, (x, y, sign) in enumerate(_IRIS_ROTORS):
+        out.append(
+            f'    <link name="rotor_{k}">\n      <pose>{x} {y} 0.023 0 0 0</pose>\n'
+            '      <inertial><mass>0.025</mass><inertia><ixx>9.75e-06</ixx>'
+            '<iyy>0.000166704</iyy><izz>0.000167604</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz>'
+            '</inertia></inertial>\n    </link>\n'
+            f'    <joint name="rotor_{k}_joint" type="revolute"><parent>base_link</parent>'
+            f'<child>rotor_{k}</child>\n'
+            '      <axis><xyz>0 0 1</xyz><limit><lower>-1e+16</lower><upper>1e+16</upper>'
+            '</limit></axis>\n    </joint>\n')
+        for blade, cp_x in ((1, 1), (2, -1)):
+            out.append(
+                f'    <plugin name="rotor_{k}_blade_{blade}" filename="libLiftDragPlugin">'
+                '<a0>0.3</a0><cla>4.25</cla><cda>0.1</cda><area>0.002</area>'
+                f'<air_density>1.2041</air_density><cp>{0.084 * cp_x:g} 0 0</cp>'
+                f'<forward>0 {sign * cp_x} 0</forward><upward>0 0 1</upward>'
+                f'<link_name>rotor_{k}</link_name></plugin>\n')
+        multiplier = 838 * sign * (-1 if k == flipped_channel else 1)
+        controls.append(f'      <control channel="{k}"><type>VELOCITY</type>'
+                        f'<jointName>rotor_{k}_joint</jointName>'
+                        f'<multiplier>{multiplier}</multiplier></control>\n')
+    out.append('    <plugin name="arducopter_plugin" filename="libArduPilotPlugin">\n'
+               + "".join(controls) + '    </plugin>\n  </model>\n</sdf>\n')
+    return "".join(out)
+
+
+def example_format(text: str) -> str:
+    """"sdf" for an example whose root element is <sdf>, "urdf" otherwise: the file suffix
+    the loader and libsdformat read it by, and the label the rules page gives it."""
+    return "sdf" if re.search(r"^\s*<sdf[\s>]", text, re.MULTILINE) else "urdf"
+
+
+# code -> (bad model, good model): URDF or SDF (example_format), each a whole file.
 EXAMPLES: dict[str, tuple[str, str]] = {
     "S101": (_arm(arm=_mass("half")), _arm(arm=_mass("0.5"))),
     "S102": (_arm(origin="0 nan 0.05"), _arm()),
@@ -293,6 +431,91 @@ EXAMPLES: dict[str, tuple[str, str]] = {
     "R303": (_quad(spin=(2, 2, "CW")), _quad()),
     "R304": (_quad(spin=(3, 2, "ccw")), _quad()),
     "R313": (_quad(joint=(0, 4, "revolute")), _quad()),
+    # Both right rotors turn cw, both left ccw: yaw torque is roll torque.
+    "R305": (_quad(front_right=(0, 2, "cw"), front_left=(2, 2, "ccw")), _quad()),
+    # The back rotors moved forward of the COM: the front ones would have to push down.
+    "R307": (_quad(back_left=(1, 0, "0.3"), back_right=(3, 0, "0.3")), _quad()),
+    # 24.0 N of thrust at full speed: a 3 kg base (29.6 N in all) stays down; a 2 kg one
+    # (19.8 N) hovers at 91 % speed.
+    "R308": (_quad_mass("3"), _quad()),
+    "R309": (_quad_mass("2"), _quad()),
+    "R310": (_quad_mass("2"), _quad()),
+    "R311": (_tilted_quad(), _quad()),
+    "R312": (_quad_extra(_MAVLINK.format(count=6)), _quad_extra(_MAVLINK.format(count=4))),
+    "R314": (_quad().replace('<jointName>rotor_0_joint<', '<jointName>rotor0_joint<'), _quad()),
+    "R315": (_quad().replace('<linkName>rotor_0<', '<linkName>base_link<'), _quad()),
+    "R316": (_quad().replace('<motorConstant>8.54858e-06<', '<motorConstant>0<', 1), _quad()),
+    # maxRotVelocity 8000 rad/s (gz-sim's test quadrotor): thrust-to-weight 183.
+    "R340": (_quad().replace('<maxRotVelocity>838<', '<maxRotVelocity>8000<'), _quad()),
+    "R341": (_quad().replace('<axis xyz="0 0 1"/>', '<axis xyz="1 0 0"/>', 1), _quad()),
+    # Back rotors 0.3 m behind the COM instead of 0.177 m: the COM sits ahead of the rotors'
+    # centroid.
+    "R342": (_quad(back_left=(1, 0, "-0.3"), back_right=(3, 0, "-0.3")), _quad()),
+    # Yaw radius of gyration sqrt(0.5 / 1.22) = 0.64 m, 2.6x the 0.25 m rotor distance.
+    "I220": (_quad().replace('ixx="0.00964" ixy="0" ixz="0" iyy="0.00964" iyz="0" izz="0.018"',
+                             'ixx="0.3" ixy="0" ixz="0" iyy="0.3" iyz="0" izz="0.5"'), _quad()),
+    # 1.0 kg·m² placeholders on the arm: 380x its box's trace; the robot's yaw inertia 75x.
+    "I209": (_arm(arm=_box_arm(ixx="1", izz="1")), _arm(arm=_box_arm())),
+    "S118": (_quad_extra(_IMU),
+             _quad_extra(_IMU + '  <gazebo reference="imu_joint"><preserveFixedJoint>true'
+                                '</preserveFixedJoint></gazebo>\n')),
+    "S119": (_arm(extra='  <!-- arm -- 0.3 m -->\n'), _arm(extra='  <!-- arm: 0.3 m -->\n')),
+    "S124": ('<!-- generated -->\n<?xml version="1.0"?>\n' + _arm(),
+             '<?xml version="1.0"?>\n<!-- generated -->\n' + _arm()),
+    # R305's spin order with one rotor moved 27 mm towards the x axis: rank 4, condition
+    # number 50.
+    "R306": (_quad(front_right=(0, 2, "cw"), front_left=(2, 2, "ccw"),
+                   back_right=(3, 1, "-0.15")), _quad()),
+    # Arms of 25 m (cm read as m): 1.22 kg on a 50 m frame, 0.006 N/m² of footprint.
+    "R343": (_quad(**{f"r{i}{j}": (i, j, v.replace("0.177", "17.7"))
+                      for i, rotor in enumerate(_QUAD_X) for j, v in enumerate(rotor[:2])}),
+             _quad()),
+    "S120": (_sdf(arm_body=""), _sdf()),
+    "S125": (_sdf(arm_pose="<pose>0 0 0.05</pose>"), _sdf()),
+    "S160": (_sdf(arm_name="arm::link"), _sdf()),
+    "S163": (_sdf(model_attr=' canonical_link="body"'),
+             _sdf(model_attr=' canonical_link="base_link"')),
+    "S165": (_sdf(arm_pose='<pose relative_to="elbow_frame">0 0 0.05 0 0 0</pose>'), _sdf()),
+    "S167": (_sdf(extra='    <model name="camera"><pose>0 0 0.1 0 0 0</pose></model>\n'),
+             _sdf()),
+    "S168": (_sdf(version=""), _sdf()),
+    "S171": (_sdf(after='  <model name="arm_2"><link name="base_link"/></model>\n'), _sdf()),
+    "S161": (_sdf(arm_body=_SDF_ARM_INERTIAL + _SDF_BOX_VISUAL.format(name="visual") * 2),
+             _sdf(arm_body=_SDF_ARM_INERTIAL + _SDF_BOX_VISUAL.format(name="visual")
+                  + _SDF_BOX_VISUAL.format(name="visual_tip"))),
+    "S162": (_sdf(extra='    <frame name="world" attached_to="arm"/>\n'),
+             _sdf(extra='    <frame name="arm_tip" attached_to="arm"/>\n')),
+    "S164": (_sdf(extra='    <frame name="arm_tip" attached_to="forearm"/>\n'),
+             _sdf(extra='    <frame name="arm_tip" attached_to="arm"/>\n')),
+    "S166": (_sdf(child="base_link"), _sdf()),
+    # Gazebo classic's OGRE script name, in a model with a gz-sim system.
+    "S170": (_sdf(arm_body=_sdf_arm_visual("<script><name>Gazebo/Orange</name></script>"),
+                  extra=_GZ_SYSTEM),
+             _sdf(arm_body=_sdf_arm_visual("<ambient>1 0.5 0 1</ambient>"
+                                           "<diffuse>1 0.5 0 1</diffuse>"), extra=_GZ_SYSTEM)),
+    # Removed in SDF 1.7; 1.7+ writes the frame as expressed_in.
+    "S123": (_sdf().replace("<xyz>0 1 0</xyz>", "<xyz>0 1 0</xyz><use_parent_model_frame>true"
+                                                "</use_parent_model_frame>"),
+             _sdf().replace("<xyz>0 1 0</xyz>", '<xyz expressed_in="__model__">0 1 0</xyz>')),
+    "S191": (_sdf(version=' version="1.6"').replace("<parent>base_link</parent>",
+                                                    "<parent>arm::base_link</parent>"),
+             _sdf(version=' version="1.6"')),
+    # Each rotor rolled 5° about its arm, alternating with its turning direction (the
+    # AscTec Neo's pattern).
+    "R320": (_quad_rpy("0.087 0 -0.785", "0.087 0 2.356", "-0.087 0 0.785", "-0.087 0 -2.356"),
+             _quad()),
+    # Alternating spins lose full control with any rotor; Du et al.'s PPNNPN keeps it.
+    "R350": (_hexa("PNPNPN"), _hexa("PPNNPN")),
+    # I2O4-style typo (a letter l for a one); the good comment silences the deliberate tilt's
+    # R311 in `validate` (inline suppressions apply after the rules ran).
+    "S142": (_tilted_quad("    <!-- reedtool: ignore[R31l] -->\n"),
+             _tilted_quad("    <!-- reedtool: ignore[R311] -->\n")),
+    # A VTOL's pusher behind the quad: its thrust axis pitched 90° to body +x.
+    "R319": (_multirotor(_QUAD_X + (("-0.3", "0", "ccw", "4", "continuous"),)).replace(
+                 '<origin xyz="-0.3 0 0.03"/>', '<origin xyz="-0.3 0 0.03" rpy="0 1.5708 0"/>'),
+             _quad()),
+    # Channel 0's control block copied from a cw rotor onto a ccw one.
+    "R318": (_ardupilot_quad(flipped_channel=0), _ardupilot_quad()),
 }
 # The rules whose documentation must carry a bad and a good example (the rest: to come
 # in this table, not in the page).

@@ -70,7 +70,7 @@ def _rule_section(r, clause_wording: str) -> list[str]:
     """One rule's page, in fixed sections: summary, severity and clause, stack and
     lifecycle, what it checks (its docstring), and a bad and a good example where the code
     table has them (EXAMPLE_CODES)."""
-    from reedtool.checks.codes import EXAMPLES
+    from reedtool.checks.codes import EXAMPLES, example_format
 
     out = ["", f"### {r.code} {r.slug}", "",
            f"**Summary.** {_md(r.summary)}", "",
@@ -80,8 +80,11 @@ def _rule_section(r, clause_wording: str) -> list[str]:
            "**What it checks.**", "", _md(r.explanation)]
     if r.code in EXAMPLES:
         bad, good = EXAMPLES[r.code]
-        out += ["", f"**Bad** (gives {r.code}):", "", "```xml", bad.rstrip("\n"), "```",
-                "", f"**Good** (no {r.code}):", "", "```xml", good.rstrip("\n"), "```"]
+        label = {"urdf": "URDF", "sdf": "SDF"}
+        out += ["", f"**Bad** ({label[example_format(bad)]}, gives {r.code}):", "", "```xml",
+                bad.rstrip("\n"), "```", "",
+                f"**Good** ({label[example_format(good)]}, no {r.code}):", "", "```xml",
+                good.rstrip("\n"), "```"]
     return out
 
 
