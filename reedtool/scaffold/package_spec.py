@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Callable, Mapping
 
 from reedtool.errors import PLAUSIBLE, ReedtoolError, check_plausible
+from reedtool.physics.propulsion import FIREFLY
 from reedtool.scaffold.airframes import Airframe, GroundLayout, get_frame
 
 # Unit factors to SI, per dimension. A dimension with no units takes plain numbers only.
@@ -91,13 +92,18 @@ PARAMS: tuple[Param, ...] = (
           "rotor height above the body centre (y6: lower rotors at minus this)"),
     Param("mass_rotor", "mass", 0.005, MULTIROTOR, "mass of one rotor (propeller)"),
     Param("radius_rotor", "length", 0.1, MULTIROTOR, "propeller radius"),
-    Param("motor_constant", "number", 8.54858e-06, MULTIROTOR,
+    # the motor model's defaults: RotorS firefly's (physics.propulsion.FIREFLY, which the
+    # summary names when no --motor/--prop/--battery derive them)
+    Param("motor_constant", "number", FIREFLY["motor_constant"], MULTIROTOR,
           "thrust per squared rotor speed [N/(rad/s)^2]"),
-    Param("moment_constant", "number", 0.016, MULTIROTOR,
+    Param("moment_constant", "number", FIREFLY["moment_constant"], MULTIROTOR,
           "drag torque per thrust [m]"),
-    Param("max_rot_velocity", "angular_velocity", 838.0, MULTIROTOR, "maximum rotor speed"),
-    Param("time_constant_up", "time", 0.0125, MULTIROTOR, "motor spin-up time constant"),
-    Param("time_constant_down", "time", 0.025, MULTIROTOR, "motor spin-down time constant"),
+    Param("max_rot_velocity", "angular_velocity", FIREFLY["max_rot_velocity"], MULTIROTOR,
+          "maximum rotor speed"),
+    Param("time_constant_up", "time", FIREFLY["time_constant_up"], MULTIROTOR,
+          "motor spin-up time constant"),
+    Param("time_constant_down", "time", FIREFLY["time_constant_down"], MULTIROTOR,
+          "motor spin-down time constant"),
     Param("rotor_drag_coefficient", "number", 8.06428e-05, MULTIROTOR,
           "RotorS rotor drag coefficient [N/(m/s)/(rad/s)]", allow_zero=True),
     Param("rolling_moment_coefficient", "number", 1e-06, MULTIROTOR,
