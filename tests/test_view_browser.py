@@ -14,9 +14,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from matplotlib import image as mpimg
 
 from browser import require_chromium, screenshot, settled_dom
+from picture_helpers import colour_masks
 from cli_helpers import run_cli
 from reedtool.report.html_viewer import MODEL_VIEWER_FILE
 
@@ -37,22 +37,11 @@ def _keep(shot: Path, name: str) -> None:
 
 
 def _spin_pixels(png: Path) -> dict[str, int]:
-    """Pixels by what they show: blue (ccw discs), orange (cw discs), body grey.
-
-    The discs are lit, so their colours are shaded versions of SPIN_RGBA; a hue test
-    (which channel leads, by a margin of 40/255 that shading keeps) classifies them
-    without depending on the light. The page's white and the caption's black text
-    fall in none of the classes.
-    """
-    rgb = (mpimg.imread(png)[..., :3] * 255).astype(int)
-    r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
-    header_rows = 90                             # title, caption and colour key (HTML, not WebGL)
-    view = np.s_[header_rows:, :]
-    blue = (b > r + 40) & (b > g)
-    orange = (r > b + 60) & (r > g) & (g > b)
-    grey = (abs(r - g) < 8) & (abs(g - b) < 8) & (r > 150) & (r < 235)
-    return {"ccw": int(blue[view].sum()), "cw": int(orange[view].sum()),
-            "grey": int(grey[view].sum())}
+    """Disc and body pixels below the page's header (title, caption and colour key are
+    HTML, not WebGL)."""
+    masks = colour_masks(png)
+    header_rows = 90
+    return {kind: int(masks[kind][header_rows:, :].sum()) for kind in ("ccw", "cw", "grey")}
 
 
 @pytest.fixture(scope="module")
@@ -155,6 +144,4 @@ def test_the_replay_plays_in_a_browser(replay, tmp_path):
     assert 0 < frames[0] < frames[1] == n - 1 and ended
     shot = screenshot(replay, tmp_path / "r.png")
     _keep(shot, "hover_replay_chromium.png")
-    rgb = (mpimg.imread(shot)[..., :3] * 255).astype(int)
-    red = (rgb[..., 0] > 150) & (rgb[..., 1] < 80) & (rgb[..., 2] < 80)
-    assert red.sum() > 100                    # the FRONT arrow, the time cursor
+    assert colour_masks(shot)["red"].sum() > 100                    # the FRONT arrow, the time cursor

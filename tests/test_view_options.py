@@ -13,10 +13,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 import trimesh
-from matplotlib import image as mpimg
 from matplotlib.path import Path as MplPath
 
 from cli_helpers import run_cli
+from picture_helpers import colour_masks
 from reedtool.assembly.view import view_robot
 from reedtool.io.loader import load_robot
 from reedtool.physics.rotors import discover_rotors
@@ -81,12 +81,9 @@ def test_top_view_has_front_up_and_left_on_the_left(example, tmp_path):
     out = tmp_path / "top.png"
     code, text = run_cli("view", EXAMPLE_QUAD, "-o", out, "--views", "top", "--size", "600x600")
     assert code == 0, text
-    rgb = (mpimg.imread(out)[..., :3] * 255).astype(int)
-    assert rgb.shape[:2] == (600, 600)
-    r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
-    blue = (b > r + 40) & (b > g)               # ccw discs (shaded SPIN_RGBA[1])
-    orange = (r > b + 60) & (r > g) & (g > b)   # cw discs
-    red = (r > 150) & (g < 80) & (b < 80)       # the FRONT arrow and label
+    masks = colour_masks(out)
+    assert masks["rgb"].shape[:2] == (600, 600)
+    blue, orange, red = masks["ccw"], masks["cw"], masks["red"]   # red: FRONT arrow, label
     centre = _centroid(blue | orange)
     front = _centroid(red)
     assert front[1] < centre[1] - 50            # above the rotors' centre, by a third of an arm
@@ -107,9 +104,9 @@ def test_outline_discs_leave_the_frame_visible(tmp_path):
         assert run_cli("view", EXAMPLE_QUAD, "-o", path, "--views", "top", "--discs", style,
                        "--size", "500x500")[0] == 0
     def disc_pixels(path):
-        rgb = (mpimg.imread(path)[..., :3] * 255).astype(int)
-        r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
-        return int(((b > r + 40) & (b > g)).sum() + ((r > b + 60) & (r > g) & (g > b)).sum())
+        masks = colour_masks(path)
+        return int(masks["ccw"].sum() + masks["cw"].sum())
+
     # a ring 8 % of the radius wide covers 1 - 0.92^2 = 15 % of the disc; the spin arrows
     # stay: the outline picture holds well under half the filled one's disc colour
     assert disc_pixels(outline) < 0.5 * disc_pixels(filled)
