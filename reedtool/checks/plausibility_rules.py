@@ -261,18 +261,9 @@ def _placeholder_geometry(ctx: CheckContext, link_name: str) -> bool:
     same mass: the geometry stands for a larger part, so it does not bound its volume."""
     from reedtool.physics.inertia import PLAUSIBLE_TRACE_RATIO
 
-    import numpy as np
-
     for comparison in ctx.link_comparisons:
         if comparison.link == link_name:
             ratio = comparison.trace_ratio
-            if ratio is None and comparison.declared is not None \
-                    and comparison.derived is not None:
-                # not compared (I204's "placeholder-geometry"): the ratio is still the
-                # evidence, whether the tensor was drawn for a larger part or not
-                derived = float(np.trace(comparison.derived.inertia_kg_m2))
-                declared = float(np.trace(comparison.declared.inertia_kg_m2))
-                ratio = declared / derived if derived > 0 else None
             return ratio is not None and math.isfinite(ratio) and ratio > PLAUSIBLE_TRACE_RATIO
     return False
 

@@ -697,15 +697,16 @@ def compare_link(link: Link, *, moving: bool = False, slowdown: float | None = N
         return result("geometry-error", f"{label}: {exc.one_line()}")
     derived = geometry.body
     density = geometry.density_kg_m3
+    trace_geom = float(np.trace(derived.inertia_kg_m2))
+    ratio = float(np.trace(declared.inertia_kg_m2)) / trace_geom if trace_geom > 0 else float("inf")
     if not problem and density is not None and density > DENSEST_MATERIAL_KG_M3:
+        # not judged, but the ratio stays the evidence of a stand-in for a larger part (I221)
         return result("placeholder-geometry",
                       f"the {label} would need {density:,.0f} kg/m³ to hold {mass:g} kg "
                       f"(no material is denser than {DENSEST_MATERIAL_KG_M3:,.0f}): a "
                       "placeholder, not the body, so the tensor is not compared with it",
-                      derived)
+                      derived, ratio=ratio)
     rel = relative_difference(declared.inertia_kg_m2, derived.inertia_kg_m2)
-    trace_geom = float(np.trace(derived.inertia_kg_m2))
-    ratio = float(np.trace(declared.inertia_kg_m2)) / trace_geom if trace_geom > 0 else float("inf")
     # With several shapes the mass may sit in any of them (a motor can heavier than its
     # prop disc): the declared tensor is judged against whichever distribution fits it
     # best, the uniform one or all of the mass in one shape.
