@@ -19,8 +19,8 @@ from click.testing import CliRunner
 
 from reedtool.cli import cli
 from reedtool.io.loader import load_robot
-from reedtool.io.mappings import parse_mappings
-from reedtool.scaffold.airframes import MULTIROTOR_FRAMES
+from reedtool.resolve.mappings import parse_mappings
+from reedtool.generate.airframes import MULTIROTOR_FRAMES
 
 TARGET_S = 1.0
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from reedtool.errors import ReedtoolError
-from reedtool.scaffold.airframes import FRAMES, GROUND_FRAMES, MULTIROTOR_FRAMES, get_frame
+from reedtool.generate.airframes import FRAMES, GROUND_FRAMES, MULTIROTOR_FRAMES, get_frame
 
 K_M = 0.016  # moment constant [m], the seed's
 

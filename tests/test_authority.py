@@ -149,7 +149,7 @@ def test_without_yaw_is_the_projection():
 
 @pytest.mark.parametrize("frame", ["quad-x", "quad-plus", "hex-x", "hex-plus", "octo-x", "y6"])
 def test_every_generated_frame_gets_a_table(tmp_path, frame):
-    from reedtool.scaffold.airframes import MULTIROTOR_FRAMES
+    from reedtool.generate.airframes import MULTIROTOR_FRAMES
 
     assert frame in MULTIROTOR_FRAMES
     name = "t_" + frame.replace("-", "_")

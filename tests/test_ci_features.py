@@ -369,14 +369,14 @@ def test_validate_package_xml_names_the_directory_to_pass(tmp_path, monkeypatch,
     (8, 14, 0.0, 2),     # never more than the available CPUs (2 here, or as many as there are)
 ])
 def test_jobs_start_workers_only_where_they_help(jobs, items, load, expected, monkeypatch):
-    from reedtool.assembly import parallel
+    from reedtool.workflows import parallel
 
     monkeypatch.setattr(parallel, "available_cpus", lambda: 2)
     assert parallel.workers_for(jobs, items, load) == expected
 
 
 def test_parallel_map_keeps_order_and_raises_the_first_error(monkeypatch):
-    from reedtool.assembly import parallel
+    from reedtool.workflows import parallel
     from reedtool.errors import ReedtoolError
 
     monkeypatch.setattr(parallel, "idle_cpus", lambda load=None: 2)

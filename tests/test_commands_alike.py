@@ -301,7 +301,7 @@ def test_inertia_reports_its_own_mass_verdicts_instead_of_refusing(tmp_path):
 
 def test_refusal_groups_by_code():
     """The policy's prefixes read as documented: the longest prefix wins, '-' excludes."""
-    from reedtool.assembly.validation import refuses
+    from reedtool.workflows.validation import refuses
 
     needs = ("structure", "mass", "rotors")
     for code in ("S101", "S112", "S113", "S116", "S117", "I201", "I203", "I209", "R303",
@@ -315,7 +315,7 @@ def test_refusal_groups_by_code():
 
 def test_the_documented_refusal_table_is_the_code():
     """docs/commands.md shows refusal_table(); regenerate the block when the rules change."""
-    from reedtool.assembly.validation import refusal_table
+    from reedtool.workflows.validation import refusal_table
 
     doc = (Path(__file__).parent.parent / "docs" / "commands.md").read_text()
     block = doc.split("<!-- refusal-table")[1].split("<!-- end refusal-table -->")[0]

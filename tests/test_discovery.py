@@ -128,7 +128,7 @@ def test_a_directory_finds_the_gazebo_top_file_not_the_base_xacro(tmp_path, caps
     .gazebo file no other file includes; <mav>_base.xacro is the part it includes through
     `$(arg mav_name)_base.xacro`, with or without the arguments."""
     shutil.copytree(SEED, tmp_path / "reed_gazebo")
-    from reedtool.io.model_inputs import expand_targets, include_globs_of, include_tree_of
+    from reedtool.workflows.targets import expand_targets, include_globs_of, include_tree_of
 
     for mappings in ({}, SEED_ARGS):
         targets = expand_targets([str(tmp_path)],
@@ -141,7 +141,7 @@ def test_a_directory_finds_the_gazebo_top_file_not_the_base_xacro(tmp_path, caps
 
 
 def test_an_include_pattern_needs_an_argument_without_a_value(tmp_path):
-    from reedtool.io.model_inputs import include_globs_of
+    from reedtool.workflows.targets import include_globs_of
 
     top = tmp_path / "top.gazebo"
     top.write_text('<robot xmlns:xacro="http://ros.org/wiki/xacro">\n'
@@ -176,7 +176,7 @@ def test_the_hook_and_discovery_know_the_same_model_files():
     discovery uses, plus the configuration files that carry xacro arguments."""
     import yaml
 
-    from reedtool.io.model_inputs import CONFIG_NAMES, MODEL_SUFFIXES
+    from reedtool.workflows.targets import CONFIG_NAMES, MODEL_SUFFIXES
 
     hooks = yaml.safe_load((Path(__file__).parents[1] / ".pre-commit-hooks.yaml").read_text())
     pattern = re.compile(hooks[0]["files"])
@@ -311,7 +311,7 @@ def test_a_changed_macro_library_is_checked_through_a_model_beside_it(flie, caps
 
 
 def test_every_command_suggests_the_mapping():
-    """Commands that take one model read the words after it as arguments (io.mappings)."""
+    """Commands that take one model read the words after it as arguments (resolve.mappings)."""
     from cli_helpers import run_cli
 
     code, out = run_cli("inertia", FLIE / "urdf" / "flie_base.xacro", "namespace=flie")

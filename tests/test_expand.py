@@ -16,7 +16,7 @@ import pytest
 from lxml import etree
 
 from reedtool.errors import ReedtoolError
-from reedtool.io.packages import BUNDLED_PACKAGES_DIR
+from reedtool.resolve.packages import BUNDLED_PACKAGES_DIR
 from reedtool.io.xacro_expand import expand_xacro
 
 FIXTURES = Path(__file__).parent / "fixtures"

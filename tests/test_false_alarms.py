@@ -225,8 +225,8 @@ def test_the_shared_name_is_refused_once_from_sdf_1_7(tmp_path):
 # ------------------------------------------------------------------ hover-test refusals
 
 def _judged(tmp_path, edit):
-    from reedtool.assembly.models import ModelRequest
-    from reedtool.assembly.validation import judge
+    from reedtool.workflows.robots import ModelRequest
+    from reedtool.workflows.validation import judge
 
     text = (Path(__file__).parent / "fixtures/validate/clean_quad_x.urdf").read_text()
     path = tmp_path / "quad.urdf"
@@ -317,7 +317,7 @@ def test_a_tilt_unit_on_a_placeholder_box_is_not_compared():
 def test_a_package_keeping_its_models_elsewhere_is_not_empty(tmp_path):
     """ntnu-arl's rmf_gz keeps its robot under resources/robots/: validate on the package
     checks it rather than saying the package holds no model."""
-    from reedtool.io.model_inputs import expand_targets
+    from reedtool.workflows.targets import expand_targets
 
     pkg = tmp_path / "rmf_gz"
     (pkg / "resources" / "robots" / "rmf").mkdir(parents=True)
@@ -435,7 +435,7 @@ def test_a_urdf_world_link_must_still_exist(tmp_path):
 def test_a_file_of_gazebo_extensions_only_is_not_a_model(tmp_path):
     """mantis' slung_load.gazebo: <robot> holding only <gazebo> plugin blocks, a fragment
     for a model to include; no "the model has no <link>" on it."""
-    from reedtool.io.model_inputs import expand_targets
+    from reedtool.workflows.targets import expand_targets
 
     (tmp_path / "quad.urdf").write_text((Path(__file__).parent /
                                          "fixtures/validate/clean_quad_x.urdf").read_text())

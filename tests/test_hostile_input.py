@@ -430,7 +430,7 @@ def test_environment_errors_are_one_line_not_internal(exc, fragment, monkeypatch
 
 
 def test_package_scan_is_bounded(tmp_path, monkeypatch, capsys):
-    from reedtool.io import packages
+    from reedtool.resolve import packages
 
     monkeypatch.setattr(packages, "MAX_CRAWL_DIRS", 30)
     for i in range(40):

@@ -12,7 +12,7 @@ from cli_helpers import run_cli
 from reedtool.checks.runner import Selection, run_checks
 from reedtool.io.loader import load_robot
 from reedtool.physics.inertia import box_inertia, compare_links, cylinder_inertia
-from reedtool.scaffold.airframes import MULTIROTOR_FRAMES
+from reedtool.generate.airframes import MULTIROTOR_FRAMES
 
 
 def rotor_model(rotor_inertia_diag, slowdown: str | None = "10", rotor_mass=0.005) -> str:
@@ -205,10 +205,10 @@ def test_a_severity_override_means_the_same_in_validate_and_inertia(
 ])
 def test_each_failing_verdict_maps_to_the_rule_validate_reports_it_with(
         tmp_path, wheel, mass, joint, verdict):
-    """inertia takes a verdict's severity from one rule (assembly.validation.verdict_code);
+    """inertia takes a verdict's severity from one rule (workflows.validation.verdict_code);
     that must be the rule validate actually reports the link with, found by running
     validate's rules, not by reading the map back."""
-    from reedtool.assembly.validation import verdict_code
+    from reedtool.workflows.validation import verdict_code
     from reedtool.physics.inertia import moving_links
 
     model = tmp_path / "cart.urdf"

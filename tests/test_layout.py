@@ -16,15 +16,17 @@ PACKAGE = Path(reedtool.__file__).resolve().parent
 CORE = {"", "errors", "model", "frames"}         # reedtool/__init__ and what every stage shares
 RANK = {
     "": 0,
-    "io": 1,
-    "physics": 2,
-    "flightstack": 3,
-    "checks": 4, "sim": 4,
-    "scaffold": 5,
-    "report": 6, "config": 6,
-    "assembly": 7,
-    "commands": 8,
-    "cli": 9,
+    "resolve": 1,
+    "io": 2,
+    "physics": 3,
+    "flightstack": 4,
+    "checks": 5, "sim": 5,
+    "port": 6,
+    "generate": 7,
+    "report": 8, "config": 8,
+    "workflows": 9,
+    "commands": 10,
+    "cli": 11,
 }
 # What the commands share that is not itself a command (click option types).
 COMMANDS_SHARED = {"reedtool.commands", "reedtool.commands.params"}
@@ -93,16 +95,16 @@ def _stage_edges(graph: dict[str, set[str]]) -> set[tuple[str, str]]:
 
 
 def test_stages_run_in_pipeline_order():
-    """The assembly sits between the output stage and the commands, checks and sim below
-    it: read from the package's imports, not from RANK. The assembly builds on checks, sim
-    and report, the commands on the assembly, and no stage below reaches up to them."""
+    """The workflows stage sits between the output stage and the commands, checks and sim below
+    it: read from the package's imports, not from RANK. The workflows stage builds on checks, sim
+    and report, the commands on it, and no stage below reaches up to them."""
     edges = _stage_edges(_graph())
-    assert {("assembly", "checks"), ("assembly", "sim"), ("assembly", "report"),
-            ("commands", "assembly")} <= edges
-    below = {"", "io", "physics", "flightstack", "checks", "sim", "scaffold", "report",
+    assert {("workflows", "checks"), ("workflows", "sim"), ("workflows", "report"),
+            ("commands", "workflows")} <= edges
+    below = {"", "resolve", "io", "physics", "flightstack", "checks", "sim", "port", "generate", "report",
              "config"}
     upward = sorted(f"{low} -> {high}" for low, high in edges
-                    if low in below and high in ("assembly", "commands", "cli"))
+                    if low in below and high in ("workflows", "commands", "cli"))
     assert upward == []
 
 
@@ -119,7 +121,7 @@ def _command_to_command(graph: dict[str, set[str]]) -> list[str]:
 
 def test_no_command_imports_another_command():
     """Each command is options -> one call -> report -> exit code; what two commands share
-    lives below them (assembly/, report/), never in one of them."""
+    lives below them (workflows/, report/), never in one of them."""
     assert _command_to_command(_graph()) == []
 
 
@@ -128,7 +130,7 @@ def test_command_to_command_imports_are_found():
     the shared option types are not."""
     graph = {"reedtool.commands.hover_test": {"reedtool.commands.validate",
                                               "reedtool.commands.params",
-                                              "reedtool.assembly.flight"}}
+                                              "reedtool.workflows.flight"}}
     assert _command_to_command(graph) == ["reedtool.commands.hover_test -> "
                                           "reedtool.commands.validate"]
 

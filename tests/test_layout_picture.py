@@ -3,7 +3,7 @@
 For every frame new-package makes, the SVG is parsed (elements by id) and mapped back
 to metres through the axis transform given by two anchors; each rotor's disc, number and
 spin arrow must sit where the model's rotor table (discover_rotors) puts that rotor, with
-the number and sense PX4's airframe reference gives its slot (scaffold.airframes).
+the number and sense PX4's airframe reference gives its slot (generate.airframes).
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from lxml import etree
 from reedtool.report.layout_picture import ANCHOR_M
 from reedtool.io.loader import load_robot
 from reedtool.physics.rotors import discover_rotors
-from reedtool.scaffold.airframes import FRAMES, MULTIROTOR_FRAMES
+from reedtool.generate.airframes import FRAMES, MULTIROTOR_FRAMES
 
 SVG = "{http://www.w3.org/2000/svg}"
 XLINK = "{http://www.w3.org/1999/xlink}"

@@ -539,8 +539,8 @@ def test_shipped_allocation_is_the_models(packages, frame):
     second derivation of the same matrix from the other file, so a sign convention
     (angle, direction) read wrong in either shows. Equal to 1e-9 m (the YAML's 10
     significant digits)."""
-    from reedtool.assembly.lee_flight import entry_of_rotor, rotors_lee_of
-    from reedtool.assembly.vehicle import Vehicle
+    from reedtool.workflows.lee_flight import entry_of_rotor, rotors_lee_of
+    from reedtool.workflows.vehicle import Vehicle
     from reedtool.flightstack.rotors_lee import load_lee_parameters
     from reedtool.io.loader import load_robot
     from reedtool.physics.allocation import allocation_matrix

@@ -326,7 +326,7 @@ def test_bad_input_is_exit_2(tmp_path):
 
 def test_the_proof_fails_on_a_port_that_differs(tmp_path, monkeypatch):
     """A writer that loses the spin direction: the proof lists it and exits 1."""
-    from reedtool.scaffold import gz_port
+    from reedtool.port import gz_port
 
     monkeypatch.setattr(gz_port, "GZ_MOTOR_PARAMS",
                         tuple(p for p in gz_port.GZ_MOTOR_PARAMS if p != "turningDirection"))
@@ -338,8 +338,8 @@ def test_the_proof_fails_on_a_port_that_differs(tmp_path, monkeypatch):
 
 def test_the_proof_catches_an_edited_constant(tmp_path):
     """Read back a port whose motorConstant was changed in the last digit."""
-    from reedtool.assembly.migration import MigrateRequest, prove
-    from reedtool.scaffold.gz_port import plan_port
+    from reedtool.workflows.migration import MigrateRequest, prove
+    from reedtool.port.gz_port import plan_port
 
     model = FIXTURES / "migrate" / "pelican_quad.xacro"
     _code, _document, target = migrate(tmp_path, model)

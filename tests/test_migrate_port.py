@@ -268,9 +268,9 @@ def test_rotors_sensor_snippets_become_gz_sensors(tmp_path):
 
 def _prove_edited(tmp_path, model: Path, edit) -> set[tuple[str, str, str]]:
     """Port `model`, apply `edit` to the written model.sdf, and prove it again."""
-    from reedtool.assembly.migration import MigrateRequest, prove
+    from reedtool.workflows.migration import MigrateRequest, prove
     from reedtool.io.loader import load_robot
-    from reedtool.scaffold.gz_port import plan_port
+    from reedtool.port.gz_port import plan_port
 
     code, _document, target = migrate(tmp_path, model)
     assert code == 0
@@ -386,7 +386,7 @@ def test_the_proof_fails_when_a_joint_axis_moves(tmp_path):
 def test_a_failed_migrate_leaves_nothing(tmp_path, monkeypatch):
     """Reading the port back fails: exit 2, no model directory, no staging left behind;
     an existing port given --force is left as it was."""
-    from reedtool.assembly import migration
+    from reedtool.workflows import migration
     from reedtool.errors import ReedtoolError
 
     def broken(*_args, **_kwargs):
@@ -472,7 +472,7 @@ def test_view_does_not_embed_outside_files(tmp_path, outside_model):
 def test_the_sensor_table_in_the_docs_is_the_code_s():
     """docs/migrate.md's sensor table lists every SensorKind: its spellings, its gz type
     (or "dropped") and its system."""
-    from reedtool.scaffold.gz_sensors import SENSOR_KINDS
+    from reedtool.port.gz_sensors import SENSOR_KINDS
 
     text = (Path(__file__).resolve().parents[1] / "docs" / "migrate.md").read_text()
     table = text[text.index("| Classic / SDF `type=` |"):]
@@ -582,10 +582,10 @@ def test_px4_contract_moves_are_proved_in_the_base_frame(tmp_path):
     """--autopilot px4 renames the iris' IMU plugin to imu_sensor and moves it to base_link,
     posed where it was: the proof holds it to the same place in the base frame (EQUAL), and
     fails when the written sensor is 1 cm off that place."""
-    from reedtool.assembly.migration import MigrateRequest, prove
+    from reedtool.workflows.migration import MigrateRequest, prove
     from reedtool.io.loader import load_robot
-    from reedtool.scaffold.gz_port import PortOptions, plan_port
-    from reedtool.scaffold.px4_gz_contract import apply_px4_contract
+    from reedtool.port.gz_port import PortOptions, plan_port
+    from reedtool.port.px4_gz_contract import apply_px4_contract
 
     code, document, target = migrate(tmp_path, IRIS_GPS, "--autopilot", "px4")
     assert code == 0, document["proof"]["differences"]

@@ -17,7 +17,7 @@ from cli_helpers import run_cli
 from oracles import CHECK_URDF
 
 from reedtool.cli import SUBCOMMANDS
-from reedtool.scaffold.airframes import FRAMES, GROUND_FRAMES, MULTIROTOR_FRAMES
+from reedtool.generate.airframes import FRAMES, GROUND_FRAMES, MULTIROTOR_FRAMES
 
 CASES = [(frame, ros) for frame in FRAMES for ros in (1, 2)]
 

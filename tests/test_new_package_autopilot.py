@@ -8,8 +8,8 @@ from reedtool.checks.runner import Selection, run_checks
 from reedtool.commands.new_package import model_path, new_package
 from reedtool.flightstack import ardupilot, px4
 from reedtool.io.loader import load_robot
-from reedtool.scaffold.airframes import MULTIROTOR_FRAMES
-from reedtool.scaffold.package_spec import build_spec
+from reedtool.generate.airframes import MULTIROTOR_FRAMES
+from reedtool.generate.package_spec import build_spec
 
 
 def _generate(tmp_path, frame: str, autopilot: str, ros: int = 2, sim: str | None = None):

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from reedtool.errors import ReedtoolError
-from reedtool.scaffold.package_spec import build_spec, check_package_name, thrust_to_weight
+from reedtool.generate.package_spec import build_spec, check_package_name, thrust_to_weight
 
 
 @pytest.mark.parametrize("name", ["reed_gazebo", "a", "quad2", "my_robot_description"])

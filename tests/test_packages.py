@@ -1,4 +1,4 @@
-"""Package search order and URI resolution (reedtool.io.packages)."""
+"""Package search order and URI resolution (reedtool.resolve.packages)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from reedtool.errors import ReedtoolError
-from reedtool.io.packages import BUNDLED_PACKAGES_DIR, PackageResolver
+from reedtool.resolve.packages import BUNDLED_PACKAGES_DIR, PackageResolver
 from reedtool.model import SourceLoc
 
 

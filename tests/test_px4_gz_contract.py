@@ -217,7 +217,7 @@ def test_px4_takes_its_own_vehicles_top_speeds(tmp_path, max_rad_s):
     1100: the 0..1000 of gz_bridge module.yaml is QGroundControl's range, not PX4's."""
     from reedtool.commands.new_package import new_package
     from reedtool.flightstack.px4 import load_px4_params
-    from reedtool.scaffold.package_spec import build_spec
+    from reedtool.generate.package_spec import build_spec
 
     spec = build_spec("fast", frame="quad-x", ros=2, flags={"max_rot_velocity": str(max_rad_s)},
                       sim="gz")
@@ -230,7 +230,7 @@ def test_px4_takes_its_own_vehicles_top_speeds(tmp_path, max_rad_s):
 def test_px4_refuses_a_speed_no_output_can_carry(tmp_path):
     from reedtool.commands.new_package import new_package
     from reedtool.errors import ReedtoolError
-    from reedtool.scaffold.package_spec import build_spec
+    from reedtool.generate.package_spec import build_spec
 
     spec = build_spec("rads", frame="quad-x", ros=2, flags={"max_rot_velocity": "70000"},
                       sim="gz")
@@ -248,7 +248,7 @@ def test_new_package_gz_px4_writes_the_contract(tmp_path, frame):
     from reedtool.commands.new_package import new_package
     from reedtool.flightstack.px4 import load_px4_params
     from reedtool.io.loader import load_robot
-    from reedtool.scaffold.package_spec import build_spec
+    from reedtool.generate.package_spec import build_spec
 
     name = f"px4_{frame.replace('-', '_')}"
     spec = build_spec(name, frame=frame, ros=2, flags={}, sim="gz")

@@ -465,7 +465,7 @@ def test_migrate_ports_exactly_the_motor_plugins_discovery_reads():
     discovery reads as RotorS / PX4 classic rotors (librotors_gazebo_motor_model.so,
     libgazebo_motor_model.so), and the gz system it writes is one discovery reads as gz."""
     from reedtool.model import motor_plugin_family
-    from reedtool.scaffold.gz_port import MOTOR_SYSTEM, PLUGIN_FAMILIES
+    from reedtool.port.gz_port import MOTOR_SYSTEM, PLUGIN_FAMILIES
 
     (motor,) = [f for f in PLUGIN_FAMILIES if f.action == "motor"]
     assert {lib: motor_plugin_family(f"lib{lib}.so", None) for lib in motor.libraries} == \

@@ -15,7 +15,7 @@ from cli_helpers import run_cli
 from reedtool.checks.runner import Selection, run_checks
 from reedtool.errors import ReedtoolError
 from reedtool.io.loader import load_robot, load_robots
-from reedtool.io.resources import RESOURCE_PATH_VARS
+from reedtool.resolve.resources import RESOURCE_PATH_VARS
 from reedtool.physics.kinematics import link_poses
 from reedtool.physics.rotors import discover_rotors
 

@@ -73,7 +73,7 @@ def test_a_directory_and_model_config_find_the_template(tmp_path):
     from reedtool.io.sdf_jinja import render
 
     (copy / "quad_jinja.sdf").write_text(render(TEMPLATE).text)
-    from reedtool.io.model_inputs import expand_targets
+    from reedtool.workflows.targets import expand_targets
 
     targets = [t for t in expand_targets([str(tmp_path)], lambda p: [p]) if t.path is not None]
     assert [t.path.name for t in targets] == ["quad_jinja.sdf.jinja"]

@@ -99,7 +99,7 @@ def _package(root: Path, name: str) -> None:
 
 
 def test_a_run_crawls_each_package_root_once(capsys, tmp_path, monkeypatch):
-    from reedtool.io import packages
+    from reedtool.resolve import packages
 
     workspace = tmp_path / "ws"
     for i in range(5):

@@ -28,7 +28,7 @@ from lxml import etree
 from cli_helpers import run_cli
 from reedtool.io.loader import load_robot
 from reedtool.physics.kinematics import link_poses
-from reedtool.assembly.view import view_robot
+from reedtool.workflows.view import view_robot
 from reedtool.report.scene import DECORATION_PREFIXES, SEVERITY_RGBA, glb_bytes, nice_length
 
 ROOT = Path(__file__).resolve().parents[1]

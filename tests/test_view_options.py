@@ -17,7 +17,7 @@ from matplotlib.path import Path as MplPath
 
 from cli_helpers import run_cli
 from picture_helpers import colour_masks
-from reedtool.assembly.view import view_robot
+from reedtool.workflows.view import view_robot
 from reedtool.io.loader import load_robot
 from reedtool.physics.rotors import discover_rotors
 from reedtool.report.layout_picture import _silhouette, rotor_marks

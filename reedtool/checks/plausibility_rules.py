@@ -43,7 +43,7 @@ JOINT_AXIS_TOL_DEG = 5.0
 
 # ---- I221: no link is denser than matter.
 # The densest solid at room conditions is osmium, 22.59 g/cm³ (CRC Handbook of Chemistry
-# and Physics, 97th ed., "Density of the elements"; iridium 22.56). No assembly of real
+# and Physics, 97th ed., "Density of the elements"; iridium 22.56). No workflows of real
 # material averages more than its densest part, so mass / volume above this is not a
 # part of any material. The bound needs a volume that does not under-state the part:
 #  - a closed mesh encloses the solid it bounds; when the part is a hollow shell drawn

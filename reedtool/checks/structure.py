@@ -354,7 +354,7 @@ def mesh_unresolved(ctx: CheckContext) -> Iterator[Issue]:
     keeps looking (its model database included) and the world never comes up (a known
     classic defect). gz-sim logs the error and spawns the model without that geometry.
     """
-    from reedtool.io.resources import is_remote_uri
+    from reedtool.resolve.resources import is_remote_uri
 
     for link, kind, shape, mesh in mesh_shapes(ctx):
         if _refused(ctx, mesh) or is_remote_uri(mesh.uri):
@@ -388,7 +388,7 @@ def remote_resource_not_checked(ctx: CheckContext) -> Iterator[Issue]:
     said so, once per URI. To check it, download it (`gz fuel download -u URI`) and pass
     `--package-path DIR` with the folder holding it, with the URI as a `model://` one.
     """
-    from reedtool.io.resources import REMOTE_NOT_CHECKED, is_remote_uri
+    from reedtool.resolve.resources import REMOTE_NOT_CHECKED, is_remote_uri
 
     yield from _reader_issues(ctx, "remote-uri")
     seen = set()

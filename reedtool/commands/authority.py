@@ -225,7 +225,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
         if plot_path.suffix.lower() not in (".png", ".svg"):
             raise ReedtoolError(f"cannot tell the plot format from '{plot_path.name}'",
                                 file=plot_path, hint="name the --plot file .png or .svg")
-    from reedtool.assembly.assemble import assemble
+    from reedtool.workflows.assemble import assemble
     from reedtool.report.validation_note import validation_json, validation_text, why_line
 
     assembled = assemble(model, request, "authority")
@@ -275,7 +275,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
     if not props.mass_kg > 0:
         raise ReedtoolError("the robot has no mass", file=model,
                             hint="run `reedtool inertia` on the model")
-    from reedtool.assembly.failures import analyse, fly_failures
+    from reedtool.workflows.failures import analyse, fly_failures
 
     report = analyse(rotors, props.mass_kg, props.com_m,
                      _efficiency(efficiency_items, [r.name for r in rotors]), degrade)

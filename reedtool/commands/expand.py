@@ -12,7 +12,7 @@ from reedtool.errors import ReedtoolError
 
 def _fix_legacy(model: Path, mappings: dict[str, str], package_paths: list[Path]) -> None:
     from reedtool.io.fileio import atomic_write_text
-    from reedtool.io.packages import is_bundled
+    from reedtool.resolve.packages import is_bundled
     from reedtool.io.xacro_expand import display_path, scan_legacy
 
     scan = scan_legacy(model, mappings, package_paths)
@@ -64,7 +64,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
     model, request = one_model_request("expand", inputs, package_paths, model_name,
                                        launch_file)
     _refuse_non_xacro(model)
-    from reedtool.assembly.models import model_mappings
+    from reedtool.workflows.robots import model_mappings
 
     mappings = model_mappings(model, request)
     if is_stdout(output):

@@ -17,8 +17,8 @@ from pathlib import Path
 
 import click
 
-from reedtool.assembly.flight import Progress
-from reedtool.assembly.vehicle import DEFAULT_MAX_MEMORY_MB
+from reedtool.workflows.flight import Progress
+from reedtool.workflows.vehicle import DEFAULT_MAX_MEMORY_MB
 from reedtool.commands.params import (
     FiniteFloatRange,
     model_inputs,
@@ -204,7 +204,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
                                        launch_file, ignore)
     note_input(model)
 
-    from reedtool.assembly.assemble import assemble
+    from reedtool.workflows.assemble import assemble
 
     # A model or batch too large for the machine is refused before any rule runs on it.
     assembled = assemble(model, request, "hover-test", samples=samples,
@@ -236,7 +236,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
                                    "message": why_line(verdict.refusing, verdict.reported,
                                                        True, "flying it")}, indent=2))
         return 1
-    from reedtool.assembly.flight import hover_test
+    from reedtool.workflows.flight import hover_test
 
     report = hover_test(robot, config, samples=samples, seed=seed,
                         spreads=(mass_spread, com_spread_m, inertia_spread, motor_spread),
@@ -278,7 +278,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
         atomic_write_bytes(plot_path, figure, force=force)
 
     if run is not None and replay_path is not None:
-        from reedtool.assembly.flight import replay_page
+        from reedtool.workflows.flight import replay_page
         from reedtool.io.fileio import atomic_write_text
 
         atomic_write_text(replay_path, replay_page(assembled.vehicle, run, config,

@@ -51,7 +51,7 @@ class ImportOutcome:
     mesh_file: Path
     collision_file: Path | None
     snippet: str
-    body_edit: object | None = None   # scaffold.package_body.BodyEdit for the package's model
+    body_edit: object | None = None   # generate.package_body.BodyEdit for the package's model
     body_written: bool = False        # the edit was written (--set-body)
     body_backup: Path | None = None
 
@@ -96,7 +96,7 @@ def run_import(mesh: Path, package_dir: Path, *, name: str | None = None, units:
                force: bool = False, progress=None, set_body: bool = False) -> ImportOutcome:
     """Import `mesh` into `package_dir`: the whole command without its printing.
 
-    When the package's model is one new-package wrote (scaffold.package_body), the edit
+    When the package's model is one new-package wrote (generate.package_body), the edit
     that makes the mesh its body is planned: written with `set_body` (a numbered backup
     of the model file first), else returned for its lines to be printed."""
     from reedtool.frames import axis_convention
@@ -128,7 +128,7 @@ def run_import(mesh: Path, package_dir: Path, *, name: str | None = None, units:
         raise ReedtoolError("the output would overwrite the input mesh", file=mesh,
                             hint="pass a different --name")
 
-    from reedtool.scaffold.package_body import find_body_model, package_mass_kg
+    from reedtool.generate.package_body import find_body_model, package_mass_kg
 
     body_model = find_body_model(package_dir)
     if set_body and body_model is None:
@@ -160,7 +160,7 @@ def run_import(mesh: Path, package_dir: Path, *, name: str | None = None, units:
         outputs.append((snippet_file, snippet.encode("utf-8")))
     edit = None
     if body_model is not None:
-        from reedtool.scaffold.package_body import check_edit, plan_body_edit
+        from reedtool.generate.package_body import check_edit, plan_body_edit
 
         edit = plan_body_edit(body_model, package, name, imported.mass,
                               set_mass=mass_kg is not None or density_kg_m3 is not None)

@@ -311,8 +311,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
     """
     model, request = one_model_request("inertia", inputs, package_paths, model_name,
                                        launch_file, ignore)
-    from reedtool.assembly.assemble import load_robot_for
-    from reedtool.assembly.validation import judge, judge_links
+    from reedtool.workflows.assemble import load_robot_for
+    from reedtool.workflows.validation import judge, judge_links
     from reedtool.checks.preflight import require_sound_model
     from reedtool.physics.inertia import compare_links, whole_robot
     from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio

@@ -44,9 +44,9 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
     model, request = one_model_request("layout", inputs, package_paths, model_name,
                                        launch_file, ignore)
     note_input(model)
-    from reedtool.assembly.assemble import load_robot_for
-    from reedtool.assembly.diagram import write_diagram
-    from reedtool.assembly.validation import judge
+    from reedtool.workflows.assemble import load_robot_for
+    from reedtool.workflows.diagram import write_diagram
+    from reedtool.workflows.validation import judge
     from reedtool.report.validation_note import validation_text
 
     robot, _ = load_robot_for(model, request)

@@ -57,7 +57,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
     directory, glob or ROS package holding one model; NAME:=VALUE words are its xacro
     arguments.
     """
-    from reedtool.assembly.migration import MigrateRequest, migrate
+    from reedtool.workflows.migration import MigrateRequest, migrate
 
     model, request = one_model_request("migrate", inputs, package_paths, model_name,
                                        launch_file)

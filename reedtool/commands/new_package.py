@@ -7,7 +7,7 @@ from pathlib import Path, PurePosixPath
 
 import click
 
-from reedtool.scaffold.airframes import FRAMES
+from reedtool.generate.airframes import FRAMES
 
 
 @dataclass
@@ -16,7 +16,7 @@ class NewPackageResult:
     files: list[PurePosixPath]
     backup: Path | None
     context: dict
-    mesh: object | None = None     # the CAD body (scaffold.cad_body.CadBody)
+    mesh: object | None = None     # the CAD body (generate.cad_body.CadBody)
 
 
 def template_sets(kind: str, ros: int, sim: str = "classic") -> list[str]:
@@ -42,7 +42,7 @@ def mesh_lines(body, spec) -> list[str]:
     """What new-package assumed about the body mesh, as import-stl says it, and where the
     CAD body put the COM and the rotors."""
     from reedtool.physics.mesh_import import assumption_lines
-    from reedtool.scaffold.cad_body import cad_lines
+    from reedtool.generate.cad_body import cad_lines
 
     imported = body.imported
     size = imported.size_m
@@ -59,10 +59,10 @@ def new_package(spec, output_dir: Path, *, force: bool = False, mesh_units: str 
     """Render the package for `spec` into output_dir/spec.name, all or nothing.
 
     `autopilot` ('px4' | 'ardupilot') adds the autopilot's rotor table, written from the
-    same frame as the model (reedtool.scaffold.autopilot).
+    same frame as the model (reedtool.generate.autopilot).
     """
-    from reedtool.scaffold.autopilot import autopilot_context, autopilot_files, prepare_spec
-    from reedtool.scaffold.render import RenderedFile, check_target, render_tree, write_tree
+    from reedtool.generate.autopilot import autopilot_context, autopilot_files, prepare_spec
+    from reedtool.generate.render import RenderedFile, check_target, render_tree, write_tree
 
     spec = prepare_spec(spec, autopilot)
 
@@ -71,7 +71,7 @@ def new_package(spec, output_dir: Path, *, force: bool = False, mesh_units: str 
     body_props = mesh_data = body = None
     if spec.mesh is not None:
         from reedtool.io.stl import stl_bytes
-        from reedtool.scaffold.cad_body import load_cad_body
+        from reedtool.generate.cad_body import load_cad_body
 
         body = load_cad_body(spec, units=mesh_units, frame=mesh_frame, centre=center)
         body_props = body.props
@@ -82,7 +82,7 @@ def new_package(spec, output_dir: Path, *, force: bool = False, mesh_units: str 
 
         raise ReedtoolError("--center places rotors on a CAD body: it needs --mesh",
                             hint="drop --center, or pass the body with --mesh")
-    from reedtool.scaffold.package_spec import template_context
+    from reedtool.generate.package_spec import template_context
 
     context = template_context(spec, body_props)
     context.update(autopilot_context(spec, autopilot))
@@ -109,7 +109,7 @@ def _summary(result: NewPackageResult, spec) -> list[str]:
         for r in ctx["rotors"]:
             lines.append(f"  motor {r['motor_number']}  {r['suffix']:<20} "
                          f"({', '.join(r['position_m'])}) m  {r['direction']}")
-        from reedtool.scaffold.package_spec import propulsion_lines
+        from reedtool.generate.package_spec import propulsion_lines
 
         lines.extend(propulsion_lines(spec))
     else:
@@ -186,7 +186,7 @@ def command(name, frame, ros, sim, spec_file, mass, arm_length, mesh, mesh_units
     MulticopterMotorModel systems, or the RotorS macro interface with --sim classic) passes
     `reedtool validate` and `hover-test` as generated.
     """
-    from reedtool.scaffold.package_spec import build_spec
+    from reedtool.generate.package_spec import build_spec
 
     spec = build_spec(name, frame=frame, ros=int(ros) if ros else None, spec_file=spec_file,
                       flags={"mass": mass, "arm_length": arm_length}, mesh=mesh, sim=sim,

@@ -3,7 +3,7 @@ reads them the same way.
 
 - `model_inputs`: the model paths (files, directories, globs, ROS packages) with their
   xacro `name:=value` words, `--package-path`, `--model` and `--launch`; `[tool.reedtool]
-  args` of the nearest configuration are added when the model is loaded (assembly/).
+  args` of the nearest configuration are added when the model is loaded (workflows/).
 - `validation_options`: `--ignore CODE` and `--ignore-validation`, for the commands that
   run validate's rules before they compute.
 
@@ -70,7 +70,7 @@ def ignore_option(command):
 
 def validation_options(command):
     """--ignore CODE and --ignore-validation: how a computing command treats validate's
-    errors (assembly/validation.py says which ones it refuses on)."""
+    errors (workflows/validation.py says which ones it refuses on)."""
     command = click.option(
         "--ignore-validation", is_flag=True,
         help="Compute even when validate reports an error that makes the result "
@@ -91,7 +91,7 @@ def note_model_files(inputs) -> None:
 def one_model_request(command_name: str, inputs, package_paths, model_name, launch_file,
                       ignore=()):
     """The command line of a single-model command -> (model path, ModelRequest)."""
-    from reedtool.assembly.models import one_model, request_from_words
+    from reedtool.workflows.robots import one_model, request_from_words
 
     paths, request = request_from_words(inputs, package_paths=package_paths,
                                         model_name=model_name, launch_file=launch_file,

@@ -16,8 +16,8 @@ from pathlib import Path
 
 import click
 
-from reedtool.assembly.models import ModelRequest, model_arguments, targets_of
-from reedtool.assembly.validation import selection_for
+from reedtool.workflows.robots import ModelRequest, model_arguments, targets_of
+from reedtool.workflows.validation import selection_for
 from reedtool.commands.params import ignore_option, model_inputs
 from reedtool.errors import ReedtoolError
 
@@ -65,19 +65,19 @@ class RunOptions:
 class Job:
     """One check of the run: a model path, with one argument variant of its config."""
 
-    target: object                  # io.model_inputs.Target
+    target: object                  # workflows.targets.Target
     variant: dict | None = None     # per-file-args variant; None: the model's arguments
 
     @property
     def name(self) -> str:
-        from reedtool.assembly.models import variant_label
+        from reedtool.workflows.robots import variant_label
 
         return self.target.name + (variant_label(self.variant) if self.variant else "")
 
 
 def jobs_of(target, request: ModelRequest) -> list[Job]:
-    """The checks of one target: one per argument variant it has (assembly.models)."""
-    from reedtool.assembly.models import variants_of
+    """The checks of one target: one per argument variant it has (workflows.robots)."""
+    from reedtool.workflows.robots import variants_of
 
     variants = variants_of(target.path, request)
     return [Job(target, v) for v in variants] if variants else [Job(target)]
@@ -104,7 +104,7 @@ def check_target(job: Job, options: RunOptions) -> tuple[list, list[str], list]:
 def check_model(name: str, model: Path, options: RunOptions) -> list:
     """The ModelResults of one model path (several for a world). Input errors of the
     model itself become a result with `error`; configuration errors raise."""
-    from reedtool.assembly.validation import check_model_path
+    from reedtool.workflows.validation import check_model_path
     from reedtool.report import ModelResult
 
     checked = check_model_path(model, options.request, controllers=options.controllers,
@@ -113,7 +113,7 @@ def check_model(name: str, model: Path, options: RunOptions) -> list:
         exc = checked.error
         return [ModelResult(name, error=exc.one_line(), error_file=exc.file,
                             error_line=exc.line)]
-    from reedtool.assembly.suppression_audit import suppression_use
+    from reedtool.workflows.suppression_audit import suppression_use
     from reedtool.config import load_config
 
     selection = selection_for(load_config(model), options.request.select,
@@ -165,7 +165,7 @@ def _write_diagram(model: Path, robot, findings, options: RunOptions, several: b
     """One picture per model: FILE itself for a run of one model; else FILE-STEM.svg, STEM
     the model file's (and -ROBOT for each model of a world), so models that share a robot
     name (variants of one xacro, fixtures) do not overwrite each other's picture."""
-    from reedtool.assembly.diagram import write_diagram
+    from reedtool.workflows.diagram import write_diagram
     from reedtool.physics.rotors import discover_rotors
 
     target = options.diagram
@@ -212,7 +212,7 @@ def print_settings(targets, options: RunOptions) -> int:
         ignores = config.ignores_for(target.path)
         if ignores:
             click.echo(f"  per-file-ignores: {', '.join(ignores)}")
-        from reedtool.assembly.models import variant_label
+        from reedtool.workflows.robots import variant_label
 
         for job in jobs_of(target, options.request):
             if job.variant is not None:
@@ -229,7 +229,7 @@ def print_settings(targets, options: RunOptions) -> int:
 
 def _prepare_workers() -> None:
     """What every model's check imports, loaded once before --jobs forks its workers."""
-    import reedtool.assembly.suppression_audit  # noqa: F401
+    import reedtool.workflows.suppression_audit  # noqa: F401
     import reedtool.io.dae  # noqa: F401
     import reedtool.io.loader  # noqa: F401
     import reedtool.io.xacro_expand  # noqa: F401
@@ -242,7 +242,7 @@ def _prepare_workers() -> None:
 def _write_baseline(results, path: Path, force: bool) -> int:
     """--write-baseline: every finding of the run recorded; exit 0 (2 when a model could
     not be read: a baseline without its findings would not be the run's)."""
-    from reedtool.assembly.baseline import baseline_text
+    from reedtool.workflows.baseline import baseline_text
     from reedtool.io.fileio import atomic_write_text
     from reedtool.report import render
 
@@ -329,8 +329,8 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
     if explain_code:
         return explain(explain_code)
 
-    from reedtool.assembly.models import request_from_words
-    from reedtool.io.packages import shared_crawls
+    from reedtool.workflows.robots import request_from_words
+    from reedtool.resolve.packages import shared_crawls
 
     context = click.get_current_context(silent=True)
     if context is not None:       # every model of the run resolves against the same roots
@@ -339,7 +339,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
                                         model_name=model_name, launch_file=launch_file,
                                         select=select, ignore=ignore)
     request.force_exclude = force_exclude
-    from reedtool.io.mappings import suggest_mapping
+    from reedtool.resolve.mappings import suggest_mapping
 
     for word in paths:
         if not Path(word).exists() and suggest_mapping(word) is not None:
@@ -351,7 +351,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
         raise click.UsageError("missing argument 'MODEL' (or use --explain CODE)")
     if len(paths) == 1 and not Path(paths[0]).exists() and not re.search(r"[*?\[]", paths[0]):
         # One model that is not there: the one-line error of every command, exit 2.
-        from reedtool.io.model_inputs import not_found_message
+        from reedtool.workflows.targets import not_found_message
 
         message = not_found_message(paths[0])
         raise ReedtoolError(message, file=paths[0],
@@ -372,7 +372,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
 
     import functools
 
-    from reedtool.assembly.parallel import map_models
+    from reedtool.workflows.parallel import map_models
     from reedtool.config import load_config
     from reedtool.report import ModelResult, render
 
@@ -417,7 +417,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
         strict_any = strict_any or model_strict
         model_failing = {"error", "warning"} if model_strict else {"error"}
         failing_of += [(r, model_failing) for r in model_results]
-    from reedtool.assembly.suppression_audit import unused_suppressions
+    from reedtool.workflows.suppression_audit import unused_suppressions
 
     # S143 over the whole run: a comment in a shared file is unused only if no model needed it.
     unused = unused_suppressions(suppression_uses)
@@ -429,7 +429,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
                                      key=Finding.sort_key)
     if write_baseline is not None:
         return _write_baseline(results, write_baseline, force)
-    from reedtool.assembly.baseline import apply_run_baselines
+    from reedtool.workflows.baseline import apply_run_baselines
     from reedtool.config import relative_to_cwd
 
     baselines, missing = apply_run_baselines(

@@ -101,7 +101,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...], model_name
                                        launch_file, ignore)
     note_input(model)
 
-    from reedtool.assembly.view import view_model
+    from reedtool.workflows.view import view_model
 
     view, findings = view_model(model, request, collision=collision,
                                 with_findings=show_findings, disc_style=disc_style,

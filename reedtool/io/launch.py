@@ -28,8 +28,8 @@ from pathlib import Path
 from typing import Sequence
 
 from reedtool.errors import ReedtoolError
-from reedtool.io.mappings import MAPPING_SEPARATOR
-from reedtool.io.packages import PackageResolver
+from reedtool.resolve.mappings import MAPPING_SEPARATOR
+from reedtool.resolve.packages import PackageResolver
 from reedtool.model import SourceLoc
 
 _MAX_INCLUDE_DEPTH = 10

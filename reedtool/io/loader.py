@@ -19,7 +19,7 @@ def load_robots(path: Path | str, mappings: Mapping[str, str] | None = None,
     path = Path(path)
     refuse_mesh(path)
     if model_name is None and _sdf_path(path) is not None and not _is_template(_sdf_path(path)):
-        from reedtool.io.packages import PackageResolver
+        from reedtool.resolve.packages import PackageResolver
         from reedtool.io.sdf import load_sdf_models
 
         from reedtool.io.sdf_jinja import relocate_rendered, take_rendered
@@ -64,7 +64,7 @@ def _with_package_notes(robot: Robot, resolver) -> Robot:
 
 def _model_dir_sdf(path: Path) -> Path:
     """The SDF file of a Gazebo model directory (model.config, else model.sdf)."""
-    from reedtool.io.resources import model_sdf_in_dir
+    from reedtool.resolve.resources import model_sdf_in_dir
 
     if not (path / "model.config").is_file() and not (path / "model.sdf").is_file():
         raise ReedtoolError("is a directory, expected a .urdf, .xacro or .sdf file "
@@ -96,7 +96,7 @@ def load_robot(path: Path | str, mappings: Mapping[str, str] | None = None,
     Legacy xacro tags found during expansion are kept as ParseIssues ("legacy-xacro")
     so that `validate` can report them with the rest.
     """
-    from reedtool.io.packages import PackageResolver
+    from reedtool.resolve.packages import PackageResolver
     from reedtool.io.urdf import load_urdf_file, parse_urdf
 
     path = Path(path)

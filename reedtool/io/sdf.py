@@ -38,7 +38,7 @@ Supported subset (SDF 1.6 to 1.11, the shape of Gazebo's own multirotor models):
   sdformat's defaults (1 kg, 1 kg*m^2 on the diagonal), as Gazebo simulates it, and a
   parse issue. `<inertial auto="true">` (SDF 1.11) is not computed: a parse issue.
 * Geometry: box, cylinder, sphere and mesh (uri, scale). `model://NAME/...` resolves
-  as includes do (reedtool.io.resources: the naming file's directory and its parent,
+  as includes do (reedtool.resolve.resources: the naming file's directory and its parent,
   --package-path, GZ_SIM_RESOURCE_PATH, IGN_GAZEBO_RESOURCE_PATH, SDF_PATH,
   GAZEBO_MODEL_PATH); `package://` through the package resolver; Fuel
   (http/https) URIs are not fetched. Planes, capsules, ellipsoids, heightmaps and
@@ -68,7 +68,7 @@ from reedtool.errors import ReedtoolError
 from reedtool.io.fileio import magnitude_problem
 from reedtool.frames import make_T, matrix_to_rpy, rpy_to_matrix
 from reedtool.io.meshes import machine_path
-from reedtool.io.resources import REMOTE_NOT_CHECKED, is_remote_uri, resolve_model_file_uri
+from reedtool.resolve.resources import REMOTE_NOT_CHECKED, is_remote_uri, resolve_model_file_uri
 from reedtool.io.sdf_include import SourceFile, SourceMap, expand_includes
 from reedtool.io.sdf_refusals import document_refusals, parse_version
 from reedtool.io.tolerant_xml import (
@@ -176,7 +176,7 @@ def _document(xml_text: str, file: Path, resolver):
         raise ReedtoolError(f"not an SDF file: the root element is <{root.tag}>, expected <sdf>",
                             file=file, line=root.sourceline)
     if resolver is None:
-        from reedtool.io.packages import PackageResolver
+        from reedtool.resolve.packages import PackageResolver
         resolver = PackageResolver(model_path=file)
     top = SourceFile(file, xml_text.splitlines())
     sources = SourceMap(top)

@@ -30,7 +30,7 @@ from typing import Sequence
 from lxml import etree
 
 from reedtool.errors import ReedtoolError
-from reedtool.io.resources import is_remote_uri, resolve_model_uri
+from reedtool.resolve.resources import is_remote_uri, resolve_model_uri
 from reedtool.io.tolerant_xml import Tolerated, parse_tolerant
 from reedtool.io.xml_lines import start_line
 

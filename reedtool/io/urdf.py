@@ -49,7 +49,7 @@ def parse_urdf(xml_text: str, file: Path | str, *, resolver=None,
 
     `element_locs`, from an xacro expansion, gives the SourceLoc of each element in
     document order; without it locations are lines of `file` itself. `resolver` resolves
-    mesh URIs (reedtool.io.packages.PackageResolver); by default one rooted at `file`.
+    mesh URIs (reedtool.resolve.packages.PackageResolver); by default one rooted at `file`.
     """
     from reedtool.io.tolerant_xml import parse_tolerant
 
@@ -60,7 +60,7 @@ def parse_urdf(xml_text: str, file: Path | str, *, resolver=None,
         raise ReedtoolError(f"not a URDF: the root element is <{root.tag}>, expected <robot>",
                             file=file, line=root.sourceline)
     if resolver is None:
-        from reedtool.io.packages import PackageResolver
+        from reedtool.resolve.packages import PackageResolver
         resolver = PackageResolver(model_path=file)
     locate = _make_locator(root, file, element_locs, xml_text.splitlines())
     robot = _RobotReader(file, locate, resolver).read(root, xml_text)
@@ -255,7 +255,7 @@ class _RobotReader:
         if not uri:
             self._issue("missing-attribute", "<mesh> has no filename= attribute", el, link)
             return Mesh(uri="", path=None, scale=scale, resolve_error="no filename")
-        from reedtool.io.resources import REMOTE_NOT_CHECKED, is_remote_uri
+        from reedtool.resolve.resources import REMOTE_NOT_CHECKED, is_remote_uri
 
         if is_remote_uri(uri):
             return Mesh(uri=uri, path=None, scale=scale, resolve_error=REMOTE_NOT_CHECKED)

@@ -34,7 +34,7 @@ def known_arguments(path: Path, mappings: Mapping[str, str] | None = None,
     """Argument names declared or read in the include tree of `path`; and whether every
     include of the tree could be followed (when not, a name may be missing)."""
     from reedtool.io.legacy_xacro import include_specs
-    from reedtool.io.packages import PackageResolver
+    from reedtool.resolve.packages import PackageResolver
     from reedtool.io.xacro_expand import include_texts, static_include_resolver
 
     mappings = dict(mappings or {})

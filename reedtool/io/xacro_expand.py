@@ -2,7 +2,7 @@
 
 pip's `xacro` does the expansion; reedtool adds what it lacks outside a ROS workspace:
 
-* `$(find pkg)` goes through reedtool.io.packages (xacro would ask ament_index_python);
+* `$(find pkg)` goes through reedtool.resolve.packages (xacro would ask ament_index_python);
 * every DOM element remembers (file, line) from the parser, clones keep it, and clones
   of a macro body also remember the chain of macro calls that produced them, so an
   element of the URDF maps to the call site the user wrote (docs/source-mapping.md);
@@ -41,7 +41,7 @@ from xacro import substitution_args
 from reedtool.errors import ReedtoolError
 from reedtool.io.fileio import MAX_TEXT_BYTES, note_input
 from reedtool.io.legacy_xacro import LegacyScan, LegacyTag, follow_includes, scan_tree
-from reedtool.io.packages import PackageResolver, is_bundled
+from reedtool.resolve.packages import PackageResolver, is_bundled
 from reedtool.model import SourceLoc
 
 # As deep as xacro itself goes: a macro calling itself through <xacro:unless> expands to

@@ -576,7 +576,7 @@ class LinkComparison:
     slowdown: float | None = None      # rotorVelocitySlowdownSim of the rotor on this link
     tensor_problem: str | None = None  # see tensor_problem()
     # How much the verdict matters is policy, not physics: the rule registry decides, with
-    # the user's configuration (assembly.validation.judge_links fills this in).
+    # the user's configuration (workflows.validation.judge_links fills this in).
     severity: str | None = None
 
     @property

@@ -1,6 +1,6 @@
 """hover-test --controller's section of the text report: the RotorS Lee controller files,
 what they tell the controller against the model, the loops the gains make, and the
-pre-flight findings. Formats the "controller" dict of assembly.lee_flight; computes
+pre-flight findings. Formats the "controller" dict of workflows.lee_flight; computes
 nothing."""
 
 from __future__ import annotations

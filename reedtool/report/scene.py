@@ -28,7 +28,7 @@ Above the base link a root node turns ROS's z-up into glTF's y-up (glTF 2.0, 3.4
 viewers show the robot standing.
 
 This module draws and computes nothing about the robot: the link poses, rotors, centre of
-mass and the links findings name come from assembly/view.py.
+mass and the links findings name come from workflows/view.py.
 """
 
 from __future__ import annotations
@@ -183,7 +183,7 @@ def _mesh_paths(robot, collision: bool) -> dict[str, object]:
 
 
 def _mesh_errors(robot) -> dict[str, str]:
-    """Mesh URI -> why it has no file (not found, or withheld: assembly.view)."""
+    """Mesh URI -> why it has no file (not found, or withheld: workflows.view)."""
     from reedtool.model import Mesh
 
     return {shape.geometry.uri.strip(): shape.geometry.resolve_error

@@ -71,7 +71,7 @@ def plan_body_edit(model_file: Path, package: str, mesh_name: str, props,
     from reedtool.io.fileio import read_xml_file
     from reedtool.io.xacro_edit import property_value_span, set_block_inertia, set_properties
     from reedtool.physics.inertia import fmt_number, inertia_element
-    from reedtool.scaffold.package_spec import com_text
+    from reedtool.generate.package_spec import com_text
 
     text, encoding = read_xml_file(model_file, what="xacro file")
     values = {"mesh_file": f"package://{package}/meshes/{mesh_name}.stl"}

@@ -227,8 +227,8 @@ ROTOR_NUMBERS = ("motor_constant", "moment_constant", "max_rot_velocity_rad_s",
 
 def compare_vehicle(original: Robot, port: Robot, proof: Proof, config, fly: bool = True) -> None:
     """Whole-robot mass properties, rotors, trim and the hover verdict, each side assembled
-    as hover-test assembles it (assembly.vehicle, assembly.flight)."""
-    from reedtool.assembly.vehicle import Vehicle
+    as hover-test assembles it (workflows.vehicle, workflows.flight)."""
+    from reedtool.workflows.vehicle import Vehicle
 
     check = _Comparer(proof)
     size_m = _size_m(original)
@@ -320,9 +320,9 @@ def _ardupilot_values(port: Robot, rotor, original, proof: Proof) -> dict:
 
 
 def _fly(vehicle, config) -> dict:
-    """hover-test's verdict on one vehicle (assembly.flight.hover_test), or why it cannot
+    """hover-test's verdict on one vehicle (workflows.flight.hover_test), or why it cannot
     fly (the same refusal hover-test makes, as a status)."""
-    from reedtool.assembly.flight import hover_test
+    from reedtool.workflows.flight import hover_test
     from reedtool.errors import ReedtoolError
 
     try:
@@ -389,7 +389,7 @@ class SensorRecord:
     plugin that simulates one (noise then in the plugin's own terms)."""
 
     name: str
-    type: str                      # gz spelling (scaffold.gz_sensors)
+    type: str                      # gz spelling (port.gz_sensors)
     link: str
     T_link_sensor: np.ndarray
     rate_hz: float | None
@@ -427,8 +427,8 @@ def sensor_inventory(robot: Robot) -> tuple[list[SensorRecord], list[str]]:
     """(the sensors the model simulates, those a gz port drops and why)."""
     from reedtool.frames import make_T, rpy_to_matrix
     from reedtool.physics.rotors import resolve_name
-    from reedtool.scaffold.gz_port import family_of
-    from reedtool.scaffold.gz_sensors import sensor_kind, split_name
+    from reedtool.port.gz_port import family_of
+    from reedtool.port.gz_sensors import sensor_kind, split_name
 
     records: list[SensorRecord] = []
     dropped: list[str] = []
@@ -506,7 +506,7 @@ def compare_sensors(original: Robot, port: Robot, fold: dict, proof: Proof,
                     added=(), moved=None) -> None:
     """Every sensor of the original against the port's: present, type, link (after
     folding), pose in that link, update rate, noise. A sensor the port drops by the table
-    (scaffold.gz_sensors) is a note, as the report lists it; one that vanishes or moves is
+    (port.gz_sensors) is a note, as the report lists it; one that vanishes or moves is
     a difference. `moved`: original name -> (port name, port link) of the sensors a port
     renames and moves on purpose (PX4's contract puts its four on base_link): those are
     held to the same place in the robot's base frame instead of in their link."""

@@ -1,4 +1,4 @@
-"""A `GzPort` (scaffold.gz_port) -> the files of a Gazebo Sim model directory.
+"""A `GzPort` (port.gz_port) -> the files of a Gazebo Sim model directory.
 
     <name>/model.sdf          SDF 1.9: links, joints, folded-link frames, gz systems
     <name>/model.config       name, version, the SDF file
@@ -20,7 +20,7 @@ import numpy as np
 from lxml import etree
 
 from reedtool.io.limits import sdf_limit_text
-from reedtool.scaffold.gz_port import Element, GzPort, PortRow, float_text, pose_text
+from reedtool.port.gz_port import Element, GzPort, PortRow, float_text, pose_text
 
 SDF_VERSION = "1.9"
 
@@ -362,7 +362,7 @@ def world_sdf(port: GzPort) -> bytes:
     if any(sensor.attrib.get("type") == "navsat" for link in port.links
            for sensor in link.sensors):
         # gz-sim's NavSat system publishes nothing without it.
-        from reedtool.scaffold.gz_port import DEFAULT_HOME
+        from reedtool.port.gz_port import DEFAULT_HOME
 
         latitude, longitude, elevation = port.home or DEFAULT_HOME
         where = _sub(world, "spherical_coordinates")

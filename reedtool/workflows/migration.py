@@ -1,12 +1,12 @@
 """`migrate`: a Gazebo Classic multirotor -> a Gazebo Sim model directory, and its proof.
 
 One call, `migrate(request)`: load the original with its arguments as every command does
-(assembly.assemble.load_robot_for: configuration, --launch, name:=value), plan the port
-(scaffold.gz_port), add what needs the whole vehicle (MulticopterVelocityControl gains,
-the PX4 airframe), stage the directory beside the target (scaffold.sdf_writer,
-scaffold.render.staged_tree), read model.sdf back there with reedtool's SDF reader and
+(workflows.assemble.load_robot_for: configuration, --launch, name:=value), plan the port
+(port.gz_port), add what needs the whole vehicle (MulticopterVelocityControl gains,
+the PX4 airframe), stage the directory beside the target (port.sdf_writer,
+generate.render.staged_tree), read model.sdf back there with reedtool's SDF reader and
 compare it with the original, both assembled as hover-test assembles them
-(assembly.port_proof), and only then rename it into place: a migrate that fails leaves
+(workflows.port_proof), and only then rename it into place: a migrate that fails leaves
 nothing on disk.
 """
 
@@ -18,9 +18,9 @@ from pathlib import Path, PurePosixPath
 
 import numpy as np
 
-from reedtool.assembly.models import ModelRequest
+from reedtool.workflows.robots import ModelRequest
 from reedtool.errors import ReedtoolError
-from reedtool.scaffold.gz_port import (
+from reedtool.port.gz_port import (
     VELOCITY_CONTROL_SYSTEM,
     Element,
     GzPort,
@@ -52,7 +52,7 @@ class MigrateResult:
     target: Path
     files: list[PurePosixPath]
     rows: list[PortRow]
-    proof: object                            # assembly.port_proof.Proof
+    proof: object                            # workflows.port_proof.Proof
     port: GzPort
     source: str
 
@@ -74,9 +74,9 @@ def port_name(robot_name: str, given: str | None) -> str:
 
 
 def migrate(request: MigrateRequest) -> MigrateResult:
-    from reedtool.assembly.assemble import load_robot_for
+    from reedtool.workflows.assemble import load_robot_for
     from reedtool.io.fileio import note_input
-    from reedtool.scaffold.render import RenderedFile, check_target, staged_tree
+    from reedtool.generate.render import RenderedFile, check_target, staged_tree
 
     note_input(request.model)
     original, _mappings = load_robot_for(request.model, request.models)
@@ -91,34 +91,34 @@ def migrate(request: MigrateRequest) -> MigrateResult:
     port.outside_files = outside_files(port, request.model)
     port.copy_outside_files = request.copy_outside_files
     port.target_dir = target
-    from reedtool.scaffold.sdf_writer import WrittenFile, port_files
+    from reedtool.port.sdf_writer import WrittenFile, port_files
 
     contract = None
     extra_plugins, extra_files = [], []
     if request.autopilot == "px4":
         # First: the root's new name is the one every later part refers to.
-        from reedtool.scaffold.px4_gz_contract import apply_px4_contract
+        from reedtool.port.px4_gz_contract import apply_px4_contract
 
         contract = apply_px4_contract(port)
     if request.velocity_control:
         extra_plugins.append(velocity_control(original, port))
     if request.autopilot == "px4":
-        from reedtool.scaffold.px4_gz_contract import airframe_path, readme_text
+        from reedtool.port.px4_gz_contract import airframe_path, readme_text
 
         extra_files.append(WrittenFile(airframe_path(name),
                                        px4_airframe(original, name).encode("utf-8")))
         extra_files.append(WrittenFile(PurePosixPath("README.md"),
                                        readme_text(name, "migrate").encode("utf-8")))
     elif request.autopilot == "ardupilot":
-        from reedtool.scaffold.ardupilot_gz import ardupilot_port
+        from reedtool.port.ardupilot_gz import ardupilot_port
 
         plugins, parm = ardupilot_port(original, port)
         extra_plugins += plugins
         extra_files.append(WrittenFile(PurePosixPath("ardupilot", f"{name}.parm"),
                                        parm.encode("utf-8")))
     if request.urdf:
-        from reedtool.scaffold.sdf_writer import mesh_targets
-        from reedtool.scaffold.urdf_writer import ros2_urdf
+        from reedtool.port.sdf_writer import mesh_targets
+        from reedtool.port.urdf_writer import ros2_urdf
 
         extra_files.append(WrittenFile(PurePosixPath("urdf", f"{name}.urdf"), ros2_urdf(
             original, port, mesh_targets(port), extra_plugins)))
@@ -160,8 +160,8 @@ def migrate(request: MigrateRequest) -> MigrateResult:
 def _px4_layout(files, name: str):
     """The flat port's files in PX4-gazebo-models' layout (models/NAME, worlds/NAME.sdf:
     PX4's world, named as its file, without the vehicle PX4 spawns itself)."""
-    from reedtool.scaffold.px4_gz_contract import px4_layout, px4_world_sdf
-    from reedtool.scaffold.sdf_writer import WrittenFile
+    from reedtool.port.px4_gz_contract import px4_layout, px4_world_sdf
+    from reedtool.port.sdf_writer import WrittenFile
 
     out = []
     for file in files:
@@ -181,15 +181,15 @@ def prove(original, model_sdf: Path, port: GzPort, request: MigrateRequest, cont
     configuration, --select/--ignore), before suppressions: an inline suppression comment
     stays in the source, so comparing after them would count it as a finding introduced.
     """
-    from reedtool.assembly.assemble import load_robot_for
-    from reedtool.assembly.port_proof import (
+    from reedtool.workflows.assemble import load_robot_for
+    from reedtool.workflows.port_proof import (
         Proof,
         compare_findings,
         compare_sensors,
         compare_structure,
         compare_vehicle,
     )
-    from reedtool.assembly.validation import selection_for
+    from reedtool.workflows.validation import selection_for
     from reedtool.checks.runner import run_checks
     from reedtool.config import load_config
     from reedtool.sim import HoverConfig
@@ -259,10 +259,10 @@ def _fold_map(original, port: GzPort, contract=None) -> dict:
 
 def velocity_control(robot, port: GzPort) -> Element:
     """gz's MulticopterVelocityControl for the model's lift rotors, gains as new-package
-    --sim gz derives them (scaffold.package_spec.scaled_lee_gains)."""
+    --sim gz derives them (generate.package_spec.scaled_lee_gains)."""
     from reedtool.physics.pinocchio_bridge import whole_robot_pinocchio
     from reedtool.physics.rotors import discover_rotors, lift_rotors
-    from reedtool.scaffold.package_spec import scaled_lee_gains
+    from reedtool.generate.package_spec import scaled_lee_gains
 
     props = whole_robot_pinocchio(robot)
     gains = scaled_lee_gains(props.mass_kg, props.inertia_kg_m2)

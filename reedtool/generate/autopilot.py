@@ -1,7 +1,7 @@
 """new-package --autopilot: the PX4 airframe or ArduPilot .parm of a generated multirotor.
 
 Both files are written from the frame catalogue entry the model is rendered from
-(reedtool.scaffold.airframes), so the package is consistent by construction:
+(reedtool.generate.airframes), so the package is consistent by construction:
 
 * PX4 (`px4/airframe_gz_<name>`): CA rotor i is the rotor with the i-th smallest motor
   number, at its position about the model's centre of mass in FRD, KM = ±momentConstant
@@ -24,7 +24,7 @@ from pathlib import PurePosixPath
 import numpy as np
 
 from reedtool.errors import ReedtoolError
-from reedtool.scaffold.airframes import Airframe
+from reedtool.generate.airframes import Airframe
 
 AUTOPILOTS = ("px4", "ardupilot")
 # ArduPilot bearings from add_motor_raw factors (Y6) are atan2 of rounded factors: 63.4°
@@ -77,7 +77,7 @@ def prepare_spec(spec, autopilot: str | None):
 def _com_m(spec, positions: np.ndarray) -> np.ndarray:
     """Whole-model COM: the body's at its COM (a CAD body's, else the origin), sensors at
     the origin, each rotor's mass at its hub."""
-    from reedtool.scaffold.package_spec import body_com_m, total_mass_estimate_kg
+    from reedtool.generate.package_spec import body_com_m, total_mass_estimate_kg
 
     moment = spec["mass"] * np.array(body_com_m(spec)) + spec["mass_rotor"] * positions.sum(axis=0)
     return moment / total_mass_estimate_kg(spec)
@@ -85,9 +85,9 @@ def _com_m(spec, positions: np.ndarray) -> np.ndarray:
 
 def autopilot_files(spec, autopilot: str | None, rendered=()):
     """The RenderedFiles for `--autopilot`, or [] without it. PX4 on gz: the airframe and
-    the model in PX4-gazebo-models' layout under px4/ (scaffold.px4_gz_contract), ported
+    the model in PX4-gazebo-models' layout under px4/ (port.px4_gz_contract), ported
     from the package's own model (`rendered`, the package's files)."""
-    from reedtool.scaffold.render import RenderedFile
+    from reedtool.generate.render import RenderedFile
 
     if autopilot is None:
         return []
@@ -95,12 +95,12 @@ def autopilot_files(spec, autopilot: str | None, rendered=()):
         raise ReedtoolError("--autopilot applies to multirotor frames only",
                             hint="drop --autopilot for a ground robot")
     frame: Airframe = spec.frame
-    from reedtool.scaffold.package_spec import rotor_positions_m
+    from reedtool.generate.package_spec import rotor_positions_m
 
     positions = rotor_positions_m(spec)
     if autopilot == "px4":
         from reedtool.flightstack.px4 import RotorSpec, px4_airframe_text, px4_hover_throttle
-        from reedtool.scaffold.package_spec import STANDARD_GRAVITY_M_S2, total_mass_estimate_kg
+        from reedtool.generate.package_spec import STANDARD_GRAVITY_M_S2, total_mass_estimate_kg
 
         com = _com_m(spec, positions)
         rotors = [RotorSpec(slot.motor_number, position - com,
@@ -112,7 +112,7 @@ def autopilot_files(spec, autopilot: str | None, rendered=()):
         throttle = px4_hover_throttle([hover_rad_s] * len(rotors),
                                       [spec["max_rot_velocity"]] * len(rotors))
         if spec.sim == "gz":
-            from reedtool.scaffold.px4_gz_contract import airframe_path, package_px4_files
+            from reedtool.port.px4_gz_contract import airframe_path, package_px4_files
 
             text = px4_airframe_text(spec.name, rotors, hover_throttle=throttle, world=spec.name)
             return [RenderedFile(PurePosixPath("px4", *airframe_path(spec.name).parts),
@@ -135,28 +135,26 @@ def autopilot_files(spec, autopilot: str | None, rendered=()):
 
 def autopilot_context(spec, autopilot: str | None) -> dict:
     """Template variables for --autopilot: `ardupilot_block`, the ArduPilotPlugin and its
-    LiftDrag blades for a gz-sim multirotor (scaffold.ardupilot_gz); `px4` and PX4's gz
-    contract (scaffold.px4_gz_contract: the sensors, the world's spherical coordinates)."""
+    LiftDrag blades for a gz-sim multirotor (port.ardupilot_gz); `px4` and PX4's gz
+    contract (port.px4_gz_contract: the sensors, the world's spherical coordinates)."""
     context = {"ardupilot_block": "", "px4": False}
     if autopilot == "ardupilot" and spec.kind == "multirotor" and spec.sim == "gz":
-        from reedtool.scaffold.ardupilot_gz import package_block
-
-        from reedtool.scaffold.package_spec import rotor_positions_m
+        from reedtool.generate.package_spec import rotor_positions_m
 
         positions = rotor_positions_m(spec)
-        block = package_block(spec, positions, _com_m(spec, positions))
+        block = _ardupilot_block(spec, positions, _com_m(spec, positions))
         context["ardupilot_block"] = block
         # The README says where SITL must send its servo outputs: what the block says.
         context["ardupilot_fdm"] = {tag: re.search(f"<{tag}>([^<]*)</{tag}>", block).group(1)
                                     for tag in ("fdm_addr", "fdm_port_in")}
     if autopilot == "px4" and spec.kind == "multirotor" and spec.sim == "gz":
-        from reedtool.scaffold.px4_gz_contract import (
+        from reedtool.port.px4_gz_contract import (
             MAGNETIC_FIELD_T,
             PX4_SENSORS,
             SPHERICAL_COORDINATES,
             px4_sensor_element,
         )
-        from reedtool.scaffold.sdf_writer import elements_text
+        from reedtool.port.sdf_writer import elements_text
 
         sensors = []
         for sensor in PX4_SENSORS:
@@ -169,3 +167,33 @@ def autopilot_context(spec, autopilot: str | None) -> dict:
                        px4_magnetic_field=MAGNETIC_FIELD_T)
     return context
 
+
+def _ardupilot_block(spec, positions: np.ndarray, com: np.ndarray) -> str:
+    """new-package --sim gz --autopilot ardupilot: the <gazebo> content (XML text) for the
+    generated frame (rotor hubs at `positions`, the whole model's COM at `com`), rotors
+    named as the template names them (rotor_N, rotor_N_joint, N the motor number = the
+    channel), the body IMU as base_link::imu."""
+    from reedtool.generate.package_spec import ROTOR_BLADE_THICKNESS_M, ROTOR_BLADE_WIDTH_M
+    from reedtool.physics.inertia import box_inertia
+    from reedtool.port.ardupilot_gz import ApRotor, ardupilot_elements
+    from reedtool.port.sdf_writer import elements_text
+
+    frame = spec.frame
+    # The template's rotor inertia: a blade box of mass_rotor * slowdown (RotorS), its
+    # origin at the joint: izz is the moment about the joint axis.
+    blade = (spec["radius_rotor"], ROTOR_BLADE_WIDTH_M, ROTOR_BLADE_THICKNESS_M)
+    izz = float(box_inertia(spec["mass_rotor"] * spec["rotor_velocity_slowdown_sim"], blade)[2, 2])
+    rotors = [ApRotor(joint=f"rotor_{slot.motor_number}_joint", link=f"rotor_{slot.motor_number}",
+                      channel=slot.motor_number,
+                      turning_sign=1 if slot.direction == "ccw" else -1,
+                      position_com_flu_m=np.asarray(position) - com,
+                      joint_axis_link=np.array([0.0, 0.0, 1.0]),
+                      thrust_axis_link=np.array([0.0, 0.0, 1.0]),
+                      motor_constant=spec["motor_constant"],
+                      moment_constant=spec["moment_constant"],
+                      max_rot_velocity_rad_s=spec["max_rot_velocity"],
+                      prop_radius_m=spec["radius_rotor"], inertia_axis_kg_m2=izz,
+                      time_constant_s=spec["time_constant_up"])
+              for slot, position in zip(frame.rotors, positions)]
+    plugins, _controls = ardupilot_elements(rotors, "base_link::imu")
+    return elements_text(plugins, indent=4)

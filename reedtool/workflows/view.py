@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from reedtool.assembly.models import ModelRequest
+from reedtool.workflows.robots import ModelRequest
 from reedtool.errors import ReedtoolError
 
 SEVERITY_RANK = {"error": 0, "warning": 1, "info": 2}
@@ -103,8 +103,8 @@ def view_model(model: Path, request: ModelRequest, *, collision: bool = False,
     """`model` with its arguments (configuration, --launch, name:=value) -> (ViewScene,
     validate's findings on it, or None without `with_findings`). A mesh file from outside
     the model's packages is not drawn (so not embedded) unless `embed_outside_files`."""
-    from reedtool.assembly.assemble import load_robot_for
-    from reedtool.assembly.validation import validation_findings
+    from reedtool.workflows.assemble import load_robot_for
+    from reedtool.workflows.validation import validation_findings
 
     robot, _ = load_robot_for(model, request, require_sound=False)
     findings = validation_findings(model, robot, request) if with_findings else None

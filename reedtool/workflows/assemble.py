@@ -1,5 +1,5 @@
 """One model path -> a robot that can be computed on -> validate's errors on it, split by
-the refusal policy (assembly/validation.py) -> its vehicle: the call every analysing or
+the refusal policy (workflows/validation.py) -> its vehicle: the call every analysing or
 flying command makes.
 """
 
@@ -8,9 +8,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from reedtool.assembly.models import ModelRequest, model_mappings
-from reedtool.assembly.validation import Verdict, judge
-from reedtool.assembly.vehicle import Vehicle, check_batch_resources
+from reedtool.workflows.robots import ModelRequest, model_mappings
+from reedtool.workflows.validation import Verdict, judge
+from reedtool.workflows.vehicle import Vehicle, check_batch_resources
 
 
 @dataclass

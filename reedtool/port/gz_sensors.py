@@ -5,7 +5,7 @@ the gz-sim system the world must load for it, the child elements gz spells diffe
 or the reason it is dropped. `SENSOR_PLUGINS` says why each Classic plugin that lives
 inside a `<sensor>` is not carried (in gz the sensor itself publishes on a gz topic). A
 model-level Classic plugin that simulates a sensor (RotorS' and PX4's IMU, PX4's
-magnetometer, barometer and GPS plugins) is in `scaffold.gz_port.PLUGIN_FAMILIES`, whose
+magnetometer, barometer and GPS plugins) is in `port.gz_port.PLUGIN_FAMILIES`, whose
 `sensor` names the gz type it becomes.
 
 Another module may rename what it takes from here (PX4's gz bridge wants the sensors named

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Sequence
 
-from reedtool.assembly.models import ModelRequest, argument_use, load_models, model_arguments
+from reedtool.workflows.robots import ModelRequest, argument_use, load_models, model_arguments
 from reedtool.errors import ReedtoolError
 
 

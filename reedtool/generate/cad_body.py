@@ -74,7 +74,7 @@ def load_cad_body(spec, *, units: str = "auto", frame: str | None = None,
     arm length when the mounts give it)."""
     from reedtool.physics.mesh_import import import_mesh
     from reedtool.physics.motor_mounts import MountReading, find_mounts
-    from reedtool.scaffold.package_spec import (
+    from reedtool.generate.package_spec import (
         CadPlacement,
         check_geometry,
         rotor_positions_m,
@@ -197,7 +197,7 @@ def hover_trim(spec, body_props):
     from reedtool.physics.allocation import allocation_from_geometry
     from reedtool.physics.inertia import MassProperties, combine
     from reedtool.physics.trim import trim_from_allocation
-    from reedtool.scaffold.package_spec import (
+    from reedtool.generate.package_spec import (
         STANDARD_GRAVITY_M_S2,
         rotor_positions_m,
         sensor_mass_kg,
@@ -251,7 +251,7 @@ def cad_lines(body: CadBody, spec) -> list[str]:
 
 def trim_lines(body: CadBody, spec) -> list[str]:
     trim = body.trim
-    from reedtool.scaffold.package_spec import rotor_positions_m
+    from reedtool.generate.package_spec import rotor_positions_m
 
     centroid = rotor_positions_m(spec).mean(axis=0)
     shift = (body.total_com_m - centroid)[:2]

@@ -9,8 +9,8 @@ from pathlib import Path, PurePosixPath
 import pytest
 
 from reedtool.errors import ReedtoolError
-from reedtool.scaffold import render as scaffold
-from reedtool.scaffold.render import RenderedFile, render_tree, templates_root, write_tree
+from reedtool.generate import render as scaffold
+from reedtool.generate.render import RenderedFile, render_tree, templates_root, write_tree
 
 
 def digest(root: Path) -> str:
@@ -122,5 +122,5 @@ def test_wheel_layout_is_found(tmp_path, monkeypatch):
     """Installed from a wheel, templates live in reedtool/_data/templates."""
     fake_pkg = tmp_path / "site" / "reedtool"
     (fake_pkg / "_data" / "templates" / "ros1").mkdir(parents=True)
-    monkeypatch.setattr(scaffold, "__file__", str(fake_pkg / "scaffold" / "render.py"))
+    monkeypatch.setattr(scaffold, "__file__", str(fake_pkg / "generate" / "render.py"))
     assert templates_root() == fake_pkg / "_data" / "templates"

@@ -33,7 +33,7 @@ class ModelRequest:
     # separately); None: the model's first variant, if it has any.
     variant: dict | None = None
     force_exclude: bool = False           # --force-exclude: `exclude` named files too
-    # Models loaded while deciding what a named file means (io.model_inputs), kept so the
+    # Models loaded while deciding what a named file means (workflows.targets), kept so the
     # check does not expand them twice: resolved path -> load_models pairs.
     preloaded: dict = field(default_factory=dict)
 
@@ -148,9 +148,9 @@ def load_models(model: Path, mappings, package_paths, model_name):
 
 def targets_of(paths: Sequence[str], request: ModelRequest):
     """The models that command-line paths (files, directories, globs, packages, a changed
-    configuration) name; arguments mean "this model" (io.model_inputs)."""
+    configuration) name; arguments mean "this model" (workflows.targets)."""
     from reedtool.config import find_config, load_config
-    from reedtool.io.model_inputs import expand_targets, include_globs_of, include_tree_of
+    from reedtool.workflows.targets import expand_targets, include_globs_of, include_tree_of
     from reedtool.report import display_path
 
     def mappings_for(path: Path) -> dict[str, str]:
@@ -241,7 +241,7 @@ def request_from_words(words: Sequence[str], *, package_paths: Sequence[Path] = 
                        select: Sequence[str] = (), ignore: Sequence[str] = ()):
     """The command line's words (paths and name:=value) and model options -> (paths,
     ModelRequest). With --launch and no path, the launch file's model is the path."""
-    from reedtool.io.mappings import MAPPING_SEPARATOR, parse_mappings
+    from reedtool.resolve.mappings import MAPPING_SEPARATOR, parse_mappings
 
     if any(not w.strip() for w in words):
         # `reedtool validate "$MODEL"` with MODEL unset: read as ".", it would check every
@@ -276,7 +276,7 @@ def one_model(paths: Sequence[str], request: ModelRequest, command: str) -> Path
         if Path(word).exists() or _GLOB_CHARS.search(word):
             continue
         if n == 0 and "=" not in word:
-            from reedtool.io.model_inputs import suggest_path
+            from reedtool.workflows.targets import suggest_path
 
             nearby = suggest_path(word)
             raise ReedtoolError("model file not found", file=word,
@@ -284,7 +284,7 @@ def one_model(paths: Sequence[str], request: ModelRequest, command: str) -> Path
                                 "pass a model file (.urdf, .xacro, .sdf, .gazebo, "
                                 ".world), a directory or a ROS package")
         # A word after the model that names nothing is a mistyped argument.
-        from reedtool.io.mappings import suggest_mapping
+        from reedtool.resolve.mappings import suggest_mapping
 
         suggestion = suggest_mapping(word)
         raise ReedtoolError(f"cannot read argument '{word}'",

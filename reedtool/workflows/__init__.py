@@ -1,4 +1,4 @@
-"""The assembly every command shares: a model path with its arguments -> robots and
+"""The workflows every command shares: a model path with its arguments -> robots and
 validate's findings -> a vehicle (rotors, mass properties, trim) -> a flight.
 
 Commands sit above this stage and stay thin (options, one call, report, exit code);

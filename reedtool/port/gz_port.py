@@ -5,7 +5,7 @@ family reedtool knows: its gz-sim counterpart, or why it is dropped. `plan_port`
 `Robot` (URDF, xacro or SDF, as the loader built it) and returns a `GzPort`: the links
 and joints to write, the gz elements (plugins, sensors) built from the table, the world
 systems they need, and one `PortRow` per source element saying what happened to it.
-`scaffold.sdf_writer` turns the plan into files; nothing here writes.
+`port.sdf_writer` turns the plan into files; nothing here writes.
 
 What is carried and how:
 - Links and joints one to one, poses as written (each link relative to its parent link,
@@ -38,7 +38,7 @@ from reedtool.model import (
     Visual,
     XmlNode,
 )
-from reedtool.scaffold.gz_sensors import SENSOR_KINDS, sensor_kind, sensor_plugin_why, split_name
+from reedtool.port.gz_sensors import SENSOR_KINDS, sensor_kind, sensor_plugin_why, split_name
 
 # ------------------------------------------------------------- mapping table
 
@@ -60,7 +60,7 @@ ARDUPILOT_SYSTEM = ("ArduPilotPlugin", "ArduPilotPlugin")
 WORLD_PHYSICS = ("gz-sim-physics-system", "gz::sim::systems::Physics")
 WORLD_USER_COMMANDS = ("gz-sim-user-commands-system", "gz::sim::systems::UserCommands")
 WORLD_SCENE = ("gz-sim-scene-broadcaster-system", "gz::sim::systems::SceneBroadcaster")
-# The gz-sim system each gz sensor type needs (scaffold.gz_sensors holds the full table).
+# The gz-sim system each gz sensor type needs (port.gz_sensors holds the full table).
 SENSOR_SYSTEMS = {kind.gz: kind.system for kind in SENSOR_KINDS if kind.gz is not None}
 # Where PX4's gz bridge sends motor speeds, below the model instance's name, as PX4's own
 # gz models subscribe.
@@ -483,7 +483,7 @@ def _gazebo_element(port: GzPort, reference: str | None, node: XmlNode, fold, by
 
 def _classic_sensor(port: GzPort, reference: str | None, node: XmlNode, fold, by_name,
                     label: str) -> None:
-    """A <sensor> of a link: its gz form from scaffold.gz_sensors' table (type and child
+    """A <sensor> of a link: its gz form from port.gz_sensors' table (type and child
     names as gz spells them, posed on the link it survives in), or a row saying why not;
     then one row for each Classic plugin inside it."""
     sensor_type = node.attrib.get("type", "")
@@ -654,7 +654,7 @@ def _motor(port: GzPort, robot, plugin: Plugin, family: Family, fold, by_name) -
     if port.options is not None and port.options.autopilot == "ardupilot":
         # ArduPilot SITL drives joints through its own plugin; the blades make the thrust.
         # The whole-vehicle parts (channels from the frame match, PID gains from the rotor
-        # inertia) are built by assembly.migration, which fills in this row's target.
+        # inertia) are built by workflows.migration, which fills in this row's target.
         row = PortRow(plugin.loc, _plugin_label(plugin), "mapped",
                       f"plugin ArduPilotPlugin <control channel=\"{plugin.param('motorNumber')}\"> "
                       "+ 2 gz-sim-lift-drag-system blades",

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from reedtool.errors import ReedtoolError
-from reedtool.scaffold.gz_port import Element, GzPort, float_text
+from reedtool.port.gz_port import Element, GzPort, float_text
 
 ARDUPILOT_PLUGIN = ("ArduPilotPlugin", "ArduPilotPlugin")
 LIFT_DRAG = ("gz-sim-lift-drag-system", "gz::sim::systems::LiftDrag")
@@ -234,35 +234,3 @@ def _imu_name(port: GzPort) -> str:
     port.add_sensor(root, sensor, "ArduPilotPlugin reads an IMU and the model has none: "
                                   "one added on the root link")
     return f"{root.name}::imu_sensor"
-
-
-# ------------------------------------------------------------------ new-package
-
-def package_block(spec, positions: np.ndarray, com: np.ndarray) -> str:
-    """new-package --sim gz --autopilot ardupilot: the <gazebo> content (XML text) for the
-    generated frame (rotor hubs at `positions`, the whole model's COM at `com`), rotors
-    named as the template names them (rotor_N, rotor_N_joint, N the motor number = the
-    channel), the body IMU as base_link::imu."""
-    from reedtool.physics.inertia import box_inertia
-    from reedtool.scaffold.package_spec import ROTOR_BLADE_THICKNESS_M, ROTOR_BLADE_WIDTH_M
-    from reedtool.scaffold.sdf_writer import elements_text
-
-    frame = spec.frame
-    # The template's rotor inertia: a blade box of mass_rotor * slowdown (RotorS), its
-    # origin at the joint: izz is the moment about the joint axis.
-    blade = (spec["radius_rotor"], ROTOR_BLADE_WIDTH_M, ROTOR_BLADE_THICKNESS_M)
-    izz = float(box_inertia(spec["mass_rotor"] * spec["rotor_velocity_slowdown_sim"], blade)[2, 2])
-    rotors = [ApRotor(joint=f"rotor_{slot.motor_number}_joint", link=f"rotor_{slot.motor_number}",
-                      channel=slot.motor_number,
-                      turning_sign=1 if slot.direction == "ccw" else -1,
-                      position_com_flu_m=np.asarray(position) - com,
-                      joint_axis_link=np.array([0.0, 0.0, 1.0]),
-                      thrust_axis_link=np.array([0.0, 0.0, 1.0]),
-                      motor_constant=spec["motor_constant"],
-                      moment_constant=spec["moment_constant"],
-                      max_rot_velocity_rad_s=spec["max_rot_velocity"],
-                      prop_radius_m=spec["radius_rotor"], inertia_axis_kg_m2=izz,
-                      time_constant_s=spec["time_constant_up"])
-              for slot, position in zip(frame.rotors, positions)]
-    plugins, _controls = ardupilot_elements(rotors, "base_link::imu")
-    return elements_text(plugins, indent=4)

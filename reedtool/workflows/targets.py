@@ -176,7 +176,7 @@ def _template_model_dir(path: Path) -> bool:
     """A PX4 Classic model directory: model.config naming X.sdf, and X.sdf.jinja beside it."""
     if not (path / "model.config").is_file():
         return False
-    from reedtool.io.resources import model_sdf_in_dir
+    from reedtool.resolve.resources import model_sdf_in_dir
 
     try:
         return _is_sdf_template(model_sdf_in_dir(path))
@@ -369,7 +369,7 @@ PACKAGE_XML_MESSAGE = ("package.xml is the package's manifest, not a model; pass
 def not_found_message(word: str) -> str:
     """"file not found", and what the word looks like it meant: an argument without `:=`,
     or a file or directory whose name is close to it."""
-    from reedtool.io.mappings import suggest_mapping
+    from reedtool.resolve.mappings import suggest_mapping
 
     suggestion = suggest_mapping(word)
     if suggestion is not None:
@@ -443,7 +443,7 @@ def include_globs_of(mappings_for: Callable[[Path], Mapping[str, str]],
 
     def globs(path: Path) -> Sequence[str]:
         from reedtool.io.legacy_xacro import include_specs
-        from reedtool.io.packages import PackageResolver
+        from reedtool.resolve.packages import PackageResolver
 
         try:
             text = path.read_text(encoding="utf-8")

@@ -21,7 +21,7 @@ from typing import Callable, Mapping
 
 from reedtool.errors import PLAUSIBLE, ReedtoolError, check_plausible
 from reedtool.physics.propulsion import FIREFLY
-from reedtool.scaffold.airframes import Airframe, GroundLayout, get_frame
+from reedtool.generate.airframes import Airframe, GroundLayout, get_frame
 
 # Unit factors to SI, per dimension. A dimension with no units takes plain numbers only.
 UNITS: dict[str, dict[str, float]] = {
@@ -134,7 +134,7 @@ PROPULSION_KEYS = ("motor_constant", "moment_constant", "max_rot_velocity", "rad
 @dataclass
 class CadPlacement:
     """Where a CAD body mesh puts things, in its own frame (base_link = the CAD origin,
-    FLU, metres): set by scaffold.cad_body when --mesh is given."""
+    FLU, metres): set by generate.cad_body when --mesh is given."""
 
     centre_m: tuple[float, float, float]            # rotors are placed about it
     body_com_m: tuple[float, float, float]          # the body's COM (its <inertial><origin>)
@@ -239,7 +239,7 @@ def check_package_name(name: str) -> None:
 def _check_not_bundled(name: str) -> None:
     """A package named like one reedtool bundles would shadow it: its own model, which
     includes the bundled macros of that name, could then not be expanded."""
-    from reedtool.io.packages import bundled_package_names
+    from reedtool.resolve.packages import bundled_package_names
 
     if name in bundled_package_names():
         raise ReedtoolError(f"package name '{name}' is the name of a package reedtool "

@@ -14,8 +14,8 @@ from __future__ import annotations
 import numpy as np
 from lxml import etree
 
-from reedtool.scaffold.gz_port import Element, GzPort, float_text
-from reedtool.scaffold.sdf_writer import to_xml
+from reedtool.port.gz_port import Element, GzPort, float_text
+from reedtool.port.sdf_writer import to_xml
 
 
 def _origin(parent, T: np.ndarray) -> None:

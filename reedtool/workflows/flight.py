@@ -9,7 +9,7 @@ from __future__ import annotations
 import contextlib
 from typing import Callable, ContextManager
 
-from reedtool.assembly.vehicle import (
+from reedtool.workflows.vehicle import (
     DEFAULT_MAX_MEMORY_MB,
     Vehicle,
     check_batch_resources,
@@ -45,7 +45,7 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
     verdict's), "message", "passed" (the verdict against `requirement`, default
     --require flies); plus "_run" (the HoverRun, for CSV/plot), "_omega_max" and
     "_envelope" (the batch's, with `envelope`). With `controller_files` (RotorS Lee
-    gains and vehicle YAML) the flight is that controller's (assembly.lee_flight) and
+    gains and vehicle YAML) the flight is that controller's (workflows.lee_flight) and
     "controller" reports its checks; it passes only when it flies.
     """
     import numpy as np
@@ -111,7 +111,7 @@ def hover_test(robot, config, *, samples: int | None = None, seed: int = 0,
         return conclude(judge.uncontrollable(acai))
 
     if controller_files:
-        from reedtool.assembly.lee_flight import fly_controller
+        from reedtool.workflows.lee_flight import fly_controller
         from reedtool.sim.lee_rotors import ROTORS_CONTROL_RATE_HZ
 
         lee = fly_controller(robot, vehicle, flying, config, controller_files,

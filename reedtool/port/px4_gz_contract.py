@@ -19,7 +19,7 @@ PX4-gazebo-models models/x500, models/x500_base, worlds/default.sdf):
   navsat and magnetometer need them) and the sensor systems, without the vehicle (PX4
   spawns it).
 
-`apply_px4_contract` rewrites a port plan (scaffold.gz_port) to that shape and says what
+`apply_px4_contract` rewrites a port plan (port.gz_port) to that shape and says what
 it changed, row by row; `px4_world_sdf` writes the world; `px4_layout` the file paths.
 """
 
@@ -31,7 +31,7 @@ from pathlib import PurePosixPath
 import numpy as np
 
 from reedtool.errors import ReedtoolError
-from reedtool.scaffold.gz_port import (
+from reedtool.port.gz_port import (
     MOTOR_SYSTEM,
     SENSOR_SYSTEMS,
     WORLD_PHYSICS,
@@ -389,8 +389,8 @@ def package_px4_files(name: str, rendered) -> list[tuple[PurePosixPath, bytes]]:
     from pathlib import Path
 
     from reedtool.io.loader import load_robot
-    from reedtool.scaffold.gz_port import PortOptions, plan_port
-    from reedtool.scaffold.sdf_writer import port_files
+    from reedtool.port.gz_port import PortOptions, plan_port
+    from reedtool.port.sdf_writer import port_files
 
     with tempfile.TemporaryDirectory(prefix="reedtool-px4-") as scratch:
         root = Path(scratch) / name

@@ -1,1 +1,0 @@
-"""`new-package`: the frame catalogue, package parameters and template rendering."""
