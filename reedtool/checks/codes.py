@@ -12,16 +12,19 @@ registered again ("codes are never reused").
 - lifecycle: "stable" (released; behaviour changes only as a bug fix) or "preview" (new,
   may still change). A code removed from the registry moves to RETIRED with the reason.
 
-EXAMPLES gives a bad and a good model for a subset of the rules (EXAMPLE_CODES), each a whole
-URDF or SDF 1.9 file (example_format tells which); docs/rules.md shows them and
-tests/test_code_table.py runs each through the rules: the bad one must give its code, the good
-one must not and must load in libsdformat, and a bad SDF one of a "refused" rule must be
-refused by it.
+EXAMPLES gives a bad and a good model for every stable rule but those of NO_EXAMPLE (each with
+why no standalone example can show it), each a whole URDF or SDF 1.9 file (example_format tells
+which), or a Case: the model with the other files `reedtool validate` is given beside it (a
+controller YAML, a PX4 airframe, an ArduPilot .parm, a mesh) and the command line that gives
+them. docs/rules.md shows them and tests/test_code_table.py runs each: the bad one must give
+its code, the good one must not and must load in libsdformat, and a bad SDF one of a
+"refused" rule must be refused by it.
 """
 
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 
 STACKS = ("core", "px4", "ardupilot", "rotors-lee")
 LIFECYCLES = ("stable", "preview")
@@ -283,6 +286,20 @@ def _quad_extra(extra: str) -> str:
 _MAVLINK = ('  <gazebo><plugin name="mavlink_interface" '
             'filename="librotors_gazebo_mavlink_interface.so">'
             '<rotorCount>{count}</rotorCount></plugin></gazebo>\n')
+# The hexacopter's rotors every 60° on a 0.25 m circle, as _hexa("PPNNPN").
+_HEXA_X = (("0.25", "0", "ccw", "0", "continuous"), ("0.125", "0.2165", "ccw", "1", "continuous"),
+           ("-0.125", "0.2165", "cw", "2", "continuous"), ("-0.25", "0", "cw", "3", "continuous"),
+           ("-0.125", "-0.2165", "ccw", "4", "continuous"),
+           ("0.125", "-0.2165", "cw", "5", "continuous"))
+# RotorS' mav_name argument, the robot named by it.
+_MAV_NAME_ARG = '  <xacro:arg name="mav_name" default="quad"/>\n'
+# An IMU macro in RotorS' component_snippets style: a link on a fixed joint and its plugin.
+_IMU_MACRO = ('  <xacro:macro name="imu">\n'
+              '    <joint name="imu_joint" type="fixed"><parent link="base_link"/>'
+              '<child link="imu_link"/></joint>\n'
+              '    <link name="imu_link"><inertial><mass value="0.015"/><inertia ixx="1e-05" '
+              'ixy="0" ixz="0" iyy="1e-05" iyz="0" izz="1e-05"/></inertial></link>\n'
+              '  </xacro:macro>\n')
 # An IMU on a link attached by a fixed joint (merged into base_link unless preserved).
 _IMU = ('  <joint name="imu_joint" type="fixed"><parent link="base_link"/>'
         '<child link="imu_link"/></joint>\n'
@@ -291,6 +308,48 @@ _IMU = ('  <joint name="imu_joint" type="fixed"><parent link="base_link"/>'
         '  <gazebo><plugin name="imu" filename="librotors_gazebo_imu_plugin.so">'
         '<linkName>imu_link</linkName></plugin></gazebo>\n')
 
+
+
+def _stl(name: str, *facets: tuple[tuple[float, float, float], ...]) -> str:
+    """An ASCII STL (the text form CAD tools also export) of triangles given by corners."""
+    out = [f"solid {name}"]
+    for facet in facets:
+        out += ["  facet normal 0 0 1", "    outer loop"]
+        out += [f"      vertex {x:g} {y:g} {z:g}" for x, y, z in facet]
+        out += ["    endloop", "  endfacet"]
+    return "\n".join(out + [f"endsolid {name}"]) + "\n"
+
+
+def _prop_stl(units_per_m: float) -> str:
+    """A 9-inch (0.2286 m) two-blade propeller disc outline, flat, written in a CAD unit:
+    1 (metres), 100 (centimetres) or 1000 (millimetres)."""
+    r, w = 0.1143 * units_per_m, 0.012 * units_per_m
+    return _stl("prop", ((-r, 0, 0), (0, -w, 0), (r, 0, 0)), ((r, 0, 0), (0, w, 0), (-r, 0, 0)))
+
+
+def _quad_prop_visual(uri: str, scale: str = "", rotor: int = 0, kind: str = "visual",
+                      table: tuple = _QUAD_X) -> str:
+    """The multirotor of `table` with a propeller mesh drawn on rotor `rotor` (as RotorS'
+    propeller_ccw.dae is) as its `kind` (visual or collision)."""
+    scale = f' scale="{scale}"' if scale else ""
+    return _multirotor(table).replace(
+        f'<link name="rotor_{rotor}"><inertial>',
+        f'<link name="rotor_{rotor}"><{kind}><geometry><mesh filename="{uri}"{scale}/>'
+        f'</geometry></{kind}><inertial>', 1)
+
+
+def _xacro(urdf: str, macros: str = "") -> str:
+    """A URDF as a .urdf.xacro file (the xacro namespace declared), `macros` after <robot>."""
+    return urdf.replace('<robot name="quad">',
+                        '<robot name="quad" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
+                        + macros, 1)
+
+
+_PROP_M = (("meshes/prop.stl", _prop_stl(1)),)
+_PACKAGE_XML = ('<?xml version="1.0"?>\n<package format="3">\n  <name>{name}</name>\n'
+                '  <version>1.0.0</version>\n  <description>A quadrotor</description>\n'
+                '  <maintainer email="me@example.com">me</maintainer>\n'
+                '  <license>BSD</license>\n</package>\n')
 
 # The same two-link arm as an SDF 1.9 model (Gazebo's own format).
 _SDF_INERTIAL = ('<inertial><mass>{mass_kg}</mass><inertia><ixx>{i}</ixx><iyy>{i}</iyy>'
@@ -370,14 +429,39 @@ def _ardupilot_quad(flipped_channel: int = -1) -> str:
     return "".join(out)
 
 
+@dataclass(frozen=True)
+class Case:
+    """An example that needs more than the model file: `files` are (path relative to the
+    model's folder, text) written beside it, `args` the words after the model on
+    `reedtool validate`'s command line, `name` the model's file name."""
+
+    model: str
+    files: tuple[tuple[str, str], ...] = ()
+    args: tuple[str, ...] = ()
+    name: str = ""
+
+    @property
+    def model_name(self) -> str:
+        return self.name or f"model.{example_format(self.model)}"
+
+    @property
+    def command(self) -> str:
+        return " ".join(("reedtool validate", self.model_name) + self.args)
+
+
+def as_case(example: "str | Case") -> Case:
+    """A plain example is a Case with no other file and no other word."""
+    return example if isinstance(example, Case) else Case(example)
+
+
 def example_format(text: str) -> str:
     """"sdf" for an example whose root element is <sdf>, "urdf" otherwise: the file suffix
     the loader and libsdformat read it by, and the label the rules page gives it."""
     return "sdf" if re.search(r"^\s*<sdf[\s>]", text, re.MULTILINE) else "urdf"
 
 
-# code -> (bad model, good model): URDF or SDF (example_format), each a whole file.
-EXAMPLES: dict[str, tuple[str, str]] = {
+# code -> (bad, good): a whole URDF or SDF file (example_format), or a Case.
+EXAMPLES: dict[str, tuple["str | Case", "str | Case"]] = {
     "S101": (_arm(arm=_mass("half")), _arm(arm=_mass("0.5"))),
     "S102": (_arm(origin="0 nan 0.05"), _arm()),
     "S104": (_arm(extra='  <link name="camera">' + _ARM_INERTIAL + '</link>\n'),
@@ -516,7 +600,94 @@ EXAMPLES: dict[str, tuple[str, str]] = {
              _quad()),
     # Channel 0's control block copied from a cw rotor onto a ccw one.
     "R318": (_ardupilot_quad(flipped_channel=0), _ardupilot_quad()),
+    # A propeller exported in millimetres and read as metres: 228.6 m across, 646 times
+    # the 0.354 m vehicle.
+    "I210": (Case(_quad_prop_visual("meshes/prop.stl"), (("meshes/prop.stl", _prop_stl(1000)),),
+                  name="quad.urdf"),
+             Case(_quad_prop_visual("meshes/prop.stl", "0.001 0.001 0.001"),
+                  (("meshes/prop.stl", _prop_stl(1000)),), name="quad.urdf")),
+    # The same propeller in centimetres on a 0.5 m hexacopter: 22.86 m across, 46 times the
+    # vehicle (under the 50 times that makes the unit certain, I210).
+    "I206": (Case(_quad_prop_visual("meshes/prop.stl", table=_HEXA_X),
+                  (("meshes/prop.stl", _prop_stl(100)),), name="hexa.urdf"),
+             Case(_quad_prop_visual("meshes/prop.stl", "0.01 0.01 0.01", table=_HEXA_X),
+                  (("meshes/prop.stl", _prop_stl(100)),), name="hexa.urdf")),
+    # The file is meshes/prop.stl; the model names it with a capital P (Linux file names
+    # have case).
+    "S115": (Case(_quad_prop_visual("meshes/Prop.stl"), _PROP_M, name="quad.urdf"),
+             Case(_quad_prop_visual("meshes/prop.stl"), _PROP_M, name="quad.urdf")),
+    # The clockwise propeller drawn as the counter-clockwise one mirrored in y (the MRS UAV
+    # models' convention).
+    "S121": (Case(_quad_prop_visual("meshes/prop.stl", "1 -1 1", rotor=2), _PROP_M,
+                  name="quad.urdf"),
+             Case(_quad_prop_visual("meshes/prop.stl", rotor=2), _PROP_M, name="quad.urdf")),
+    "S122": (Case(_quad_prop_visual("meshes/prop.stl", "1 -1 1", rotor=2, kind="collision"),
+                  _PROP_M, name="quad.urdf"),
+             Case(_quad_prop_visual("meshes/prop.stl", rotor=2, kind="collision"), _PROP_M,
+                  name="quad.urdf")),
+    # A CAD part referenced as exported (STEP), in a Gazebo classic (RotorS) model.
+    "S130": (Case(_quad_prop_visual("meshes/prop.step"),
+                  (("meshes/prop.step", "ISO-10303-21;\nHEADER;\nENDSEC;\nDATA;\nENDSEC;\n"
+                                        "END-ISO-10303-21;\n"),), name="quad.urdf"),
+             Case(_quad_prop_visual("meshes/prop.stl"), _PROP_M, name="quad.urdf")),
+    "S131": (Case(_quad_prop_visual("package://quad_description/../../../meshes/prop.stl"),
+                  (("quad_description/package.xml", _PACKAGE_XML.format(name="quad_description")),
+                   ("quad_description/meshes/prop.stl", _prop_stl(1))),
+                  name="quad_description/urdf/quad.urdf"),
+             Case(_quad_prop_visual("package://quad_description/meshes/prop.stl"),
+                  (("quad_description/package.xml", _PACKAGE_XML.format(name="quad_description")),
+                   ("quad_description/meshes/prop.stl", _prop_stl(1))),
+                  name="quad_description/urdf/quad.urdf")),
+    # A path on the author's machine (elsewhere also S115: the file is not there).
+    "S169": (Case(_quad_prop_visual("file:///home/me/quad/meshes/prop.stl"), _PROP_M,
+                  name="quad.urdf"),
+             Case(_quad_prop_visual("meshes/prop.stl"), _PROP_M, name="quad.urdf")),
+    # gz-sim's X3 propeller mesh from Fuel.
+    "S190": (Case(_quad_prop_visual("https://fuel.gazebosim.org/1.0/OpenRobotics/models/"
+                                    "X3%20UAV/4/files/meshes/x3.dae"), _PROP_M,
+                  name="quad.urdf"),
+             Case(_quad_prop_visual("meshes/prop.stl"), _PROP_M, name="quad.urdf")),
+    # A backup copy of the package beside it, its package.xml still naming quad_description.
+    "S150": (Case(_quad_prop_visual("package://quad_description/meshes/prop.stl"),
+                  (("src/quad_description/package.xml",
+                    _PACKAGE_XML.format(name="quad_description")),
+                   ("src/quad_description/meshes/prop.stl", _prop_stl(1)),
+                   ("src/quad_description_backup/package.xml",
+                    _PACKAGE_XML.format(name="quad_description")),
+                   ("src/quad_description_backup/meshes/prop.stl", _prop_stl(1))),
+                  ("--package-path", "src"), name="quad.urdf"),
+             Case(_quad_prop_visual("package://quad_description/meshes/prop.stl"),
+                  (("src/quad_description/package.xml",
+                    _PACKAGE_XML.format(name="quad_description")),
+                   ("src/quad_description/meshes/prop.stl", _prop_stl(1))),
+                  ("--package-path", "src"), name="quad.urdf")),
+    # An IMU macro called the pre-xacro-2 way (<imu/>): xacro copies the call, no IMU link
+    # is made.
+    "S103": (Case(_xacro(_quad_extra('  <imu/>\n'), _IMU_MACRO), name="quad.urdf.xacro"),
+             Case(_xacro(_quad_extra('  <xacro:imu/>\n'), _IMU_MACRO), name="quad.urdf.xacro")),
+    # RotorS' mav_name argument misspelt: xacro ignores it and the default stays.
+    "S140": (Case(_xacro(_quad(), _MAV_NAME_ARG), args=("mav_nmae:=hex",),
+                  name="quad.urdf.xacro"),
+             Case(_xacro(_quad(), _MAV_NAME_ARG), args=("mav_name:=hex",),
+                  name="quad.urdf.xacro")),
+    # A launch file's argument for another node (CrazyS passes it to every vehicle).
+    "S141": (Case(_xacro(_quad(), _MAV_NAME_ARG),
+                  args=("mav_name:=hex", "enable_mellinger_controller:=true"),
+                  name="quad.urdf.xacro"),
+             Case(_xacro(_quad(), _MAV_NAME_ARG), args=("mav_name:=hex",),
+                  name="quad.urdf.xacro")),
+    # A suppression left after the tilted rotor it excused was made level again.
+    "S143": (Case(_quad().replace('    <origin xyz="0.177 -0.177 0.03"/>',
+                                  '    <!-- reedtool: ignore[R311] -->\n'
+                                  '    <origin xyz="0.177 -0.177 0.03"/>'), name="quad.urdf"),
+             Case(_tilted_quad("    <!-- reedtool: ignore[R311] -->\n"), name="quad.urdf")),
+    # ArduPilot's iris: no motor constant written, k_f estimated from the two LiftDrag
+    # blades as 2.167e-05 N/(rad/s)² per rotor; a RotorS motor writes its own (8.54858e-06),
+    # nothing to explain.
+    "R317": (_ardupilot_quad(), _quad()),
 }
-# The rules whose documentation must carry a bad and a good example (the rest: to come
-# in this table, not in the page).
+# The rules whose documentation carries a bad and a good example.
 EXAMPLE_CODES = frozenset(EXAMPLES)
+
+# code -> why no standalone example can show the rule (docs/rules.md says so on its page).
+NO_EXAMPLE: dict[str, str] = {}
