@@ -351,6 +351,53 @@ _PACKAGE_XML = ('<?xml version="1.0"?>\n<package format="3">\n  <name>{name}</na
                 '  <maintainer email="me@example.com">me</maintainer>\n'
                 '  <license>BSD</license>\n</package>\n')
 
+
+# The quad's RotorS vehicle parameters (rotors_gazebo/resource/<mav>.yaml): mass 1.2 kg body
+# + 4 x 5 g rotors; inertia about the COM (the rotors 0.177 m out on x and y, 0.03 m up):
+# xx = 0.00964 + 4 (1.25e-05 + 0.005 (0.177² + 0.03²)) - 1.22 (4.92e-04)² = 0.010334.
+# Entry i: the rotor with motorNumber i, angle from +x towards +y, arm 0.177·√2 m.
+_ROTORS_ROWS = (("-0.785398", "1.0"), ("2.356194", "1.0"), ("0.785398", "-1.0"),
+                ("-2.356194", "-1.0"))
+
+
+def _rotors_yaml(mass_kg: str = "1.22",
+                 inertia: str = "{xx: 0.010334, xy: 0.0, xz: 0.0, yy: 0.010334, yz: 0.0, "
+                                "zz: 0.019353}",
+                 rows: int = 4, **change: tuple[int, str, str]) -> str:
+    """The quad's vehicle YAML with entry i's `key` set: change={"name": (i, key, text)}."""
+    entries = [{"angle": angle, "arm_length": "0.250316", "rotor_force_constant": "8.54858e-06",
+                "rotor_moment_constant": "0.016", "direction": direction}
+               for angle, direction in _ROTORS_ROWS[:rows]]
+    for i, key, value in change.values():
+        if value:
+            entries[i][key] = value
+        else:
+            del entries[i][key]
+    lines = "".join(f"  '{i}': {{" + ", ".join(f"{k}: {v}" for k, v in e.items()) + "}\n"
+                    for i, e in enumerate(entries))
+    return f"mass: {mass_kg}\ninertia: {inertia}\nrotor_configuration:\n{lines}"
+
+
+def _controller(yaml_text: str, gains: str = "") -> Case:
+    """The RotorS quad with its vehicle YAML (and Lee gains) given to validate."""
+    files = (("quad.yaml", yaml_text),)
+    args = ("--controller", "quad.yaml")
+    if gains:
+        files += (("lee_controller_quad.yaml", gains),)
+        args += ("--controller", "lee_controller_quad.yaml")
+    return Case(_quad(), files, args, name="quad.urdf")
+
+
+def _lee_gains(**change: str) -> str:
+    """lee_controller_<mav>.yaml: RotorS' Firefly gains scaled to the quad (position and
+    velocity by mass, attitude and rate by each principal moment), one line changed."""
+    gains = {"position_gain": "{x: 4.7, y: 4.7, z: 4.7}",
+             "velocity_gain": "{x: 3.7, y: 3.7, z: 3.7}",
+             "attitude_gain": "{x: 0.89, y: 0.89, z: 0.03}",
+             "angular_rate_gain": "{x: 0.15, y: 0.15, z: 0.036}"}
+    gains.update(change)
+    return "".join(f"{key}: {value}\n" for key, value in gains.items())
+
 # The same two-link arm as an SDF 1.9 model (Gazebo's own format).
 _SDF_INERTIAL = ('<inertial><mass>{mass_kg}</mass><inertia><ixx>{i}</ixx><iyy>{i}</iyy>'
                  '<izz>{i}</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>')
@@ -685,6 +732,47 @@ EXAMPLES: dict[str, tuple["str | Case", "str | Case"]] = {
     # blades as 2.167e-05 N/(rad/s)² per rotor; a RotorS motor writes its own (8.54858e-06),
     # nothing to explain.
     "R317": (_ardupilot_quad(), _quad()),
+    # The vehicle YAML of a tricopter-turned-quad: three entries for four motors.
+    "C401": (_controller(_rotors_yaml(rows=3)), _controller(_rotors_yaml())),
+    # Entry 2 (the front-left rotor, cw) given direction +1 (ccw).
+    "C404": (_controller(_rotors_yaml(d=(2, "direction", "1.0"))), _controller(_rotors_yaml())),
+    # Entry 0 mirrored: +45° (front-left) for the front-right rotor at -45°.
+    "C405": (_controller(_rotors_yaml(a=(0, "angle", "0.785398"))), _controller(_rotors_yaml())),
+    # Entry 0's arm written as the rotor's x offset, 0.177 m, not its 0.2503 m distance.
+    "C406": (_controller(_rotors_yaml(a=(0, "arm_length", "0.177"))),
+             _controller(_rotors_yaml())),
+    # RotorS' pelican force constant (9.9865e-06) on a motor with 8.54858e-06: 17 % off.
+    "C407": (_controller(_rotors_yaml(k=(1, "rotor_force_constant", "9.9865e-06"))),
+             _controller(_rotors_yaml())),
+    # 0.025 m where the motor's momentConstant is 0.016: 56 % off.
+    "C408": (_controller(_rotors_yaml(k=(3, "rotor_moment_constant", "0.025"))),
+             _controller(_rotors_yaml())),
+    # The base link's 1.2 kg without the rotors: 1.6 % under the 1.22 kg total.
+    "C409": (_controller(_rotors_yaml(mass_kg="1.2")), _controller(_rotors_yaml())),
+    # RotorS' firefly.yaml inertia copied unchanged: xx 0.0348 against 0.0103.
+    "C410": (_controller(_rotors_yaml(inertia="{xx: 0.0347563, xy: 0.0, xz: 0.0, "
+                                              "yy: 0.0458929, yz: 0.0, zz: 0.0977}")),
+             _controller(_rotors_yaml())),
+    # Entry 3 without its direction (RotorS would keep its default).
+    "C411": (_controller(_rotors_yaml(d=(3, "direction", ""))), _controller(_rotors_yaml())),
+    # The mass in grams: 1220 written where kg is read, 1000x the model's 1.22 kg.
+    "C452": (_controller(_rotors_yaml(mass_kg="1220")), _controller(_rotors_yaml())),
+    # The inertia in g·m²: 1000x the model's.
+    "C453": (_controller(_rotors_yaml(inertia="{xx: 10.334, xy: 0.0, xz: 0.0, yy: 10.334, "
+                                              "yz: 0.0, zz: 19.353}")),
+             _controller(_rotors_yaml())),
+    # The yaw attitude gain's sign lost: -0.03 pushes the heading away from its setpoint.
+    "C450": (_controller(_rotors_yaml(), _lee_gains(attitude_gain="{x: 0.89, y: 0.89, z: -0.03}")),
+             _controller(_rotors_yaml(), _lee_gains())),
+    # The roll attitude gain 100x (89 for 0.89): the sampled loop diverges at 100 Hz (and
+    # rings, C454).
+    "C451": (_controller(_rotors_yaml(), _lee_gains(attitude_gain="{x: 89, y: 0.89, z: 0.03}")),
+             _controller(_rotors_yaml(), _lee_gains())),
+    # The roll rate gain a third of the scaled Firefly's: damping ratio
+    # 0.04 / (2 sqrt(0.89 x 0.010334)) = 0.21 (0.78 with 0.15), under 0.3.
+    "C454": (_controller(_rotors_yaml(),
+                         _lee_gains(angular_rate_gain="{x: 0.04, y: 0.15, z: 0.036}")),
+             _controller(_rotors_yaml(), _lee_gains())),
 }
 # The rules whose documentation carries a bad and a good example.
 EXAMPLE_CODES = frozenset(EXAMPLES)
