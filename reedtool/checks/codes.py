@@ -23,6 +23,7 @@ its code, the good one must not and must load in libsdformat, and a bad SDF one 
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 
@@ -397,6 +398,178 @@ def _lee_gains(**change: str) -> str:
              "angular_rate_gain": "{x: 0.15, y: 0.15, z: 0.036}"}
     gains.update(change)
     return "".join(f"{key}: {value}\n" for key, value in gains.items())
+
+
+# PX4's x500 for gz-sim as one SDF 1.9 model (its base and the four MulticopterMotorModel
+# systems of PX4-gazebo-models' x500, includes resolved): 2.0 kg body, 16 g rotors on a
+# 0.174 m square, rotor k (x, y, turning direction) driven by motor number k, up to
+# 1000 rad/s, motorConstant 8.54858e-06, momentConstant 0.016.
+_X500_ROTORS = (("0.174", "-0.174", "ccw"), ("-0.174", "0.174", "ccw"),
+                ("0.174", "0.174", "cw"), ("-0.174", "-0.174", "cw"))
+
+
+def _x500(extra: str = "", *, base: str = "base_link", topic: str = "command/motor_speed",
+          max_rad_s: str = "1000") -> str:
+    """The x500; `extra` (more systems) before </model>, the base link named `base`, the
+    motors listening on `topic`, spinning up to `max_rad_s`."""
+    out = ['<?xml version="1.0"?>\n<sdf version="1.9">\n  <model name="x500">\n'
+           f'    <link name="{base}">\n'
+           '      <inertial><mass>2.0</mass><inertia><ixx>0.0216667</ixx><iyy>0.0216667</iyy>'
+           '<izz>0.04</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>\n'
+           '      <collision name="collision"><geometry><box><size>0.35 0.35 0.05</size></box>'
+           '</geometry></collision>\n    </link>\n']
+    for k, (x, y, _spin) in enumerate(_X500_ROTORS):
+        out.append(
+            f'    <link name="rotor_{k}">\n      <pose>{x} {y} 0.06 0 0 0</pose>\n'
+            '      <inertial><mass>0.016</mass><inertia><ixx>3.8e-07</ixx><iyy>2.6e-05</iyy>'
+            '<izz>2.6e-05</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>\n'
+            '      <collision name="collision"><geometry><box><size>0.28 0.017 0.001</size>'
+            '</box></geometry></collision>\n    </link>\n'
+            f'    <joint name="rotor_{k}_joint" type="revolute"><parent>{base}</parent>'
+            f'<child>rotor_{k}</child>\n'
+            '      <axis><xyz>0 0 1</xyz><limit><lower>-1e+16</lower><upper>1e+16</upper>'
+            '</limit></axis>\n    </joint>\n')
+    for k, (_x, _y, spin) in enumerate(_X500_ROTORS):
+        out.append(
+            '    <plugin filename="gz-sim-multicopter-motor-model-system" '
+            'name="gz::sim::systems::MulticopterMotorModel">\n'
+            f'      <jointName>rotor_{k}_joint</jointName><linkName>rotor_{k}</linkName>'
+            f'<turningDirection>{spin}</turningDirection>\n'
+            '      <timeConstantUp>0.0125</timeConstantUp><timeConstantDown>0.025'
+            f'</timeConstantDown><maxRotVelocity>{max_rad_s}</maxRotVelocity>\n'
+            '      <motorConstant>8.54858e-06</motorConstant><momentConstant>0.016'
+            '</momentConstant>\n'
+            f'      <commandSubTopic>{topic}</commandSubTopic><motorNumber>{k}</motorNumber>'
+            '<motorType>velocity</motorType>\n    </plugin>\n')
+    return "".join(out) + extra + '  </model>\n</sdf>\n'
+
+
+def _velocity_control(joints: tuple[str, ...] = ("rotor_0_joint", "rotor_1_joint",
+                                                 "rotor_2_joint", "rotor_3_joint"),
+                      com_link: str = "<comLinkName>base_link</comLinkName>") -> str:
+    """gz-sim's MulticopterVelocityControl as its X3 example sets it, one <rotor> per joint
+    in `joints` (direction +1 for the ccw rotors 0 and 1)."""
+    rotors = "".join(
+        f'        <rotor><jointName>{joint}</jointName><forceConstant>8.54858e-06'
+        '</forceConstant><momentConstant>0.016</momentConstant>'
+        f'<direction>{1 if joint[6] in "01" else -1}</direction></rotor>\n' for joint in joints)
+    return ('    <plugin filename="gz-sim-multicopter-control-system" '
+            'name="gz::sim::systems::MulticopterVelocityControl">\n'
+            '      <commandSubTopic>cmd_vel</commandSubTopic><enableSubTopic>enable'
+            f'</enableSubTopic>{com_link}\n'
+            '      <velocityGain>2.7 2.7 2.7</velocityGain><attitudeGain>2 3 0.15</attitudeGain>'
+            '<angularRateGain>0.4 0.52 0.18</angularRateGain>\n'
+            '      <maximumLinearAcceleration>2 2 2</maximumLinearAcceleration>\n'
+            '      <rotorConfiguration>\n' + rotors + '      </rotorConfiguration>\n'
+            '    </plugin>\n')
+
+
+def _px4_airframe(header: str, params: dict[str, str], **change: str | None) -> str:
+    """A PX4 airframe script (ROMFS init.d-posix/airframes shape): `params` as
+    `param set-default` lines, each of `change` set (None: the line left out)."""
+    values = {**params, **change}
+    return header + "".join(f"param set-default {name} {value}\n"
+                            for name, value in values.items() if value is not None)
+
+
+def _ca_rotors(arm_m: str, km: str) -> dict[str, str]:
+    """CA_ROTOR0..3 of a quad X in PX4's order, positions in FRD (x forward, y right),
+    KM positive for the counter-clockwise rotors 0 and 1."""
+    signs = ((1, 1, ""), (-1, -1, ""), (1, -1, "-"), (-1, 1, "-"))
+    out = {"CA_AIRFRAME": "0", "CA_ROTOR_COUNT": "4"}
+    for i, (sx, sy, spin) in enumerate(signs):
+        out[f"CA_ROTOR{i}_PX"] = ("-" if sx < 0 else "") + arm_m
+        out[f"CA_ROTOR{i}_PY"] = ("-" if sy < 0 else "") + arm_m
+        out[f"CA_ROTOR{i}_KM"] = spin + km
+    return out
+
+
+# PX4's 4001_gz_x500 for the x500 above: its CA table at the model's rotors, KM the motors'
+# momentConstant, ESC output k driving motor k-1 from 150 to 1000 rad/s (the maxRotVelocity).
+_GZ_AIRFRAME_HEADER = ("#!/bin/sh\n#\n# @name x500 (Gazebo Sim)\n#\n"
+                       ". ${R}etc/init.d/rc.mc_defaults\n\n"
+                       "PX4_SIMULATOR=${PX4_SIMULATOR:=gz}\nPX4_SIM_MODEL=${PX4_SIM_MODEL:=x500}\n\n")
+_GZ_PARAMS = {"SIM_GZ_EN": "1", **_ca_rotors("0.174", "0.016"),
+              **{f"SIM_GZ_EC_FUNC{k}": str(100 + k) for k in range(1, 5)},
+              **{f"SIM_GZ_EC_MIN{k}": "150" for k in range(1, 5)},
+              **{f"SIM_GZ_EC_MAX{k}": "1000" for k in range(1, 5)},
+              "MPC_THR_HOVER": "0.73"}
+
+
+def _gz_px4(model: str = "", **change: str | None) -> Case:
+    """The x500 (or `model`) with its PX4 airframe, changed, given by --airframe."""
+    return Case(model or _x500(), (("4001_gz_x500", _px4_airframe(_GZ_AIRFRAME_HEADER,
+                                                                   _GZ_PARAMS, **change)),),
+                ("--airframe", "4001_gz_x500"), name="x500.sdf")
+
+
+# PX4 Gazebo Classic: the RotorS quad with PX4's gazebo_mavlink_interface, whose channel i
+# turns PX4's output u into (u + input_offset) * input_scaling + zero_position_armed rad/s
+# for motor i: 100 + 738 u, up to the motors' 838 rad/s.
+def _mavlink_channels(scaling: str = "738", armed: str = "100") -> str:
+    channels = "".join(
+        f'<channel name="rotor{i}"><input_index>{i}</input_index><input_offset>0'
+        f'</input_offset><input_scaling>{scaling}</input_scaling><zero_position_disarmed>0'
+        f'</zero_position_disarmed><zero_position_armed>{armed}</zero_position_armed>'
+        '<joint_control_type>velocity</joint_control_type></channel>\n' for i in range(4))
+    return ('  <gazebo><plugin name="mavlink_interface" filename="libgazebo_mavlink_interface.so">'
+            '\n    <control_channels>\n' + channels + '    </control_channels>\n'
+            '  </plugin></gazebo>\n')
+
+
+_CLASSIC_AIRFRAME_HEADER = ("#!/bin/sh\n#\n# @name quad (Gazebo Classic)\n#\n"
+                            ". ${R}etc/init.d/rc.mc_defaults\n\n")
+_CLASSIC_PARAMS = {**_ca_rotors("0.177", "0.016"),
+                   **{f"PWM_MAIN_FUNC{k}": str(100 + k) for k in range(1, 5)},
+                   "MPC_THR_HOVER": "0.67"}
+
+
+def _classic_px4(scaling: str = "738", armed: str = "100", **change: str | None) -> Case:
+    return Case(_quad_extra(_mavlink_channels(scaling, armed)),
+                (("10015_gazebo-classic_quad", _px4_airframe(_CLASSIC_AIRFRAME_HEADER,
+                                                             _CLASSIC_PARAMS, **change)),),
+                ("--airframe", "10015_gazebo-classic_quad"), name="quad.urdf")
+
+
+def _parm(**change: str | None) -> str:
+    """ArduPilot's gazebo-iris defaults (.parm: NAME VALUE lines) for the iris above: quad X,
+    motor m on servo output m, which the plugin's channel m-1 reads."""
+    values = {"FRAME_CLASS": "1", "FRAME_TYPE": "1",
+              **{f"SERVO{m}_FUNCTION": str(32 + m) for m in range(1, 5)},
+              "MOT_SPIN_ARM": "0.1", "MOT_SPIN_MIN": "0.15", "MOT_THST_HOVER": "0.36", **change}
+    return ("# quad X: motor 1 front-right CCW, 2 back-left CCW, 3 front-left CW, "
+            "4 back-right CW\n"
+            + "".join(f"{name} {value}\n" for name, value in values.items() if value is not None))
+
+
+def _ardupilot(**change: str | None) -> Case:
+    return Case(_ardupilot_quad(), (("iris.parm", _parm(**change)),),
+                ("--autopilot-params", "iris.parm"), name="iris.sdf")
+
+
+def _thrust_axes_frd(roll_rad: float) -> dict[str, str]:
+    """CA_ROTORi_AX/AY/AZ of the x500 with rotor i rolled about its arm by ±roll_rad (the
+    R320 pattern of _tilted_x500): the model rotor's thrust axis R_z(yaw) R_x(roll) z in FRD."""
+    out = {}
+    for i, (roll, yaw) in enumerate(_X500_TILTS):
+        r, y = roll * roll_rad, yaw
+        flu = (math.sin(y) * math.sin(r), -math.cos(y) * math.sin(r), math.cos(r))
+        for axis, value in zip("XYZ", (flu[0], -flu[1], -flu[2])):
+            out[f"CA_ROTOR{i}_A{axis}"] = f"{value:.4f}"
+    return out
+
+
+# Per x500 rotor: (roll sign, yaw of its pose in rad): each rotor rolled about its arm,
+# alternating with its turning direction (the AscTec Neo's pattern, R320).
+_X500_TILTS = ((1, -0.785398), (1, 2.356194), (-1, 0.785398), (-1, -2.356194))
+
+
+def _tilted_x500(roll_rad: float) -> str:
+    out = _x500()
+    for (x, y, _spin), (sign, yaw) in zip(_X500_ROTORS, _X500_TILTS):
+        out = out.replace(f"<pose>{x} {y} 0.06 0 0 0</pose>",
+                          f"<pose>{x} {y} 0.06 {sign * roll_rad:g} 0 {yaw}</pose>")
+    return out
 
 # The same two-link arm as an SDF 1.9 model (Gazebo's own format).
 _SDF_INERTIAL = ('<inertial><mass>{mass_kg}</mass><inertia><ixx>{i}</ixx><iyy>{i}</iyy>'
@@ -773,9 +946,86 @@ EXAMPLES: dict[str, tuple["str | Case", "str | Case"]] = {
     "C454": (_controller(_rotors_yaml(),
                          _lee_gains(angular_rate_gain="{x: 0.04, y: 0.15, z: 0.036}")),
              _controller(_rotors_yaml(), _lee_gains())),
+    # The table names rotor 3's joint as rotor3_joint.
+    "C402": (_x500(_velocity_control(("rotor_0_joint", "rotor_1_joint", "rotor_2_joint",
+                                      "rotor3_joint"))), _x500(_velocity_control())),
+    # Entries 2 and 3 swapped: speed 2 goes to the motor with motorNumber 3.
+    "C403": (_x500(_velocity_control(("rotor_0_joint", "rotor_1_joint", "rotor_3_joint",
+                                      "rotor_2_joint"))), _x500(_velocity_control())),
+    "C412": (_x500(_velocity_control(com_link="")), _x500(_velocity_control())),
+    # A hexacopter's CA_ROTOR_COUNT 6 kept on the x500's airframe (and C414: rotors 4 and 5
+    # on no output).
+    "C413": (_gz_px4(CA_ROTOR_COUNT="6"), _gz_px4()),
+    # ESC output 4 disabled (SIM_GZ_EC_FUNC4 0): CA rotor 3 reaches no motor.
+    "C414": (_gz_px4(SIM_GZ_EC_FUNC4="0"), _gz_px4()),
+    # CA rotor 0's y in FLU (left positive) where FRD wants right: bearing -45° for the
+    # front-right motor at +45°.
+    "C415": (_gz_px4(CA_ROTOR0_PY="-0.174"), _gz_px4()),
+    # CA_ROTOR2_KM positive (ccw) for the front-left motor, which turns cw.
+    "C416": (_gz_px4(CA_ROTOR2_KM="0.016"), _gz_px4()),
+    # PX4's x500 airframe value, |KM| 0.05: 3.12x the motors' momentConstant 0.016.
+    "C417": (_gz_px4(**{f"CA_ROTOR{i}_KM": ("-" if i > 1 else "") + "0.05" for i in range(4)}),
+             _gz_px4()),
+    # SIM_GZ_EC_MAX 1200 on motors that stop at 1000 rad/s: the top 19 % of PX4's output
+    # does nothing.
+    "C419": (_gz_px4(**{f"SIM_GZ_EC_MAX{k}": "1200" for k in range(1, 5)}), _gz_px4()),
+    # An idle of 800 rad/s, above the 769 rad/s each rotor needs to hold the 2.064 kg up:
+    # sqrt(2.064 x 9.80665 / 4 / 8.54858e-06).
+    "C420": (_gz_px4(**{f"SIM_GZ_EC_MIN{k}": "800" for k in range(1, 5)}), _gz_px4()),
+    # PX4's default 0.5 where the model hovers at (769 - 150) / (1000 - 150) = 0.729.
+    "C422": (_gz_px4(MPC_THR_HOVER="0.5"), _gz_px4()),
+    # PX4's x500 airframe describes the real frame (0.13, 0.22); the model is a 0.174 m
+    # square: 64 mm and 14.4° of bearing apart, same quadrant.
+    "C423": (_gz_px4(**{f"CA_ROTOR{i}_P{a}": v for i, (x, y) in enumerate(
+        (("0.13", "0.22"), ("-0.13", "-0.20"), ("0.13", "-0.22"), ("-0.13", "0.20")))
+        for a, v in (("X", x), ("Y", y))}), _gz_px4()),
+    # SIM_GZ_EC_MAX 900 on motors that reach 1000 rad/s: PX4 gets (900/1000)² = 81 % of the
+    # thrust.
+    "C424": (_gz_px4(**{f"SIM_GZ_EC_MAX{k}": "900" for k in range(1, 5)}), _gz_px4()),
+    # Above PX4's documented 0.1..0.8 (the model hovers at 0.729, C421).
+    "C425": (_gz_px4(MPC_THR_HOVER="0.85"), _gz_px4()),
+    # Motors on gz-sim's X3 topic (gazebo/command/motor_speed), not the command/motor_speed
+    # PX4's gz bridge publishes on.
+    "C439": (_gz_px4(_x500(topic="gazebo/command/motor_speed")), _gz_px4()),
+    # PX4's gz airframe (SIM_GZ_EN 1) on a Gazebo Classic (RotorS) model; the good one is
+    # the Classic airframe for it (PWM_MAIN_FUNC outputs).
+    "C435": (Case(_quad(), (("4001_gz_x500", _px4_airframe(_GZ_AIRFRAME_HEADER,
+                                                            _GZ_PARAMS)),),
+                  ("--airframe", "4001_gz_x500"), name="quad.urdf"), _classic_px4()),
+    # PX4's iris channel values (input_scaling 1000, zero_position_armed 100) on 838 rad/s
+    # motors: up to 1100 rad/s, the top 24 % does nothing (and C422: the hover moves to 0.492).
+    "C436": (_classic_px4(scaling="1000"), _classic_px4()),
+    # input_scaling 600: PX4's full output is 700 rad/s, (700/838)² = 70 % of the thrust.
+    "C437": (_classic_px4(scaling="600"), _classic_px4()),
+    # An armed idle of 650 rad/s (650 + 188 u: still up to 838), above the 592 rad/s each
+    # rotor needs to hover.
+    "C438": (_classic_px4(scaling="188", armed="650"), _classic_px4()),
+    # A parameter file that leaves the frame to SITL's defaults: FRAME_CLASS unset.
+    "C430": (_ardupilot(FRAME_CLASS=None), _ardupilot()),
+    # FRAME_CLASS 2 (hexa) for the quad: six motors mixed for four rotors.
+    "C431": (_ardupilot(FRAME_CLASS="2"), _ardupilot()),
+    # FRAME_TYPE 0 (plus): motor 1 straight ahead at 90° from the nose, not at 45°.
+    "C432": (_ardupilot(FRAME_TYPE="0"), _ardupilot()),
+    # FRAME_TYPE 3 (H): the X positions with every spin reversed.
+    "C433": (_ardupilot(FRAME_TYPE="3"), _ardupilot()),
+    # Motor 4's output given to a camera gimbal (SERVO4_FUNCTION 0): the back-right rotor
+    # gets no motor.
+    "C434": (_ardupilot(SERVO4_FUNCTION="0"), _ardupilot()),
+    # Rotor 0 allocated as a forward pusher (CA_ROTOR0_AX 1, AZ 0): 90° from its upward thrust.
+    "C418": (_gz_px4(CA_ROTOR0_AX="1", CA_ROTOR0_AZ="0"), _gz_px4()),
+    # Rotor 0's axis written 15° forward (AX 0.2588, AZ -0.9659) on a level rotor.
+    "C426": (_gz_px4(CA_ROTOR0_AX="0.2588", CA_ROTOR0_AZ="-0.9659"), _gz_px4()),
+    # Rotors rolled 0.2 rad (11.5°) in a balanced pattern, PX4's table left at its upward
+    # default (the quadtailsitter's convention); the good airframe gives PX4 the axes.
+    "C427": (_gz_px4(_tilted_x500(0.2)), _gz_px4(_tilted_x500(0.2), **_thrust_axes_frd(0.2))),
 }
 # The rules whose documentation carries a bad and a good example.
 EXAMPLE_CODES = frozenset(EXAMPLES)
 
 # code -> why no standalone example can show the rule (docs/rules.md says so on its page).
-NO_EXAMPLE: dict[str, str] = {}
+NO_EXAMPLE: dict[str, str] = {
+    "C421": "every PX4 airframe whose MPC_THR_HOVER is within 0.15 of the throttle the model "
+            "needs gets this line, and one further off gets C422 instead, so no model and "
+            "airframe are without both: C422's good example shows it (MPC_THR_HOVER 0.73 "
+            "beside the 0.729 the x500 needs), C422's bad one is the only way not to get it",
+}
