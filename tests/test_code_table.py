@@ -1,9 +1,14 @@
 """The code table (reedtool/checks/codes.py) is the registry's list: every registered rule
-is in it with the same name, its stack and lifecycle; retired codes stay out; and each
-documented example does what the page says (the bad model gives its code, the good one not).
+is in it with the same name, its stack and lifecycle; retired codes stay out; every stable
+rule has a bad and a good example but the few NO_EXAMPLE justifies; and each example does
+what the page says (the bad one gives its code, the good one not). A model alone runs
+through the rules; a Case (files beside the model, validate's words) through
+`reedtool validate` as the page shows it.
 """
 
 from __future__ import annotations
+
+import re
 
 import pytest
 
@@ -172,3 +177,70 @@ def test_bad_sdf_examples_of_refusal_rules_are_refused_by_the_consumer(code, tmp
     bad = as_case(EXAMPLES[code][0])
     _write(bad, tmp_path / "bad")
     assert sdformat_oracle.libsdformat_error(_consumed(bad, tmp_path / "bad")) is not None
+
+
+def test_the_good_vehicle_yaml_is_the_quads_by_hand():
+    """The controller examples' good quad.yaml, held to the quad's numbers derived here
+    (parallel axis theorem over the body and four rotors, bearings and arms from the rotor
+    table), not to reedtool's reading: a wrong 'good' file would make every C40x pair
+    prove nothing."""
+    import math
+
+    import numpy as np
+    import yaml
+
+    # The RotorS quad of the examples: rotor (x, y, spin) with motorNumber 0..3.
+    rotors = ((0.177, -0.177, "ccw"), (-0.177, 0.177, "ccw"), (0.177, 0.177, "cw"),
+              (-0.177, -0.177, "cw"))
+    body_kg, rotor_kg, rotor_z_m = 1.2, 0.005, 0.03
+    I_body = np.diag([0.00964, 0.00964, 0.018])
+    I_rotor = np.diag([1.25e-05, 1.25e-05, 2.5e-05])
+    positions = [np.array([x, y, rotor_z_m]) for x, y, _ in rotors]
+    mass = body_kg + 4 * rotor_kg
+    com = sum(rotor_kg * p for p in positions) / mass
+    I = I_body + body_kg * (com @ com * np.eye(3) - np.outer(com, com))
+    for p in positions:
+        d = p - com
+        I = I + I_rotor + rotor_kg * (d @ d * np.eye(3) - np.outer(d, d))
+    good = EXAMPLES["C401"][1]
+    assert "<mass value=\"1.2\"/>" in good.model and good.model.count("<mass value=\"0.005\"/>") == 4
+    table = yaml.safe_load(dict(good.files)["quad.yaml"])
+    # The file writes 2-3 decimals of mass and 6 of each moment: tolerances are half a
+    # unit of the last written digit.
+    assert table["mass"] == pytest.approx(mass, abs=0.005)
+    for key, (i, j) in {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1)}.items():
+        assert table["inertia"][key] == pytest.approx(I[i, j], abs=5e-7), key
+    for number, (x, y, spin) in enumerate(rotors):
+        entry = table["rotor_configuration"][str(number)]
+        assert f'<origin xyz="{x:g} {y:g} {rotor_z_m:g}"/>' in good.model
+        assert entry["angle"] == pytest.approx(math.atan2(y, x), abs=5e-7)
+        assert entry["arm_length"] == pytest.approx(math.hypot(x, y), abs=5e-7)
+        assert entry["direction"] == (1.0 if spin == "ccw" else -1.0)
+
+
+def test_the_good_px4_thrust_axes_are_the_tilted_rotors():
+    """C427's good airframe gives PX4 each tilted rotor's axis: derived here as the SDF
+    pose's rotation (extrinsic roll, pitch, yaw: R = Rz Ry Rx) applied to the rotor's z axis,
+    turned into FRD (x, -y, -z), against the airframe's CA_ROTORi_AX/AY/AZ lines."""
+    import numpy as np
+
+    def rot_x(a):
+        return np.array([[1, 0, 0], [0, np.cos(a), -np.sin(a)], [0, np.sin(a), np.cos(a)]])
+
+    def rot_z(a):
+        return np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
+
+    good = EXAMPLES["C427"][1]
+    airframe = {name: float(value) for name, value in re.findall(
+        r"param set-default (CA_ROTOR\d_A[XYZ]) (\S+)", dict(good.files)["4001_gz_x500"])}
+    for i, (x, y) in enumerate(((0.174, -0.174), (-0.174, 0.174), (0.174, 0.174),
+                                (-0.174, -0.174))):
+        roll, pitch, yaw = (float(v) for v in re.search(
+            rf"<pose>{x:g} {y:g} 0.06 (\S+) (\S+) (\S+)</pose>", good.model).groups())
+        assert pitch == 0.0      # exact: the pose writes "0"
+        flu = rot_z(yaw) @ rot_x(roll) @ np.array([0.0, 0.0, 1.0])
+        frd = (flu[0], -flu[1], -flu[2])
+        # Written with 4 decimals: half a unit of the last one.
+        for axis, value in zip("XYZ", frd):
+            assert airframe[f"CA_ROTOR{i}_A{axis}"] == pytest.approx(value, abs=5e-5)
+        assert np.degrees(np.arccos(-frd[2])) == pytest.approx(11.46, abs=0.01)  # > C427's 10°

@@ -989,11 +989,11 @@ EXAMPLES: dict[str, tuple["str | Case", "str | Case"]] = {
     "C439": (_gz_px4(_x500(topic="gazebo/command/motor_speed")), _gz_px4()),
     # PX4's gz airframe (SIM_GZ_EN 1) on a Gazebo Classic (RotorS) model; the good one is
     # the Classic airframe for it (PWM_MAIN_FUNC outputs).
-    "C435": (Case(_quad(), (("4001_gz_x500", _px4_airframe(_GZ_AIRFRAME_HEADER,
-                                                            _GZ_PARAMS)),),
+    "C435": (Case(_quad_extra(_mavlink_channels()),
+                  (("4001_gz_x500", _px4_airframe(_GZ_AIRFRAME_HEADER, _GZ_PARAMS)),),
                   ("--airframe", "4001_gz_x500"), name="quad.urdf"), _classic_px4()),
     # PX4's iris channel values (input_scaling 1000, zero_position_armed 100) on 838 rad/s
-    # motors: up to 1100 rad/s, the top 24 % does nothing (and C422: the hover moves to 0.492).
+    # motors: up to 1100 rad/s, the top 26 % does nothing (and C422: the hover moves to 0.492).
     "C436": (_classic_px4(scaling="1000"), _classic_px4()),
     # input_scaling 600: PX4's full output is 700 rad/s, (700/838)² = 70 % of the thrust.
     "C437": (_classic_px4(scaling="600"), _classic_px4()),
@@ -1024,8 +1024,9 @@ EXAMPLE_CODES = frozenset(EXAMPLES)
 
 # code -> why no standalone example can show the rule (docs/rules.md says so on its page).
 NO_EXAMPLE: dict[str, str] = {
-    "C421": "every PX4 airframe whose MPC_THR_HOVER is within 0.15 of the throttle the model "
-            "needs gets this line, and one further off gets C422 instead, so no model and "
-            "airframe are without both: C422's good example shows it (MPC_THR_HOVER 0.73 "
-            "beside the 0.729 the x500 needs), C422's bad one is the only way not to get it",
+    "C421": "Every PX4 airframe whose MPC_THR_HOVER is within 0.15 of the throttle the model "
+            "needs gets this line, and one further off gets C422 instead: no model and "
+            "airframe get neither, so there is no good example to show. C422's good example "
+            "gives this line (MPC_THR_HOVER 0.73 beside the 0.729 the x500 needs), C422's "
+            "bad one is the only way not to get it.",
 }

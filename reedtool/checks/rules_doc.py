@@ -74,8 +74,8 @@ def _missing_examples(rules) -> list[str]:
     notes = []
     without = [r.code for r in rules if r.code in NO_EXAMPLE]
     if without:
-        notes.append(f"No standalone example can show {', '.join(without)}: their pages say "
-                     "why.")
+        notes.append(f"No standalone example can show {', '.join(without)}: "
+                     + ("its page says why." if len(without) == 1 else "their pages say why."))
     missing = [r.code for r in rules if r.code not in EXAMPLE_CODES and r.code not in NO_EXAMPLE]
     if missing:
         notes.append(f"The rules {', '.join(missing)} have no examples yet.")
