@@ -203,7 +203,7 @@ def test_the_good_vehicle_yaml_is_the_quads_by_hand():
         d = p - com
         I = I + I_rotor + rotor_kg * (d @ d * np.eye(3) - np.outer(d, d))
     good = EXAMPLES["C401"][1]
-    assert "<mass value=\"1.2\"/>" in good.model and good.model.count("<mass value=\"0.005\"/>") == 4
+    assert '<mass value="1.2"/>' in good.model and good.model.count('<mass value="0.005"/>') == 4
     table = yaml.safe_load(dict(good.files)["quad.yaml"])
     # The file writes 2-3 decimals of mass and 6 of each moment: tolerances are half a
     # unit of the last written digit.

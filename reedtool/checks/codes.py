@@ -488,7 +488,8 @@ def _ca_rotors(arm_m: str, km: str) -> dict[str, str]:
 # momentConstant, ESC output k driving motor k-1 from 150 to 1000 rad/s (the maxRotVelocity).
 _GZ_AIRFRAME_HEADER = ("#!/bin/sh\n#\n# @name x500 (Gazebo Sim)\n#\n"
                        ". ${R}etc/init.d/rc.mc_defaults\n\n"
-                       "PX4_SIMULATOR=${PX4_SIMULATOR:=gz}\nPX4_SIM_MODEL=${PX4_SIM_MODEL:=x500}\n\n")
+                       "PX4_SIMULATOR=${PX4_SIMULATOR:=gz}\n"
+                       "PX4_SIM_MODEL=${PX4_SIM_MODEL:=x500}\n\n")
 _GZ_PARAMS = {"SIM_GZ_EN": "1", **_ca_rotors("0.174", "0.016"),
               **{f"SIM_GZ_EC_FUNC{k}": str(100 + k) for k in range(1, 5)},
               **{f"SIM_GZ_EC_MIN{k}": "150" for k in range(1, 5)},
