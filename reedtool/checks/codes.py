@@ -509,7 +509,7 @@ def _gz_px4(model: str = "", **change: str | None) -> Case:
 # for motor i: 100 + 738 u, up to the motors' 838 rad/s.
 def _mavlink_channels(scaling: str = "738", armed: str = "100") -> str:
     channels = "".join(
-        f'<channel name="rotor{i}"><input_index>{i}</input_index><input_offset>0'
+        f'<channel name="rotor{i + 1}"><input_index>{i}</input_index><input_offset>0'
         f'</input_offset><input_scaling>{scaling}</input_scaling><zero_position_disarmed>0'
         f'</zero_position_disarmed><zero_position_armed>{armed}</zero_position_armed>'
         '<joint_control_type>velocity</joint_control_type></channel>\n' for i in range(4))
