@@ -22,7 +22,7 @@ def _md(text: str) -> str:
 
 
 def render() -> str:
-    from reedtool.checks.codes import EXAMPLE_CODES, RETIRED
+    from reedtool.checks.codes import RETIRED
     from reedtool.checks.registry import FAMILIES, POLICY_CLAUSES, all_rules
 
     rules = all_rules()
@@ -47,9 +47,11 @@ def render() -> str:
           POLICY_CLAUSES.items()],
         "",
         "Each rule's page has the same sections: summary, severity and clause, stack and "
-        "lifecycle (from the code table, `reedtool/checks/codes.py`), what it checks, and for "
-        f"the rules {', '.join(sorted(EXAMPLE_CODES))} a bad and a good model, each checked by "
-        "the test suite (the bad one gives the code, the good one does not).",
+        "lifecycle (from the code table, `reedtool/checks/codes.py`), what it checks, and a "
+        "bad and a good example, each checked by the test suite (the bad one gives the code, "
+        "the good one does not). An example that needs more than the model file shows the "
+        "`reedtool validate` command line and every file beside the model."
+        + "".join(f" {note}" for note in _missing_examples(rules)),
         "",
         "| Code | Name | Severity | Clause | Stack | Summary |",
         "| --- | --- | --- | --- | --- | --- |",
@@ -66,11 +68,25 @@ def render() -> str:
     return "\n".join(out) + "\n"
 
 
+def _missing_examples(rules) -> list[str]:
+    from reedtool.checks.codes import EXAMPLE_CODES, NO_EXAMPLE
+
+    notes = []
+    without = [r.code for r in rules if r.code in NO_EXAMPLE]
+    if without:
+        notes.append(f"No standalone example can show {', '.join(without)}: "
+                     + ("its page says why." if len(without) == 1 else "their pages say why."))
+    missing = [r.code for r in rules if r.code not in EXAMPLE_CODES and r.code not in NO_EXAMPLE]
+    if missing:
+        notes.append(f"The rules {', '.join(missing)} have no examples yet.")
+    return notes
+
+
 def _rule_section(r, clause_wording: str) -> list[str]:
     """One rule's page, in fixed sections: summary, severity and clause, stack and
     lifecycle, what it checks (its docstring), and a bad and a good example where the code
     table has them (EXAMPLE_CODES)."""
-    from reedtool.checks.codes import EXAMPLES, example_format
+    from reedtool.checks.codes import EXAMPLES, NO_EXAMPLE, as_case
 
     out = ["", f"### {r.code} {r.slug}", "",
            f"**Summary.** {_md(r.summary)}", "",
@@ -80,11 +96,41 @@ def _rule_section(r, clause_wording: str) -> list[str]:
            "**What it checks.**", "", _md(r.explanation)]
     if r.code in EXAMPLES:
         bad, good = EXAMPLES[r.code]
-        label = {"urdf": "URDF", "sdf": "SDF"}
-        out += ["", f"**Bad** ({label[example_format(bad)]}, gives {r.code}):", "", "```xml",
-                bad.rstrip("\n"), "```", "",
-                f"**Good** ({label[example_format(good)]}, no {r.code}):", "", "```xml",
-                good.rstrip("\n"), "```"]
+        out += _example("Bad", f"gives {r.code}", bad)
+        out += _example("Good", f"no {r.code}", good, shown=as_case(bad))
+    elif r.code in NO_EXAMPLE:
+        out += ["", f"**No example.** {_md(NO_EXAMPLE[r.code])}"]
+    return out
+
+
+# Code-block language of a file beside the model, by its suffix (else plain text).
+_LANGUAGE = {".urdf": "xml", ".sdf": "xml", ".xacro": "xml", ".xml": "xml", ".yaml": "yaml",
+             ".yml": "yaml", ".parm": "text", ".params": "text", ".stl": "text", ".obj": "text"}
+
+
+def _example(title: str, says: str, example, shown=None) -> list[str]:
+    """One example: a model alone in a code block; a Case with its command line, then the
+    model and every file beside it in a code block each, where a file the bad example
+    (`shown`) already showed with the same text is named, not repeated."""
+    from reedtool.checks.codes import Case, as_case, example_format
+
+    case = as_case(example)
+    label = {"urdf": "URDF", "sdf": "SDF"}[example_format(case.model)]
+    files = ((case.model_name, case.model),) + case.files
+    if not isinstance(example, Case):
+        return ["", f"**{title}** ({label}, {says}):", "", "```xml", case.model.rstrip("\n"),
+                "```"]
+    out = ["", f"**{title}** ({label}, {says}): `{case.command}`"]
+    before = dict(((shown.model_name, shown.model),) + shown.files) if shown else {}
+    same = [name for name, text in files if before.get(name) == text]
+    for name, text in files:
+        if name in same:
+            continue
+        suffix = name[name.rfind("."):].lower() if "." in name.rsplit("/", 1)[-1] else ""
+        out += ["", f"`{name}`:", "", f"```{_LANGUAGE.get(suffix, 'sh')}", text.rstrip("\n"),
+                "```"]
+    if same:
+        out += ["", ", ".join(f"`{name}`" for name in same) + " as in the bad example."]
     return out
 
 
