@@ -24,11 +24,16 @@ use it, not at collection.
 from __future__ import annotations
 
 import logging
+import os
 from pathlib import Path
 
 from lxml import etree
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
+
+# Staged copies carry the process id: pytest-xdist workers loading the same fixture at once
+# must never write, read or delete each other's copy.
+_STAGED = f".drake-{os.getpid()}-"
 
 # Drake-side refusals of files libsdformat itself accepts, each with why it is Drake's.
 # Drake runs libsdformat with its warnings and unrecognized-element policies set to
@@ -113,12 +118,12 @@ def _include_target(text: str, package_map) -> tuple[str, Path] | None:
 
 
 def _includes_as_files(path: Path | None, package_map, text: str | None = None,
-                       staged: list | None = None) -> str:
+                       staged: list | None = None, pointed: list | None = None) -> str:
     """The file's text (or `text`) with each `<include>` of a model folder pointed at its
     SDF file. An included file that includes folders itself is staged beside itself
-    (`.drake-model.sdf`, listed in `staged` for the caller to remove) with its own
-    includes pointed so. Text strict XML cannot read (TinyXML2 takes `--` in a comment)
-    is handed to Drake as it is."""
+    (`.drake-PID-model.sdf`, listed in `staged` for the caller to remove) with its own
+    includes pointed so; each `<uri>` pointed is listed in `pointed`. Text strict XML cannot
+    read (TinyXML2 takes `--` in a comment) is handed to Drake as it is."""
     raw = path.read_bytes() if text is None else text.encode()
     try:
         tree = etree.ElementTree(etree.fromstring(raw))
@@ -135,11 +140,13 @@ def _includes_as_files(path: Path | None, package_map, text: str | None = None,
         inner = folder / model_file
         inner_text = _includes_as_files(inner, package_map, staged=staged)
         if staged is not None and inner_text != inner.read_text():
-            copy = inner.with_name(f".drake-{inner.name}")
+            copy = inner.with_name(f"{_STAGED}{inner.name}")
             copy.write_text(inner_text)
             staged.append(copy)
             model_file = copy.name
         uri.text = f"{prefix}/{model_file}"
+        if pointed is not None:
+            pointed.append(uri.text)
     return etree.tostring(tree, encoding="unicode")
 
 
@@ -148,15 +155,18 @@ def _load(path: Path | str, model_dirs) -> tuple[str | None, MultibodyPlant]:
     parser, plant = _parser(model_dirs)
     staged: list[Path] = []
     try:
-        text = _includes_as_files(path, parser.package_map(), staged=staged)
-        # Written beside the original, so relative mesh URIs resolve as they would there.
-        staged.append(path.with_name(f".drake-{path.name}"))
-        staged[-1].write_text(text)
-        parser.AddModels(str(staged[-1]))
+        pointed: list[str] = []
+        text = _includes_as_files(path, parser.package_map(), staged=staged, pointed=pointed)
+        if pointed:
+            # Written beside the original, so relative mesh URIs resolve as they would there.
+            staged.append(path.with_name(f"{_STAGED}{path.name}"))
+            staged[-1].write_text(text)
+        # No include pointed elsewhere: Drake reads the file itself, nothing is written.
+        parser.AddModels(str(staged[-1] if pointed else path))
     except Exception as exc:  # noqa: BLE001 - pydrake raises RuntimeError for every refusal
         message = str(exc)
         for copy in staged:
-            message = message.replace(str(copy), str(copy.with_name(copy.name[7:])))
+            message = message.replace(str(copy), str(copy.with_name(copy.name[len(_STAGED):])))
         return message, plant
     finally:
         for copy in staged:

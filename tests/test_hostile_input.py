@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import errno
 import hashlib
-import math
 import os
 import stat
 import struct
@@ -28,6 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import pytest
+from rotors_builder import multirotor_urdf
 
 from reedtool.cli import main
 
@@ -69,27 +69,11 @@ def sparse_stl(path: Path, facets: int, header_count: int | None = None) -> None
 
 def many_rotor_urdf(n: int) -> str:
     """n RotorS rotors on a circle, alternating directions (a generated-wrongly model)."""
-    parts = [('<?xml version="1.0"?>\n<robot name="many">\n  <link name="base_link">\n'
-              '    <inertial><mass value="1.5"/><inertia ixx="0.03" ixy="0" ixz="0" iyy="0.03" '
-              'iyz="0" izz="0.06"/></inertial>\n  </link>\n')]
-    for i in range(n):
-        a = 2 * math.pi * (i + 0.5) / n
-        parts.append(
-            f'  <joint name="rotor_{i}_joint" type="continuous"><parent link="base_link"/>'
-            f'<child link="rotor_{i}"/><origin xyz="{0.3 * math.cos(a):.6f} '
-            f'{0.3 * math.sin(a):.6f} 0.03"/><axis xyz="0 0 1"/></joint>\n'
-            f'  <link name="rotor_{i}"><inertial><mass value="0.001"/><inertia ixx="1e-7" '
-            'ixy="0" ixz="0" iyy="1e-7" iyz="0" izz="1e-7"/></inertial></link>\n'
-            f'  <gazebo><plugin name="m{i}" filename="librotors_gazebo_motor_model.so">'
-            f'<jointName>rotor_{i}_joint</jointName><linkName>rotor_{i}</linkName>'
-            f'<turningDirection>{"ccw" if i % 2 else "cw"}</turningDirection>'
-            '<timeConstantUp>0.0125</timeConstantUp><timeConstantDown>0.025</timeConstantDown>'
-            '<maxRotVelocity>838</maxRotVelocity><motorConstant>8.54858e-06</motorConstant>'
-            f'<momentConstant>0.016</momentConstant><motorNumber>{i}</motorNumber>'
-            '<rotorDragCoefficient>8.06428e-05</rotorDragCoefficient>'
-            '<rollingMomentCoefficient>1e-06</rollingMomentCoefficient></plugin></gazebo>\n')
-    parts.append("</robot>\n")
-    return "".join(parts)
+    return multirotor_urdf(n, name="many", arm_m=0.3, height_m=0.03, digits=6,
+                           body_inertia=(0.03, 0.03, 0.06), rotor_kg=0.001,
+                           rotor_inertia=(1e-7,) * 3, plugin_name="m{i}",
+                           spins=[("cw", "ccw")[i % 2] for i in range(n)],
+                           motor={"rotorVelocitySlowdownSim": None})
 
 
 # ------------------------------------------------------------------ the scratch tree

@@ -9,7 +9,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 from lxml import etree
-from test_hover_test_cli import multirotor_urdf, run_cli
+from test_hover_test_cli import frame_urdf, run_cli
 
 from reedtool.sim import HoverConfig
 from reedtool.sim.batch import Spreads, robustness_batch
@@ -65,7 +65,7 @@ def test_failure_marks_read_every_shape(shape, expected):
 
 def test_plot_format_follows_the_extension(tmp_path, capsys):
     path = tmp_path / "quad.urdf"
-    path.write_text(multirotor_urdf(4))
+    path.write_text(frame_urdf(4))
     svg = tmp_path / "run.svg"
     assert run_cli("hover-test", str(path), "--duration", "2", "--samples", "3",
                    "--plot", str(svg)) in (0, 1)

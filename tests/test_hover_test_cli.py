@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from lxml import etree
+from rotors_builder import multirotor_urdf
 
 from reedtool.io.loader import load_robot
 
@@ -136,46 +137,19 @@ def test_seed_with_com_outside_the_rotor_square_fails(capsys, tmp_path):
 
 # ------------------------------------------------------------------ generated frames
 
-def multirotor_urdf(n: int, *, arm_m: float = 0.25, body_kg: float = 1.2,
-                    rotor_kg: float = 0.02, imu_kg: float = 0.015,
-                    k: float = 8.54858e-06) -> str:
-    """A flat n-rotor frame with rotor links and an IMU link, RotorS motor plugins."""
-    parts = ['<robot name="frame%d">' % n,
-             '<link name="base_link"><inertial><mass value="%g"/>'
-             '<inertia ixx="0.02" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.04"/>'
-             '</inertial></link>' % body_kg,
-             '<link name="imu_link"><inertial><mass value="%g"/>'
-             '<inertia ixx="1e-5" ixy="0" ixz="0" iyy="1e-5" iyz="0" izz="1e-5"/></inertial></link>'
-             % imu_kg,
-             '<joint name="imu_joint" type="fixed"><origin xyz="0 0 -0.02"/>'
-             '<parent link="base_link"/><child link="imu_link"/></joint>']
-    for i in range(n):
-        angle = 2 * math.pi * (i + 0.5) / n
-        x, y = arm_m * math.cos(angle), arm_m * math.sin(angle)
-        direction = "ccw" if i % 2 == 0 else "cw"
-        parts.append(
-            f'<link name="rotor_{i}"><inertial><mass value="{rotor_kg}"/>'
-            '<inertia ixx="1e-5" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial>'
-            f'</link><joint name="rotor_{i}_joint" type="continuous">'
-            f'<origin xyz="{x} {y} 0.03"/><axis xyz="0 0 1"/>'
-            f'<parent link="base_link"/><child link="rotor_{i}"/></joint>'
-            f'<gazebo><plugin name="motor_{i}" filename="librotors_gazebo_motor_model.so">'
-            f'<jointName>rotor_{i}_joint</jointName><linkName>rotor_{i}</linkName>'
-            f'<turningDirection>{direction}</turningDirection>'
-            '<timeConstantUp>0.0125</timeConstantUp><timeConstantDown>0.025</timeConstantDown>'
-            f'<maxRotVelocity>838</maxRotVelocity><motorConstant>{k}</motorConstant>'
-            '<momentConstant>0.016</momentConstant>'
-            f'<motorNumber>{i}</motorNumber>'
-            '<rotorDragCoefficient>8.06428e-05</rotorDragCoefficient>'
-            '<rollingMomentCoefficient>1e-06</rollingMomentCoefficient>'
-            '</plugin></gazebo>')
-    parts.append("</robot>")
-    return "\n".join(parts)
+def frame_urdf(n: int, **changes) -> str:
+    """A flat n-rotor frame (0.25 m arms, 0.03 m up) with an IMU link: a 1.2 kg body, 20 g
+    rotors, RotorS motor plugins without the slowdown; changes go to the builder."""
+    motor = {"rotorVelocitySlowdownSim": None, **changes.pop("motor", {})}
+    return multirotor_urdf(n, name=f"frame{n}", arm_m=0.25, height_m=0.03, body_kg=1.2,
+                           body_inertia=(0.02, 0.02, 0.04), rotor_kg=0.02,
+                           rotor_inertia=(1e-5, 1e-4, 1e-4), imu_kg=0.015,
+                           imu_origin='xyz="0 0 -0.02"', motor=motor, **changes)
 
 
 @pytest.mark.parametrize("n", [4, 6, 8])
 def test_symmetric_frames_trim_and_hover_at_the_formula_speed(capsys, tmp_path, n):
-    xml = multirotor_urdf(n)
+    xml = frame_urdf(n)
     path = tmp_path / f"frame{n}.urdf"
     path.write_text(xml)
     code, report = run_json(capsys, str(path))
@@ -205,7 +179,7 @@ def test_model_without_rotors_fails_with_its_cause(capsys, tmp_path):
 
 def test_csv_and_plot_are_written_and_never_clobbered(capsys, tmp_path):
     path = tmp_path / "quad.urdf"
-    path.write_text(multirotor_urdf(4))
+    path.write_text(frame_urdf(4))
     csv_path, png_path = tmp_path / "run.csv", tmp_path / "run.png"
     args = [str(path), "--duration", "2", "--csv", str(csv_path), "--plot", str(png_path)]
     assert run_cli("hover-test", *args) in (0, 1)
@@ -229,7 +203,7 @@ def test_csv_and_plot_are_written_and_never_clobbered(capsys, tmp_path):
 
 def test_batch_reports_pass_rate_reproducibly(capsys, tmp_path):
     path = tmp_path / "quad.urdf"
-    path.write_text(multirotor_urdf(4))
+    path.write_text(frame_urdf(4))
     args = [str(path), "--duration", "4", "--samples", "6", "--seed", "5"]
     code, first = run_json(capsys, *args)
     _, again = run_json(capsys, *args)
@@ -247,7 +221,7 @@ def test_batch_reports_pass_rate_reproducibly(capsys, tmp_path):
 ])
 def test_bad_input_is_one_line_and_exit_2(capsys, tmp_path, args, needle):
     path = tmp_path / "quad.urdf"
-    path.write_text(multirotor_urdf(4))
+    path.write_text(frame_urdf(4))
     argv = [a.replace("{model}", str(path)) if "{model}" in a else
             str(tmp_path / a) if a.endswith(".urdf") else a for a in args]
     assert run_cli("hover-test", *argv) == 2
@@ -299,8 +273,7 @@ def test_absent_time_constants_take_the_motor_plugins_defaults(capsys, tmp_path)
     being refused as bad input. Written but unreadable stays an error (control)."""
     from reedtool.physics.rotors import discover_rotors
 
-    xml = multirotor_urdf(4).replace(
-        '<timeConstantUp>0.0125</timeConstantUp><timeConstantDown>0.025</timeConstantDown>', "")
+    xml = frame_urdf(4, motor={"timeConstantUp": None, "timeConstantDown": None})
     path = tmp_path / "no_tau.urdf"
     path.write_text(xml)
     rotors = discover_rotors(load_robot(path))
@@ -309,5 +282,5 @@ def test_absent_time_constants_take_the_motor_plugins_defaults(capsys, tmp_path)
     code, report = run_json(capsys, str(path))
     assert code == 0 and report["status"] == "flies"
     bad = tmp_path / "bad_tau.urdf"
-    bad.write_text(multirotor_urdf(4).replace("<timeConstantUp>0.0125<", "<timeConstantUp>x<"))
+    bad.write_text(frame_urdf(4, motor={"timeConstantUp": "x"}))
     assert run_cli("hover-test", str(bad)) == 2

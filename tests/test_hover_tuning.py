@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from cli_helpers import run_cli
-from test_hover_test_cli import multirotor_urdf
+from test_hover_test_cli import frame_urdf
 
 from reedtool.sim import ExitStatus, HoverConfig
 from reedtool.sim.controller import ControllerDesign, ControllerGains
@@ -331,21 +331,16 @@ def _variant(tmp_path: Path, xml: str) -> tuple[int, dict]:
 
 @pytest.mark.parametrize("change,cause", [
     # one rotor's spin flipped: yaw cannot cancel
-    (lambda xml: xml.replace("<turningDirection>cw</turningDirection>",
-                             "<turningDirection>ccw</turningDirection>", 1), "yaw-unbalanced"),
+    ({"per_rotor": {1: {"spin": "ccw"}}}, "yaw-unbalanced"),
     # all rotors one way
-    (lambda xml: xml.replace("<turningDirection>cw</turningDirection>",
-                             "<turningDirection>ccw</turningDirection>"), "yaw-unbalanced"),
+    ({"spins": ["ccw"] * 4}, "yaw-unbalanced"),
     # weak motors: a tenth of the motor constant, thrust-to-weight 0.17
-    (lambda xml: xml.replace("<motorConstant>8.54858e-06</motorConstant>",
-                             "<motorConstant>8.54858e-07</motorConstant>"),
-     "insufficient-thrust"),
+    ({"motor": {"motorConstant": 8.54858e-07}}, "insufficient-thrust"),
     # thrust-to-weight below 1: maximum speed 500 rad/s, 1.89 (500 / 838)^2 = 0.67
-    (lambda xml: xml.replace("<maxRotVelocity>838</maxRotVelocity>",
-                             "<maxRotVelocity>500</maxRotVelocity>"), "insufficient-thrust"),
+    ({"motor": {"maxRotVelocity": 500}}, "insufficient-thrust"),
 ])
 def test_every_defect_caught_before_still_fails(tmp_path, change, cause):
-    code, report = _variant(tmp_path, change(multirotor_urdf(4)))
+    code, report = _variant(tmp_path, frame_urdf(4, **change))
     assert (code, report["status"], report["trim"]["cause"]) == (1, "cannot-hover", cause)
     assert report["passed"] is False
     code, report = hover_json(tmp_path / "variant.urdf", "--ignore-validation",

@@ -8,6 +8,7 @@ import json
 import numpy as np
 import pytest
 from cli_helpers import run_cli
+from rotors_builder import multirotor_urdf
 
 from reedtool.checks.runner import Selection, run_checks
 from reedtool.io.loader import load_robot
@@ -17,26 +18,18 @@ from reedtool.generate.airframes import MULTIROTOR_FRAMES
 
 def rotor_model(rotor_inertia_diag, slowdown: str | None = "10", rotor_mass=0.005) -> str:
     """A body box and one RotorS-style rotor (0.1 m radius, 5 mm disc) with its motor plugin."""
-    ixx, iyy, izz = np.diag(box_inertia(1.0, (0.3, 0.3, 0.1)))
-    rxx, ryy, rzz = rotor_inertia_diag
-    slow = f"<rotorVelocitySlowdownSim>{slowdown}</rotorVelocitySlowdownSim>" if slowdown else ""
-    return f"""<?xml version="1.0"?>
-<robot name="r">
-  <link name="base_link"><inertial><mass value="1"/>
-    <inertia ixx="{ixx}" ixy="0" ixz="0" iyy="{iyy}" iyz="0" izz="{izz}"/></inertial>
-    <collision><geometry><box size="0.3 0.3 0.1"/></geometry></collision></link>
-  <joint name="rotor_0_joint" type="continuous"><parent link="base_link"/><child link="rotor_0"/>
-    <origin xyz="0.2 0 0.05"/><axis xyz="0 0 1"/></joint>
-  <link name="rotor_0"><inertial><mass value="{rotor_mass}"/>
-    <inertia ixx="{rxx}" ixy="0" ixz="0" iyy="{ryy}" iyz="0" izz="{rzz}"/></inertial>
-    <collision><geometry><cylinder length="0.005" radius="0.1"/></geometry></collision></link>
-  <gazebo><plugin name="m0" filename="librotors_gazebo_motor_model.so">
-    <jointName>rotor_0_joint</jointName><linkName>rotor_0</linkName>
-    <turningDirection>ccw</turningDirection>{slow}</plugin></gazebo>
-  <gazebo><plugin name="base" filename="librotors_gazebo_multirotor_base_plugin.so">
-    <linkName>base_link</linkName>{slow}</plugin></gazebo>
-</robot>
-"""
+    slow = {"rotorVelocitySlowdownSim": slowdown} if slowdown else {}
+    base = ''.join(f"<{k}>{v}</{k}>" for k, v in {"linkName": "base_link", **slow}.items())
+    return multirotor_urdf(
+        1, name="r", arm_m=0.2, angles_rad=[0.0], height_m=0.05, body_kg=1,
+        body_inertia=np.diag(box_inertia(1.0, (0.3, 0.3, 0.1))),
+        body_xml='<collision><geometry><box size="0.3 0.3 0.1"/></geometry></collision>',
+        rotor_kg=rotor_mass, rotor_inertia=rotor_inertia_diag,
+        rotor_xml='<collision><geometry><cylinder length="0.005" radius="0.1"/></geometry>'
+                  '</collision>',
+        plugin_name="m0", motor_defaults={}, motor=slow, numbered=False,
+        extra='<gazebo><plugin name="base" filename="librotors_gazebo_multirotor_base_plugin.so">'
+              f"{base}</plugin></gazebo>")
 
 
 # RotorS multirotor_base.xacro: box_inertia(x=radius, y=0.015, z=0.003, mass=m * slowdown).

@@ -7,6 +7,7 @@ stages of the same rank (checks and sim) are siblings and may not import each ot
 from __future__ import annotations
 
 import ast
+import functools
 from pathlib import Path
 
 import reedtool
@@ -70,6 +71,7 @@ def _imports(path: Path, module: str) -> set[str]:
 DATA_DIRS = {"_data", "ros_packages"}   # bundled files (an installed wheel's templates), not code
 
 
+@functools.cache           # parsed once for the five tests that read it; none changes it
 def _graph() -> dict[str, set[str]]:
     return {_module_name(p): _imports(p, _module_name(p)) for p in PACKAGE.rglob("*.py")
             if not DATA_DIRS & set(p.relative_to(PACKAGE).parts)}

@@ -7,38 +7,28 @@ intersect, and every distinct arm length is still written somewhere.
 
 from __future__ import annotations
 
-import math
 import re
 
 import numpy as np
 from cli_helpers import run_cli
 from lxml import etree
+from rotors_builder import multirotor_urdf
 
 SVG = "{http://www.w3.org/2000/svg}"
 
 
 def ring_urdf(n: int, arm_m: float, prop_radius_m: float, stretch: float = 1.0) -> str:
-    parts = ['<link name="base_link"><inertial><mass value="1.5"/><inertia ixx="0.03" ixy="0" '
-             'ixz="0" iyy="0.03" iyz="0" izz="0.05"/></inertial><collision><geometry>'
-             '<cylinder radius="0.08" length="0.05"/></geometry></collision></link>']
-    for i in range(n):
-        angle = 2 * math.pi * (i + 0.5) / n
-        r = arm_m * (stretch if i % 2 else 1.0)
-        parts.append(
-            f'<joint name="rotor_{i}_joint" type="continuous"><parent link="base_link"/>'
-            f'<child link="rotor_{i}"/><origin xyz="{r * math.cos(angle):.5f} '
-            f'{r * math.sin(angle):.5f} 0.03"/><axis xyz="0 0 1"/></joint>'
-            f'<link name="rotor_{i}"><inertial><mass value="0.005"/><inertia ixx="1e-6" ixy="0" '
-            f'ixz="0" iyy="1e-6" iyz="0" izz="2e-6"/></inertial><visual><geometry><cylinder '
-            f'radius="{prop_radius_m}" length="0.005"/></geometry></visual></link>'
-            f'<gazebo><plugin name="m{i}" filename="librotors_gazebo_motor_model.so">'
-            f"<jointName>rotor_{i}_joint</jointName><linkName>rotor_{i}</linkName>"
-            f"<turningDirection>{'ccw' if i % 2 == 0 else 'cw'}</turningDirection>"
-            "<timeConstantUp>0.0125</timeConstantUp><timeConstantDown>0.025</timeConstantDown>"
-            "<maxRotVelocity>838</maxRotVelocity><motorConstant>8.54858e-06</motorConstant>"
-            f"<momentConstant>0.016</momentConstant><motorNumber>{i}</motorNumber></plugin>"
-            "</gazebo>")
-    return f'<?xml version="1.0"?>\n<robot name="ring">{"".join(parts)}</robot>\n'
+    """n rotors of prop_radius_m on a ring, every odd arm stretch times as long."""
+    return multirotor_urdf(
+        n, name="ring", arm_m=arm_m, height_m=0.03, digits=5, body_inertia=(0.03, 0.03, 0.05),
+        body_xml='<collision><geometry><cylinder radius="0.08" length="0.05"/></geometry>'
+                 '</collision>',
+        rotor_inertia=(1e-6, 1e-6, 2e-6), plugin_name="m{i}",
+        rotor_xml=f'<visual><geometry><cylinder radius="{prop_radius_m}" length="0.005"/>'
+                  '</geometry></visual>',
+        per_rotor={i: {"arm_m": arm_m * stretch} for i in range(1, n, 2)},
+        motor={"rotorDragCoefficient": None, "rollingMomentCoefficient": None,
+               "rotorVelocitySlowdownSim": None})
 
 
 def label_boxes(svg_path) -> list[tuple[str, np.ndarray, np.ndarray]]:

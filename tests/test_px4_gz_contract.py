@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 from cli_helpers import run_cli
 from lxml import etree
+from rotors_builder import multirotor_urdf
 
 from reedtool.io.fileio import reset_inputs
 
@@ -332,38 +333,21 @@ def test_tilted_rotors_get_their_thrust_axes(tmp_path):
 
 def _quad_urdf(imu_xyz: str, imu_rpy: str, sensor_pose: str) -> str:
     """A small URDF quad (gz motor systems) with an IMU sensor on its own link."""
-    rotors, motors = [], []
-    for i, (x, y, spin) in enumerate([(0.2, -0.2, "ccw"), (-0.2, 0.2, "ccw"),
-                                      (0.2, 0.2, "cw"), (-0.2, -0.2, "cw")]):
-        rotors.append(f"""
-  <link name="rotor_{i}"><inertial><mass value="0.01"/>
-    <inertia ixx="1e-5" ixy="0" ixz="0" iyy="1e-5" iyz="0" izz="2e-5"/></inertial>
-    <collision><geometry><cylinder radius="0.1" length="0.005"/></geometry></collision></link>
-  <joint name="rotor_{i}_joint" type="continuous"><parent link="base_link"/>
-    <child link="rotor_{i}"/><origin xyz="{x} {y} 0.05"/><axis xyz="0 0 1"/></joint>""")
-        motors.append(f"""
-  <gazebo><plugin filename="gz-sim-multicopter-motor-model-system"
-      name="gz::sim::systems::MulticopterMotorModel">
-    <jointName>rotor_{i}_joint</jointName><linkName>rotor_{i}</linkName>
-    <turningDirection>{spin}</turningDirection><timeConstantUp>0.0125</timeConstantUp>
-    <timeConstantDown>0.025</timeConstantDown><maxRotVelocity>1000</maxRotVelocity>
-    <motorConstant>8.54858e-06</motorConstant><momentConstant>0.016</momentConstant>
-    <commandSubTopic>command/motor_speed</commandSubTopic><actuator_number>{i}</actuator_number>
-    <motorType>velocity</motorType></plugin></gazebo>""")
-    return f"""<?xml version="1.0"?>
-<robot name="imuquad">
-  <link name="base_link"><inertial><mass value="1.5"/>
-    <inertia ixx="0.03" ixy="0" ixz="0" iyy="0.03" iyz="0" izz="0.05"/></inertial>
-    <collision><geometry><box size="0.3 0.3 0.1"/></geometry></collision></link>
-  <link name="imu_link"><inertial><mass value="0.015"/>
-    <inertia ixx="1e-5" ixy="0" ixz="0" iyy="1e-5" iyz="0" izz="1e-5"/></inertial></link>
-  <joint name="imu_joint" type="fixed"><parent link="base_link"/><child link="imu_link"/>
-    <origin xyz="{imu_xyz}" rpy="{imu_rpy}"/></joint>
-  <gazebo reference="imu_link"><sensor name="my_imu" type="imu">
+    return multirotor_urdf(
+        4, name="imuquad", positions=[(0.2, -0.2, 0.05), (-0.2, 0.2, 0.05), (0.2, 0.2, 0.05),
+                                      (-0.2, -0.2, 0.05)], spins=["ccw", "ccw", "cw", "cw"],
+        body_inertia=(0.03, 0.03, 0.05),
+        body_xml='<collision><geometry><box size="0.3 0.3 0.1"/></geometry></collision>',
+        rotor_kg=0.01, rotor_inertia=(1e-5, 1e-5, 2e-5),
+        rotor_xml='<collision><geometry><cylinder radius="0.1" length="0.005"/></geometry>'
+                  '</collision>',
+        plugin="gz", motor={"maxRotVelocity": 1000, "rotorDragCoefficient": None,
+                            "rollingMomentCoefficient": None, "rotorVelocitySlowdownSim": None,
+                            "commandSubTopic": "command/motor_speed", "motorType": "velocity"},
+        imu_kg=0.015, imu_origin=f'xyz="{imu_xyz}" rpy="{imu_rpy}"',
+        extra=f"""<gazebo reference="imu_link"><sensor name="my_imu" type="imu">
     <pose>{sensor_pose}</pose><always_on>1</always_on><update_rate>200</update_rate>
-    <topic>/imuquad/imu</topic></sensor></gazebo>{''.join(rotors)}{''.join(motors)}
-</robot>
-"""
+    <topic>/imuquad/imu</topic></sensor></gazebo>""")
 
 
 def test_an_imu_on_another_link_moves_to_base_link_where_it_was(tmp_path):
