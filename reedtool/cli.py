@@ -72,6 +72,7 @@ def main(argv: list[str] | None = None) -> None:
     from reedtool.errors import ReedtoolError, os_error, shorten
     from reedtool.io.fileio import reset_inputs
 
+    _one_blas_thread()
     reset_inputs()
     try:
         with warnings.catch_warnings():
@@ -128,6 +129,23 @@ def main(argv: list[str] | None = None) -> None:
                    "and report it)", err=True)
         sys.exit(2)
     sys.exit(exit_code if isinstance(exit_code, int) else 0)
+
+
+def _one_blas_thread() -> None:
+    """One OpenBLAS thread, unless the user chose a number.
+
+    numpy's OpenBLAS starts a pool of one thread per core when numpy is imported, and the
+    idle pool spins: about half of check_urdf's whole run in CPU time, before validate's
+    first finding (issue 29 item 7). reedtool's products are small (3x3 to 6xN) or a
+    mesh's N x 3 vertices times a 3x3 rotation, which memory bounds, not threads; the
+    parallel paths (--jobs processes, numba's threads) have workers of their own, which a
+    second pool per process would only crowd. It must be
+    set before numpy is first imported: OpenBLAS reads it once, when it loads (the first of
+    these names that is set counts).
+    """
+    chosen = ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS")
+    if "numpy" not in sys.modules and not any(name in os.environ for name in chosen):
+        os.environ["OPENBLAS_NUM_THREADS"] = "1"
 
 
 def _quiet_stdout() -> None:
