@@ -9,18 +9,34 @@ hexacopter with resolvable COLLADA meshes (benchmarks/rotors_hexa_case.py), `ree
 validate` on the xacro within 1.0x of the `xacro` + `check_urdf` pipeline on the same file
 (reedtool also reads every .dae for its extent and unit; check_urdf reads none).
 
-Issue 29 item 7 (seed validate <= 3x check_urdf), measured 2026-11-27 on the shared 2-core
-machine under heavy load, as whole processes in pairs (A B A B ..., the ratio pair by pair,
-20 pairs, medians; the seed's README command against check_urdf on the same expanded URDF):
-  before (modules only writes, baselines, templates or error hints need loaded eagerly):
-      validate / check_urdf  4.77x cpu, 4.55x wall
-  after (those imported where used; 347 -> 329 modules loaded):
-      validate / check_urdf  4.61x cpu, 3.71x wall;  after / before 0.97x cpu, 0.89x wall
-  floor: `python -c "import numpy, click, xacro, xacro.substitution_args, lxml.etree"`
-      alone is 2.30x cpu check_urdf (bare `python -c pass`: 0.32x). What is left above it
-      is reedtool's own ~65 modules (creating ~70 dataclasses is ~10% of the run), the
-      xacro expansion, and the rules: not start-up work that can be skipped, so the 3x
-      goal is still MISSED on this machine.
+Issue 29 item 7 (seed validate <= 3x check_urdf). Measured 2026-11-27 on the shared 2-core
+machine under heavy load (load average 5-6), as whole processes in pairs (A B A B ..., the
+ratio pair by pair, medians of 20-30 pairs).
+  First pass (the seed000 fixture, modules only writes, baselines, templates or error hints
+  need imported where used; 347 -> 329 modules):
+      validate / check_urdf  4.77x -> 4.61x cpu, 4.55x -> 3.71x wall
+  Second pass (the README quick start model, examples/reed_quad_x, against check_urdf on its
+  expanded URDF; reedtool's own process only):
+    - numpy's OpenBLAS no longer starts its idle thread pool (cli._one_blas_thread; the
+      pool spun ~40 ms of CPU before the first finding);
+    - the cycle collector runs every 100 000 allocations, not 700 (cli._fewer_collections;
+      ~80 collections walked the just-imported heap, ~18 ms of CPU);
+    - PX4's parameter table, RotorS' Lee model, the ACAI failure search, a mesh's topology
+      and unit detector, the xacro argument reader: imported only by a rule or model that
+      uses them (331 -> 326 modules, 72 -> 56 dataclasses).
+      validate / check_urdf  before 4.27x, 4.05x cpu (two calls of 30 pairs)
+                             after  3.86x, 3.54x cpu; 3.45x, 3.43x wall
+      after / before (30 pairs, same call)  0.85x cpu, 0.83x wall
+  The 3x goal is still MISSED on this machine: ~3.5x. What is left, in check_urdf's
+  whole-run CPU (each line a separate process, medians of 25, one BLAS thread):
+      python -c pass (with the venv's cmeel .pth)          0.30x
+      + click                                              0.74x
+      + numpy                                              1.56x
+      + lxml, xacro (+ PyYAML, which xacro imports), tomllib, ElementTree   2.03x
+      + reedtool's 60 modules (56 dataclasses, ~0.5 ms each to create)      2.76x
+      + the work: xacro expansion (~37 ms warm), URDF parse, 125 rules      3.5-3.75x
+  None of it is start-up work a finding can do without: numpy holds every pose and
+  tensor, xacro expands the model, the dataclasses are the model and the findings.
 """
 
 from __future__ import annotations
