@@ -23,10 +23,13 @@ ratio pair by pair, medians of 20-30 pairs).
       ~80 collections walked the just-imported heap, ~18 ms of CPU);
     - PX4's parameter table, RotorS' Lee model, the ACAI failure search, a mesh's topology
       and unit detector, the xacro argument reader: imported only by a rule or model that
-      uses them (331 -> 326 modules, 72 -> 56 dataclasses).
-      validate / check_urdf  before 4.27x, 4.05x cpu (two calls of 30 pairs)
-                             after  3.86x, 3.54x cpu; 3.45x, 3.43x wall
-      after / before (30 pairs, same call)  0.85x cpu, 0.83x wall
+      uses them (331 -> 326 modules, 72 -> 56 dataclasses);
+    - a named xacro file's siblings are sorted into top-level models only when two or
+      more of them include it (workflows/targets.py).
+      validate / check_urdf, medians of 30 pairs (three calls, the last with the final code):
+          before  4.27x, 4.05x, 4.17x cpu;  4.15x, 3.82x, 3.96x wall
+          after   3.86x, 3.54x, 3.48x cpu;  3.45x, 3.43x, 3.37x wall
+      after / before, A B pairs in one call: 0.79x cpu, 0.77x wall (final code)
   The 3x goal is still MISSED on this machine: ~3.5x. What is left, in check_urdf's
   whole-run CPU (each line a separate process, medians of 25, one BLAS thread):
       python -c pass (with the venv's cmeel .pth)          0.30x
@@ -37,6 +40,10 @@ ratio pair by pair, medians of 20-30 pairs).
       + the work: xacro expansion (~37 ms warm), URDF parse, 125 rules      3.5-3.75x
   None of it is start-up work a finding can do without: numpy holds every pose and
   tensor, xacro expands the model, the dataclasses are the model and the findings.
+  Measured and not taken (not start-up work): xacro lexes every attribute and text, 1 531
+  of the seed's 1 854 without a `$` (returning them as they are saves ~6 ms, 0.07x);
+  loading a named file before scanning its siblings for includers saves ~4 ms, but would
+  load every named file in the parent process, serially, under --jobs.
 """
 
 from __future__ import annotations
