@@ -17,7 +17,6 @@ from reedtool.checks.finding import Issue
 from reedtool.checks.registry import rule
 from reedtool.checks.rotor_rules import all_rotors, physics_ready
 from reedtool.physics.allocation import allocation_matrix
-from reedtool.physics.authority import full_control_after_failures_many
 from reedtool.physics.trim import STANDARD_GRAVITY_M_S2
 
 # Fewer rotors cannot survive a failure with full control whatever the spin order
@@ -29,6 +28,9 @@ MAX_ROTORS_SEARCHED = 8
 def _survivors(rotors, com_m, sign_rows, weight_N) -> list[tuple[int, float]]:
     """Per spin order (a row of signs): (number of single failures that keep full
     control, their worst ACAI)."""
+    # Only a vehicle of MIN_ROTORS or more gets here; validate of a quad does not load it.
+    from reedtool.physics.authority import full_control_after_failures_many
+
     Bs = _allocations_with_signs(rotors, com_m, np.atleast_2d(sign_rows))
     K = np.array([r.max_thrust_N for r in rotors])
     out = []

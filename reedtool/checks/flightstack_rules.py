@@ -222,13 +222,14 @@ def px4_output_mapping(ctx: CheckContext) -> Iterator[Issue]:
     Severity (error, flight-stack): PX4 commands a motor the model does not have, or
     never commands one it has.
     """
-    from reedtool.flightstack.px4 import MAX_GZ_OUTPUTS, MOTOR_FUNCTION_BASE
-
     rotors = _all_rotors(ctx)
     by_actuator = {_actuator(r): r for r in rotors if _actuator(r) is not None}
     for params in _px4(ctx):
         if not rotors or not params.uses_gz_outputs or not _gz_commands(ctx, params):
             continue
+        # Here, not at the top: without a PX4 parameter file the table is never loaded.
+        from reedtool.flightstack.px4 import MAX_GZ_OUTPUTS, MOTOR_FUNCTION_BASE
+
         ca_count = min(params.rotor_count or 0, 12)
         for i in range(ca_count):
             if not params.outputs_of(i):
@@ -785,13 +786,13 @@ def px4_gz_bridge_unreachable(ctx: CheckContext) -> Iterator[Issue]:
 
     Severity (error, flight-stack): PX4 cannot fly the model.
     """
-    from reedtool.flightstack.px4 import PX4_BRIDGE_LINK, PX4_MOTOR_TOPIC
-
     for params in _px4(ctx):
         model = _model_simulator(ctx)
         airframe = params.simulator()
         if model is None or model[0] != "gz" or airframe is None or airframe.simulator != "gz":
             continue
+        from reedtool.flightstack.px4 import PX4_BRIDGE_LINK, PX4_MOTOR_TOPIC   # a PX4 file
+
         if PX4_BRIDGE_LINK not in ctx.robot.link_map:
             yield Issue(f"{params.label} is for PX4's gz bridge ({airframe.what}), which reads "
                         f"its sensors from a link named '{PX4_BRIDGE_LINK}'; the model has none "
@@ -928,11 +929,11 @@ def px4_param_out_of_range(ctx: CheckContext) -> Iterator[Issue]:
     Severity (warning, suspicious): QGroundControl refuses the value and PX4 may clamp
     it, but the vehicle loads.
     """
-    from reedtool.flightstack.px4 import out_of_range
-
     for params in ctx.flight_params:
         if params.kind != "px4":
             continue
+        from reedtool.flightstack.px4 import out_of_range   # only with a PX4 parameter file
+
         for value, (low, high, _default, source) in out_of_range(params):
             if value.name.startswith("SIM_GZ_EC_"):
                 continue

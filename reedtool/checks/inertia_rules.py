@@ -20,7 +20,6 @@ from reedtool.physics.inertia import (
     robot_mass_problem,
     tensor_problem,
 )
-from reedtool.physics.mesh_units import UNIT_WORDS, UNITS_M
 
 # How far outside its geometry's bounding box a COM may lie, as a fraction of the box size.
 COM_MARGIN_FRACTION = 0.1
@@ -455,6 +454,8 @@ def _mesh_scale_findings(ctx: CheckContext, certain: bool) -> Iterator[Issue]:
                 continue
             if _unit_certainly_wrong(ctx, extent) != certain:
                 continue
+            from reedtool.physics.mesh_units import UNIT_WORDS, UNITS_M
+
             scale = np.asarray(mesh.scale, dtype=float)
             read = ctx.mesh_file(mesh)
             units = ["mm"]

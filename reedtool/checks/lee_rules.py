@@ -112,18 +112,19 @@ def lee_loop_unstable(ctx: CheckContext) -> Iterator[Issue]:
 
     Severity (error, cannot-fly): the controller oscillates with growing amplitude.
     """
-    from reedtool.flightstack.rotors_lee import (
-        firefly_scaled,
-        largest_stable_scale,
-        loop_spectral_radius,
-    )
-
     whole = ctx.whole_robot
     J = _flyable_inertia(ctx)
     if J is None:
         return
     lag_s = _motor_lag_s(ctx)
     for table in _lee_tables(ctx):
+        # Here, not at the top: a model without Lee gain files never loads the node's model.
+        from reedtool.flightstack.rotors_lee import (
+            firefly_scaled,
+            largest_stable_scale,
+            loop_spectral_radius,
+        )
+
         gains = table.lee_gains
         loops = [("attitude_gain", "angular_rate_gain", J[i, i], lag_s, i,
                   f"J{AXES[i] * 2} = {J[i, i]:.4g} kg*m^2") for i in range(3)]

@@ -16,9 +16,7 @@ from typing import Iterable, Iterator
 import numpy as np
 
 from reedtool.errors import ReedtoolError
-from reedtool.io.meshes import load_triangles
 from reedtool.model import Box, Cylinder, Link, Mesh, Robot, Sphere
-from reedtool.physics.mesh_topology import convex_hull_triangles, topology
 
 # ------------------------------------------------------------ the value object
 
@@ -203,6 +201,9 @@ def mesh_mass_properties(triangles_m: np.ndarray, density_kg_m3: float = 1.0,
     `closed` is the caller's topology verdict (watertight and consistently wound); when
     None it is computed here. Raises ReedtoolError when there is no volume to speak of.
     """
+    # Imported here: a model of primitives (validate's seed) never measures a mesh.
+    from reedtool.physics.mesh_topology import convex_hull_triangles, topology
+
     if closed is None:
         closed = topology(triangles_m).closed
     from_hull = not closed
@@ -221,6 +222,8 @@ def mesh_mass_properties(triangles_m: np.ndarray, density_kg_m3: float = 1.0,
 @lru_cache(maxsize=64)
 def _unit_density_mesh_properties(path: str, mtime_ns: int, scale: tuple[float, float, float]
                                   ) -> MassProperties:
+    from reedtool.io.meshes import load_triangles
+
     triangles = load_triangles(path) * np.asarray(scale)
     try:
         return mesh_mass_properties(triangles)

@@ -101,10 +101,10 @@ def model_mappings(model: Path, request: ModelRequest) -> dict[str, str]:
 def argument_use(model: Path, mappings, given, origins, checked, config,
                  request: ModelRequest):
     """What rule S140 needs: the arguments the model declares against those it was given."""
-    from reedtool.io.xacro_args import ArgumentUse, known_arguments
-
     if model.is_dir() or model.suffix.lower() in _NOT_XACRO or not given:
         return None
+    from reedtool.io.xacro_args import ArgumentUse, known_arguments
+
     declared, complete = known_arguments(model, mappings, request.package_paths)
     # The config's `args` apply to every model of a repository; they are checked for a
     # model that reads at least one of them (they are meant for it), so a plain xacro file

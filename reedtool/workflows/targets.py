@@ -206,9 +206,11 @@ def _includers(path: Path, include_tree: Callable[[Path], Sequence[Path]],
     siblings = [f for f in _model_files(path.parent, recursive=False,
                                         suffixes=PACKAGE_SUFFIXES)
                 if f.resolve() != key and f.stat().st_size <= SIBLING_MAX_BYTES]
-    top = set(_top_level(siblings, include_tree, include_globs))
     includers = [sibling for sibling in siblings if not is_macro_library(sibling)
                  and key in {p.resolve() for p in include_tree(sibling)[1:]}]
+    if len(includers) < 2:
+        return includers       # nothing to order: the siblings' own models are not needed
+    top = set(_top_level(siblings, include_tree, include_globs))
     return sorted(includers, key=lambda sibling: sibling not in top)
 
 
