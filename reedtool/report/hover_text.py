@@ -10,7 +10,27 @@ import math
 
 
 def render_text(report: dict) -> str:
-    model, trim, sim, batch = report["model"], report["trim"], report["sim"], report["batch"]
+    """The whole text report of a flown (or judged unflyable) vehicle."""
+    lines = _model_lines(report["model"]) + _trim_lines(report["trim"])
+    if report.get("controller") is not None:
+        from reedtool.report.lee_text import controller_lines
+
+        lines += controller_lines(report["controller"])
+    if report["sim"] is not None:
+        lines += _sim_lines(report["sim"])
+    if report["batch"] is not None:
+        lines += _batch_lines(report["batch"])
+    verdict = report.get("verdict")
+    if verdict is not None:
+        lines.append(f"verdict: {verdict['status'].upper()}: {verdict['message']}")
+    from reedtool.sim.verdict import final_line
+
+    lines.append(final_line(report.get("status", ""), report["passed"],
+                            report.get("require", "flies"), report.get("message", "")))
+    return "\n".join(lines)
+
+
+def _model_lines(model: dict) -> list[str]:
     lines = [f"hover-test {model['name']}: {model['rotors']} rotors, "
              f"mass {model['mass_kg']:.4g} kg, COM ({', '.join(f'{v:.4g}' for v in model['com_m'])}) m"]
     others = [r for r in model.get("rotor_table", ()) if r["role"] != "lift"]
@@ -28,10 +48,14 @@ def render_text(report: dict) -> str:
                           f"{axis} {a:.3g} kg*m^2" for axis, a, t in zip("xyz", added, total))
         lines.append(f"locked rigid: {lj['joint']} ({lj['type']}, no plugin drives it; "
                      f"{lj['mass_kg']:.3g} kg beyond it adds {share} about the COM)")
+    return lines
+
+
+def _trim_lines(trim: dict) -> list[str]:
     if trim["feasible"]:
-        lines.append(f"trim: {trim['message']}")
+        lines = [f"trim: {trim['message']}"]
     else:
-        lines.append(f"trim: INFEASIBLE ({trim['cause']}): {trim['message']}")
+        lines = [f"trim: INFEASIBLE ({trim['cause']}): {trim['message']}"]
     if trim["rotors"]:
         width = max(len(r["name"]) for r in trim["rotors"])
         lines.append(f"  {'rotor':<{width}}  {'thrust N':>9}  {'omega rad/s':>11}  {'throttle':>8}")
@@ -47,51 +71,46 @@ def render_text(report: dict) -> str:
                      f"; torque authority at hover: roll {a['roll']:.3g}, "
                      f"pitch {a['pitch']:.3g}, yaw {a['yaw']:.3g} N*m")
         lines.append(f"  thrust-to-weight {trim['thrust_to_weight']:.3f}{authority}")
-    if report.get("controller") is not None:
-        from reedtool.report.lee_text import controller_lines
+    return lines
 
-        lines += controller_lines(report["controller"])
-    if sim is not None:
-        from reedtool.sim.verdict import tuning_line
 
-        c = sim["config"]
-        if sim["gains"].get("controller") != "rotors-lee":
-            lines.append(f"tuning: {tuning_line(sim['gains'])}")
-        lines.append(f"sim: {sim['status'].upper()}: {sim['message']}")
-        lines.append(f"  start {c['offset_m']} m off, roll {c['roll_rad']:g} pitch "
-                     f"{c['pitch_rad']:g} yaw {c['yaw_rad']:g} rad; {c['duration_s']:g} s at "
-                     f"{c['rate_hz']:g} Hz ({c['integrator']}; engine {sim['engine']})")
-        lines.append(f"  max error {sim['max_position_error_m']:.3f} m, "
-                     f"{sim['max_attitude_error_deg']:.1f} deg; final "
-                     f"{100 * sim['final_position_error_m']:.2f} cm, "
-                     f"{sim['final_attitude_error_deg']:.2f} deg; max throttle "
-                     f"{_pct(sim['max_throttle'])}")
-        if sim["passed"]:
-            speeds = ", ".join(f"{w:.2f}" for w in sim["final_omega_rad_s"].values())
-            lines.append(f"  final rotor speeds {speeds} rad/s")
-    if batch is not None:
-        s = batch["spreads"]
-        counts = ", ".join(f"{k} {v}" for k, v in sorted(batch["counts"].items()))
-        lines.append(f"batch: {batch['passed']}/{batch['samples']} passed "
-                     f"({100 * batch['pass_rate']:.1f}%, need "
-                     f"{100 * batch['min_pass_rate']:.0f}%): {counts}")
-        lines.append(f"  spreads: mass +-{100 * s['mass_rel']:g}%, COM +-{1000 * s['com_m']:g} mm, "
-                     f"inertia +-{100 * s['inertia_rel']:g}%, motor constant "
-                     f"+-{100 * s['motor_constant_rel']:g}%; seed {batch['seed']}"
-                     + (f"; from {batch['start_scale']:.3g} of the start (the recoverable margin)"
-                        if batch.get("start_scale", 1.0) != 1.0 else ""))
-        for w in batch["worst"]:
-            lines.append(f"  #{w['index']}: {w['status']}: {w['message']} "
-                         f"(mass {w['mass_kg']:.4g} kg, COM shift "
-                         f"{', '.join(f'{1000 * v:.1f}' for v in w['com_shift_m'])} mm)")
-    verdict = report.get("verdict")
-    if verdict is not None:
-        lines.append(f"verdict: {verdict['status'].upper()}: {verdict['message']}")
-    from reedtool.sim.verdict import final_line
+def _sim_lines(sim: dict) -> list[str]:
+    from reedtool.sim.verdict import tuning_line
 
-    lines.append(final_line(report.get("status", ""), report["passed"],
-                            report.get("require", "flies"), report.get("message", "")))
-    return "\n".join(lines)
+    c, lines = sim["config"], []
+    if sim["gains"].get("controller") != "rotors-lee":
+        lines.append(f"tuning: {tuning_line(sim['gains'])}")
+    lines.append(f"sim: {sim['status'].upper()}: {sim['message']}")
+    lines.append(f"  start {c['offset_m']} m off, roll {c['roll_rad']:g} pitch "
+                 f"{c['pitch_rad']:g} yaw {c['yaw_rad']:g} rad; {c['duration_s']:g} s at "
+                 f"{c['rate_hz']:g} Hz ({c['integrator']}; engine {sim['engine']})")
+    lines.append(f"  max error {sim['max_position_error_m']:.3f} m, "
+                 f"{sim['max_attitude_error_deg']:.1f} deg; final "
+                 f"{100 * sim['final_position_error_m']:.2f} cm, "
+                 f"{sim['final_attitude_error_deg']:.2f} deg; max throttle "
+                 f"{_pct(sim['max_throttle'])}")
+    if sim["passed"]:
+        speeds = ", ".join(f"{w:.2f}" for w in sim["final_omega_rad_s"].values())
+        lines.append(f"  final rotor speeds {speeds} rad/s")
+    return lines
+
+
+def _batch_lines(batch: dict) -> list[str]:
+    s = batch["spreads"]
+    counts = ", ".join(f"{k} {v}" for k, v in sorted(batch["counts"].items()))
+    lines = [f"batch: {batch['passed']}/{batch['samples']} passed "
+             f"({100 * batch['pass_rate']:.1f}%, need "
+             f"{100 * batch['min_pass_rate']:.0f}%): {counts}"]
+    lines.append(f"  spreads: mass +-{100 * s['mass_rel']:g}%, COM +-{1000 * s['com_m']:g} mm, "
+                 f"inertia +-{100 * s['inertia_rel']:g}%, motor constant "
+                 f"+-{100 * s['motor_constant_rel']:g}%; seed {batch['seed']}"
+                 + (f"; from {batch['start_scale']:.3g} of the start (the recoverable margin)"
+                    if batch.get("start_scale", 1.0) != 1.0 else ""))
+    for w in batch["worst"]:
+        lines.append(f"  #{w['index']}: {w['status']}: {w['message']} "
+                     f"(mass {w['mass_kg']:.4g} kg, COM shift "
+                     f"{', '.join(f'{1000 * v:.1f}' for v in w['com_shift_m'])} mm)")
+    return lines
 
 
 def series_csv(series: dict) -> str:
