@@ -9,7 +9,6 @@ Exit 0 when the model meets --require, 1 when it does not, 2 on unreadable input
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import click
@@ -62,20 +61,19 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
     """
     model, request = one_model_request("authority", inputs, package_paths, model_name,
                                        launch_file, ignore)
-    from reedtool.workflows.authority import SCHEMA, AuthorityOptions, run_authority
+    from reedtool.workflows.authority import AuthorityOptions, run_authority
 
-    options = AuthorityOptions(efficiency_items, degrade, policy, fly, fail_at_s, duration_s,
-                               plot_path, force, ignore_validation)
+    options = AuthorityOptions(efficiency_items=efficiency_items, degrade=degrade,
+                               policy=policy, fly=fly, fail_at_s=fail_at_s,
+                               duration_s=duration_s, plot_path=plot_path, force=force,
+                               ignore_validation=ignore_validation)
     result = run_authority(model, request, options,
                            on_validation=_show_validation(model, fmt, ignore_validation))
+    from reedtool.report.authority_text import render_json, render_text
+
     if fmt == "json":
-        from reedtool.report.json_format import envelope
-
-        click.echo(json.dumps({**envelope(SCHEMA), **result.document}, indent=2,
-                              allow_nan=result.refused))
-    elif not result.refused:
-        from reedtool.report.authority_text import render_text
-
+        click.echo(render_json(result))
+    elif not result.refused:     # a refusal's text is validate's errors, already shown
         click.echo(render_text(result))
     return 0 if result.passed else 1
 

@@ -8,7 +8,6 @@ Exit 0 when the model hovers (and the batch meets --min-pass-rate), 1 when it do
 from __future__ import annotations
 
 import contextlib
-import json
 import sys
 from pathlib import Path
 
@@ -23,7 +22,6 @@ from reedtool.commands.params import (
     one_model_request,
     validation_options,
 )
-from reedtool.io.json_values import finite_tree
 
 SPREAD_HELP = "Half-width of the uniform perturbation"
 # A COM shifted by a metre is another vehicle, not a perturbation of this one.
@@ -121,33 +119,27 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
     not flown (exit 1) unless --ignore CODE or --ignore-validation is given; other errors
     are listed and the model flown.
     """
-    from reedtool.workflows.hover_test import (
-        SCHEMA,
-        HoverTestOptions,
-        plan_hover_test,
-        run_hover_test,
-    )
+    from reedtool.workflows.hover_test import HoverTestOptions, plan_hover_test, run_hover_test
 
     note_model_files(inputs)          # the model is never an output of its own run
     plan = plan_hover_test(HoverTestOptions(
-        duration_s, rate_hz, tuple(offset_m), roll_rad, pitch_rad, yaw_rad, plot_path,
-        replay_path, csv_path, force, samples, max_memory_mb, seed,
-        (mass_spread, com_spread_m, inertia_spread, motor_spread), engine, min_pass_rate,
-        require, controller_files, controller_rate_hz, ignore_validation))
+        duration_s=duration_s, rate_hz=rate_hz, offset_m=tuple(offset_m), roll_rad=roll_rad,
+        pitch_rad=pitch_rad, yaw_rad=yaw_rad, plot_path=plot_path, replay_path=replay_path,
+        csv_path=csv_path, force=force, samples=samples, max_memory_mb=max_memory_mb,
+        seed=seed, spreads=(mass_spread, com_spread_m, inertia_spread, motor_spread),
+        engine=engine, min_pass_rate=min_pass_rate, require=require,
+        controller_files=controller_files, controller_rate_hz=controller_rate_hz,
+        ignore_validation=ignore_validation))
     model, request = one_model_request("hover-test", inputs, package_paths, model_name,
                                        launch_file, ignore)
     result = run_hover_test(model, request, plan,
                             progress=TerminalProgress() if fmt == "text" else None,
                             on_validation=_show_validation(model, fmt, ignore_validation))
+    from reedtool.report.hover_text import render_json, render_text
+
     if fmt == "json":
-        from reedtool.report.json_format import envelope
-
-        document = {**envelope(SCHEMA), **result.document}
-        click.echo(json.dumps(document, indent=2) if result.refused else
-                   json.dumps(finite_tree(document), indent=2, allow_nan=False))
-    elif not result.refused:
-        from reedtool.report.hover_text import render_text
-
+        click.echo(render_json(result))
+    elif not result.refused:     # a refusal's text is validate's errors, already shown
         click.echo(render_text(result.document))
     return 0 if result.passed else 1
 

@@ -7,14 +7,11 @@ the differences listed, 2 on input errors (an existing output directory without 
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import click
 
 from reedtool.commands.params import model_inputs, one_model_request
-
-SCHEMA = "reedtool.migrate/1"
 
 
 @click.command(name="migrate")
@@ -64,13 +61,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
     result = migrate(MigrateRequest(model, output_dir, request, name, velocity_control,
                                     autopilot, force, urdf,
                                     copy_outside_files=copy_outside_files))
-    if fmt == "json":
-        from reedtool.report.json_format import envelope
+    from reedtool.report.migrate_text import render_json, render_text
 
-        click.echo(json.dumps({**envelope(SCHEMA), **result.to_dict()}, indent=2,
-                              allow_nan=False))
-    else:
-        from reedtool.report.migrate_text import render_text
-
-        click.echo(render_text(result))
+    click.echo(render_json(result) if fmt == "json" else render_text(result))
     return 0 if result.proof.equal else 1

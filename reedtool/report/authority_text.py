@@ -4,6 +4,18 @@ workflows.authority; computes nothing."""
 
 from __future__ import annotations
 
+import json
+
+SCHEMA = "reedtool.authority/1"
+
+
+def render_json(result) -> str:
+    """`result`: a workflows.authority.AuthorityReport (an analysis holds no NaN)."""
+    from reedtool.report.json_format import envelope
+
+    return json.dumps({**envelope(SCHEMA), **result.document}, indent=2,
+                      allow_nan=result.refused)
+
 
 def _ttw(value: float | None) -> str:
     return "never" if value is None else f"{value:.3g}"

@@ -6,7 +6,22 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import math
+
+SCHEMA = "reedtool.hover-test/1"
+
+
+def render_json(result) -> str:
+    """`result`: a workflows.hover_test.HoverTestReport; NaN and infinity as null (a
+    refusal carries no number)."""
+    from reedtool.io.json_values import finite_tree
+    from reedtool.report.json_format import envelope
+
+    document = {**envelope(SCHEMA), **result.document}
+    if result.refused:
+        return json.dumps(document, indent=2)
+    return json.dumps(finite_tree(document), indent=2, allow_nan=False)
 
 
 def render_text(report: dict) -> str:

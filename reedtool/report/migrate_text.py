@@ -4,6 +4,16 @@ nothing."""
 
 from __future__ import annotations
 
+import json
+
+SCHEMA = "reedtool.migrate/1"
+
+
+def render_json(result) -> str:
+    from reedtool.report.json_format import envelope
+
+    return json.dumps({**envelope(SCHEMA), **result.to_dict()}, indent=2, allow_nan=False)
+
 
 def render_text(result) -> str:
     rows, proof = result.rows, result.proof

@@ -15,8 +15,6 @@ from typing import Callable
 from reedtool.errors import ReedtoolError
 from reedtool.workflows.robots import ModelRequest
 
-SCHEMA = "reedtool.authority/1"
-
 # --require policies: what must hold for exit 0.
 POLICIES = {
     "none": "report only",

@@ -15,7 +15,6 @@ from reedtool.workflows.flight import Progress
 from reedtool.workflows.robots import ModelRequest
 from reedtool.workflows.vehicle import DEFAULT_MAX_MEMORY_MB
 
-SCHEMA = "reedtool.hover-test/1"
 DEFAULT_DURATION_S = 10.0
 # 10^7 fixed steps is 10,000 s at 1 kHz, far beyond any hover test; more is a typo
 # (`--duration 1e9`) that would keep the machine busy for days.
