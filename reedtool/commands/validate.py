@@ -22,15 +22,13 @@ FORMATS = ("text", "json", "github", "sarif", "junit")
 
 def explain(code: str) -> int:
     from reedtool.checks.registry import get_rule
+    from reedtool.report.rules_text import explanation_text
 
     found = get_rule(code)
     if found is None:
         raise ReedtoolError(f"unknown rule '{code}'",
                             hint="`reedtool rules` lists every rule code and name")
-    click.echo(f"{found.code} {found.slug} ({found.severity}, {found.family})\n")
-    click.echo(f"{found.summary}\n")
-    click.echo(found.explanation)
-    click.echo(f"\nSeverity policy ({found.clause}): {found.policy}.")
+    click.echo(explanation_text(found))
     return 0
 
 

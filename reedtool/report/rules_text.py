@@ -24,3 +24,12 @@ def rules_lines(rules) -> list[str]:
         return ["no rule matches"]
     width = max(len(r.slug) for r in rules)
     return [f"{r.code}  {r.slug:<{width}}  {r.severity:<7}  {r.summary}" for r in rules]
+
+
+def explanation_text(rule) -> str:
+    """`validate --explain CODE`: the rule's heading, summary, documentation and the
+    severity policy's clause behind its default severity."""
+    return (f"{rule.code} {rule.slug} ({rule.severity}, {rule.family})\n\n"
+            f"{rule.summary}\n\n"
+            f"{rule.explanation}\n"
+            f"\nSeverity policy ({rule.clause}): {rule.policy}.")
