@@ -46,7 +46,7 @@ def main() -> int:
     import trimesh
 
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-    from reedtool.commands.import_stl import run_import
+    from reedtool.workflows.import_mesh import run_import
 
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)

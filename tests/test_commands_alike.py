@@ -279,7 +279,8 @@ def test_inertia_reports_its_own_mass_verdicts_instead_of_refusing(tmp_path):
 
 
 def test_refusal_groups_by_code():
-    """The policy's prefixes read as documented: the longest prefix wins, '-' excludes."""
+    """The policy's groups read as documented: a family less the codes it leaves out, or the
+    codes named (read from the rule registry, never from a code's prefix)."""
     from reedtool.workflows.validation import refuses
 
     needs = ("structure", "mass", "rotors")

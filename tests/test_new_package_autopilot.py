@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from reedtool.checks.runner import Selection, run_checks
-from reedtool.commands.new_package import model_path, new_package
+from reedtool.workflows.new_package import model_path, new_package
 from reedtool.flightstack import ardupilot, px4
 from reedtool.io.loader import load_robot
 from reedtool.generate.airframes import MULTIROTOR_FRAMES
@@ -107,7 +107,7 @@ def test_ardupilot_gz_package_is_driven_by_the_plugin(tmp_path, frame):
 def test_ardupilot_on_gazebo_classic_is_refused_with_the_reason(tmp_path):
     """ardupilot_gazebo's ArduPilotPlugin supports Gazebo Garden and later (its README): a
     ROS 1 / RotorS package (Gazebo Classic) would carry no plugin SITL talks to."""
-    from reedtool.commands.new_package import new_package
+    from reedtool.workflows.new_package import new_package
     from reedtool.errors import ReedtoolError
 
     spec = build_spec("ap_ros1", frame="quad-x", ros=1, flags={}, sim="classic")

@@ -216,7 +216,7 @@ def test_seed_quad_port_takes_px4_names_and_places(tmp_path):
 def test_px4_takes_its_own_vehicles_top_speeds(tmp_path, max_rad_s):
     """PX4's Classic iris (1100 rad/s) and typhoon_h480 (1500), px4vision's SIM_GZ_EC_MAX
     1100: the 0..1000 of gz_bridge module.yaml is QGroundControl's range, not PX4's."""
-    from reedtool.commands.new_package import new_package
+    from reedtool.workflows.new_package import new_package
     from reedtool.flightstack.px4 import load_px4_params
     from reedtool.generate.package_spec import build_spec
 
@@ -229,7 +229,7 @@ def test_px4_takes_its_own_vehicles_top_speeds(tmp_path, max_rad_s):
 
 
 def test_px4_refuses_a_speed_no_output_can_carry(tmp_path):
-    from reedtool.commands.new_package import new_package
+    from reedtool.workflows.new_package import new_package
     from reedtool.errors import ReedtoolError
     from reedtool.generate.package_spec import build_spec
 
@@ -246,7 +246,7 @@ def test_new_package_gz_px4_writes_the_contract(tmp_path, frame):
     base_link, no velocity controller), and px4/ holds the same model in PX4's layout with
     its airframe; PX4's airframe and the model agree (no flight-stack warning)."""
     from reedtool.checks.runner import run_checks
-    from reedtool.commands.new_package import new_package
+    from reedtool.workflows.new_package import new_package
     from reedtool.flightstack.px4 import load_px4_params
     from reedtool.io.loader import load_robot
     from reedtool.generate.package_spec import build_spec

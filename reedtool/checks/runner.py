@@ -33,7 +33,8 @@ INTERNAL_ERROR = "internal error in this rule: "
 # A static SDF model (a warehouse floor, a runway) is never moved by the physics engine:
 # the inertia family (masses, tensors, mesh units against a vehicle's size) and the rotor
 # family judge a vehicle, and libsdformat loads a static model whatever they would say.
-SCENERY_EXEMPT_FAMILIES = ("I", "R")
+# Families by their registry title (checks.registry.FAMILIES), read from each rule.
+SCENERY_EXEMPT_FAMILIES = ("Inertia", "Rotors")
 
 
 def has_internal_errors(findings: Iterable[Finding]) -> bool:
@@ -136,7 +137,7 @@ def run_checks(robot: Robot, selection: Selection | None = None, *,
     for rule in all_rules():
         if rule.run_level or not selection.enabled(rule.code):
             continue      # a run-level rule is judged over the whole run (validate)
-        if robot.static and rule.code.startswith(SCENERY_EXEMPT_FAMILIES):
+        if robot.static and rule.family in SCENERY_EXEMPT_FAMILIES:
             continue    # scenery: Gazebo never moves a static model, its masses are unused
         severity = selection.severity_of(rule)
         issues, crashed = _issues_of(rule, ctx)

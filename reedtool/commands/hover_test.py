@@ -8,10 +8,6 @@ Exit 0 when the model hovers (and the batch meets --min-pass-rate), 1 when it do
 from __future__ import annotations
 
 import contextlib
-import csv
-import io
-import json
-import math
 import sys
 from pathlib import Path
 
@@ -26,17 +22,10 @@ from reedtool.commands.params import (
     one_model_request,
     validation_options,
 )
-from reedtool.errors import ReedtoolError
-from reedtool.io.json_values import finite_tree
 
 SPREAD_HELP = "Half-width of the uniform perturbation"
 # A COM shifted by a metre is another vehicle, not a perturbation of this one.
 MAX_COM_SPREAD_M = 1.0
-# 10^7 fixed steps is 10,000 s at 1 kHz, far beyond any hover test; more is a typo
-# (`--duration 1e9`) that would keep the machine busy for days.
-MAX_STEPS = 10_000_000
-SCHEMA = "reedtool.hover-test/1"
-DEFAULT_DURATION_S = 10.0
 
 
 # A run longer than this on a terminal shows that it is still working.
@@ -130,171 +119,40 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
     not flown (exit 1) unless --ignore CODE or --ignore-validation is given; other errors
     are listed and the model flown.
     """
-    from reedtool.errors import check_plausible
-    from reedtool.sim import HoverConfig
-    from reedtool.sim.verdict import Requirement
-
-    try:
-        requirement = Requirement.parse(require)
-    except ValueError as exc:
-        raise ReedtoolError(f"bad option: {exc}",
-                            hint="e.g. --require stable, or --require margin:10") from exc
-
-    check_plausible("rate", rate_hz, "--rate")
-    auto_duration = duration_s is None
-    duration_s = DEFAULT_DURATION_S if auto_duration else duration_s
-    check_plausible("duration", duration_s, "--duration")
-    for axis, value in zip("xyz", offset_m):
-        check_plausible("offset", value, f"--offset {axis}", magnitude=True)
-    for option, value in (("--roll", roll_rad), ("--pitch", pitch_rad), ("--yaw", yaw_rad)):
-        check_plausible("angle", value, option, magnitude=True)
-    config = HoverConfig(duration_s=duration_s, rate_hz=rate_hz, offset_m=tuple(offset_m),
-                         roll_rad=roll_rad, pitch_rad=pitch_rad, yaw_rad=yaw_rad)
-    try:
-        config.validate()
-    except ValueError as exc:
-        raise ReedtoolError(f"bad option: {exc}", hint="see reedtool hover-test --help") from exc
-    steps = duration_s * rate_hz
-    if steps > MAX_STEPS:
-        raise ReedtoolError(f"bad option: --duration {duration_s:g} s at --rate {rate_hz:g} Hz "
-                            f"is {steps:.3g} steps, more than {MAX_STEPS:.0e}",
-                            hint="a hover test settles in seconds; the defaults are 10 s at "
-                                 "1000 Hz")
-    if controller_files:
-        check_plausible("rate", controller_rate_hz, "--controller-rate")
-        if controller_rate_hz > rate_hz:
-            raise ReedtoolError(f"bad option: --controller-rate {controller_rate_hz:g} Hz is "
-                                f"faster than the simulation's --rate {rate_hz:g} Hz",
-                                hint="keep --controller-rate at or below --rate")
-        for option, given in (("--samples", samples is not None),
-                              ("--engine numba", engine == "numba")):
-            if given:
-                raise ReedtoolError(f"bad option: {option} with --controller: the Lee "
-                                    "controller flies one vehicle on the numpy engine",
-                                    hint=f"drop {option}, or drop --controller to fly "
-                                         "reedtool's own controller")
-    from reedtool.sim import choose_engine
-
-    engine = choose_engine(engine, batch=samples is not None and not controller_files)
-    if engine == "numba":
-        from reedtool.sim.compiled import available, unavailable_reason
-
-        if not available():
-            raise ReedtoolError(f"bad option: --engine numba: {unavailable_reason()}",
-                                hint="or use --engine numpy")
-    from reedtool.io.fileio import check_writable, note_input
+    from reedtool.workflows.hover_test import HoverTestOptions, plan_hover_test, run_hover_test
 
     note_model_files(inputs)          # the model is never an output of its own run
-    for path in controller_files:
-        note_input(path)
-    if plot_path is not None:   # fail before flying, not after
-        check_writable(plot_path, force)
-    if replay_path is not None:
-        if replay_path.suffix.lower() != ".html":
-            raise ReedtoolError(f"--replay writes an HTML page, not '{replay_path.suffix or replay_path.name}'",
-                                file=replay_path, hint="name the --replay file .html")
-        check_writable(replay_path, force)
-    if csv_path is not None:
-        check_writable(csv_path, force, stdout_ok=True)
-    # What the path is comes first (a FIFO is refused as such), then its format.
-    if plot_path is not None and plot_path.suffix.lower() not in (".png", ".svg"):
-        raise ReedtoolError(f"cannot tell the plot format from '{plot_path.suffix or plot_path.name}'",
-                            file=plot_path, hint="name the --plot file .png or .svg")
+    plan = plan_hover_test(HoverTestOptions(
+        duration_s=duration_s, rate_hz=rate_hz, offset_m=tuple(offset_m), roll_rad=roll_rad,
+        pitch_rad=pitch_rad, yaw_rad=yaw_rad, plot_path=plot_path, replay_path=replay_path,
+        csv_path=csv_path, force=force, samples=samples, max_memory_mb=max_memory_mb,
+        seed=seed, spreads=(mass_spread, com_spread_m, inertia_spread, motor_spread),
+        engine=engine, min_pass_rate=min_pass_rate, require=require,
+        controller_files=controller_files, controller_rate_hz=controller_rate_hz,
+        ignore_validation=ignore_validation))
     model, request = one_model_request("hover-test", inputs, package_paths, model_name,
                                        launch_file, ignore)
-    note_input(model)
-
-    from reedtool.workflows.assemble import assemble
-
-    # A model or batch too large for the machine is refused before any rule runs on it.
-    assembled = assemble(model, request, "hover-test", samples=samples,
-                         max_memory_bytes=max_memory_mb * 1024 * 1024)
-    robot, verdict = assembled.robot, assembled.verdict
-    every_rotor = assembled.vehicle.every_rotor
-    refused = bool(verdict.refusing) and not ignore_validation
-    if refused:
-        # Bad input (exit 2) comes before what validate finds (exit 1): unreadable rotor
-        # parameters.
-        from reedtool.sim.params import check_rotor_dynamics
-
-        # ArduPilotPlugin rotors carry no time constants: hover_test derives them from
-        # the joint's velocity PID (or refuses with the reason) only when it flies.
-        check_rotor_dynamics([r for r in every_rotor if r.kind != "ardupilot"])
-    from reedtool.report.validation_note import validation_json, validation_text, why_line
-
-    if fmt == "text":
-        click.echo(validation_text(str(model), verdict.refusing, verdict.reported, refused,
-                                   "flying it", ignore_validation), nl=False)
-    if refused:
-        if fmt == "json":
-            from reedtool.report.json_format import envelope
-
-            click.echo(json.dumps({**envelope(SCHEMA), "model": {"file": str(model)},
-                                   "validation": validation_json(verdict.refusing,
-                                                                 verdict.reported, True),
-                                   "passed": False, "status": "refused",
-                                   "message": why_line(verdict.refusing, verdict.reported,
-                                                       True, "flying it")}, indent=2))
-        return 1
-    from reedtool.workflows.flight import hover_test
-
-    report = hover_test(robot, config, samples=samples, seed=seed,
-                        spreads=(mass_spread, com_spread_m, inertia_spread, motor_spread),
-                        record=bool(plot_path or csv_path or replay_path),
-                        progress=TerminalProgress() if fmt == "text" else None,
-                        engine=engine, envelope=plot_path is not None,
-                        max_memory_bytes=max_memory_mb * 1024 * 1024,
-                        vehicle=assembled.vehicle, requirement=requirement,
-                        auto_duration=auto_duration, controller_files=controller_files,
-                        control_rate_hz=controller_rate_hz)
-    batch = report.get("batch")
-    if batch is not None:
-        batch["min_pass_rate"] = min_pass_rate
-        if report["passed"] and batch["pass_rate"] < min_pass_rate:
-            report["passed"] = False
-            report["message"] = (f"only {100 * batch['pass_rate']:.1f}% of the perturbed "
-                                 f"vehicles hover, {100 * min_pass_rate:.0f}% required")
-
-    from reedtool.sim.verdict import outcome
-
-    report["outcome"] = outcome(report.get("status", ""), report["passed"])
-    run, omega_max = report.pop("_run", None), report.pop("_omega_max")
-    envelope = report.pop("_envelope", None)
-    if run is not None and csv_path is not None:
-        _write_csv(csv_path, run.series, force)
-    if run is not None and plot_path is not None:
-        from reedtool.io.fileio import atomic_write_bytes
-        from reedtool.sim.plot import failure_marks, render
-
-        figure = render(run.series, omega_max, run.initial_omega_rad_s,
-                        f"{robot.name}: {run.status.value}"
-                        + (f" ({batch['passed']}/{batch['samples']} of the batch passed)"
-                           if batch is not None else ""),
-                        fmt=plot_path.suffix.lower()[1:],
-                        position_tol_m=config.position_tol_m,
-                        attitude_tol_deg=config.attitude_tol_deg,
-                        settle_time_s=run.settle_time_s, failures=failure_marks(run),
-                        envelope=envelope)
-        atomic_write_bytes(plot_path, figure, force=force)
-
-    if run is not None and replay_path is not None:
-        from reedtool.workflows.flight import replay_page
-        from reedtool.io.fileio import atomic_write_text
-
-        atomic_write_text(replay_path, replay_page(assembled.vehicle, run, config,
-                                                   robot.name, f"verdict: {report['status']}: "
-                                                   f"{report['message']}"),
-                          force=force)
+    result = run_hover_test(model, request, plan,
+                            progress=TerminalProgress() if fmt == "text" else None,
+                            on_validation=_show_validation(model, fmt, ignore_validation))
+    from reedtool.report.hover_text import render_json, render_text
 
     if fmt == "json":
-        from reedtool.report.json_format import envelope
+        click.echo(render_json(result))
+    elif not result.refused:     # a refusal's text is validate's errors, already shown
+        click.echo(render_text(result.document))
+    return 0 if result.passed else 1
 
-        document = {**envelope(SCHEMA), **report,
-                    "validation": validation_json(verdict.refusing, verdict.reported, False)}
-        click.echo(json.dumps(finite_tree(document), indent=2, allow_nan=False))
-    else:
-        click.echo(render_text(report))
-    return 0 if report["passed"] else 1
+
+def _show_validation(model: Path, fmt: str, ignore_validation: bool):
+    """validate's errors, shown in the text report before the flight."""
+    def show(verdict, refused: bool) -> None:
+        if fmt == "text":
+            from reedtool.report.validation_note import validation_text
+
+            click.echo(validation_text(str(model), verdict.refusing, verdict.reported, refused,
+                                       "flying it", ignore_validation), nl=False)
+    return show
 
 
 class TerminalProgress(Progress):
@@ -341,114 +199,3 @@ def _still_working(label: str, enabled: bool):
     finally:
         done.set()
         thread.join()
-
-
-# ------------------------------------------------------------------ output
-
-def render_text(report: dict) -> str:
-    model, trim, sim, batch = report["model"], report["trim"], report["sim"], report["batch"]
-    lines = [f"hover-test {model['name']}: {model['rotors']} rotors, "
-             f"mass {model['mass_kg']:.4g} kg, COM ({', '.join(f'{v:.4g}' for v in model['com_m'])}) m"]
-    others = [r for r in model.get("rotor_table", ()) if r["role"] != "lift"]
-    if others:
-        lines.append("not used for hover: " + ", ".join(f"{r['name']} ({r['role']})"
-                                                         for r in others))
-    for line in model.get("derived", ()):
-        lines.append(f"derived: {line}")
-    for lj in model.get("locked_joints", ()):
-        # Passive joints (no plugin drives them) are flown rigid: say so, with what the
-        # mass beyond them adds to the inertia about the COM.
-        added = [lj["inertia_about_com_kg_m2"][i][i] for i in range(3)]
-        total = [model["inertia_kg_m2"][i][i] for i in range(3)]
-        share = ", ".join(f"{axis} {a:.3g} kg*m^2 ({100 * a / t:.0f}%)" if t > 0 else
-                          f"{axis} {a:.3g} kg*m^2" for axis, a, t in zip("xyz", added, total))
-        lines.append(f"locked rigid: {lj['joint']} ({lj['type']}, no plugin drives it; "
-                     f"{lj['mass_kg']:.3g} kg beyond it adds {share} about the COM)")
-    if trim["feasible"]:
-        lines.append(f"trim: {trim['message']}")
-    else:
-        lines.append(f"trim: INFEASIBLE ({trim['cause']}): {trim['message']}")
-    if trim["rotors"]:
-        width = max(len(r["name"]) for r in trim["rotors"])
-        lines.append(f"  {'rotor':<{width}}  {'thrust N':>9}  {'omega rad/s':>11}  {'throttle':>8}")
-        for r in trim["rotors"]:
-            # A saturated rotor shows what it can give, and what the allocation asked.
-            limit = {"max": "  at max, needs {:.4g} N", "min": "  at 0, needs {:.4g} N"
-                     }.get(r.get("limit") or "", "").format(r.get("demand_N"))
-            lines.append(f"  {r['name']:<{width}}  {_num(r['thrust_N'], '9.4f')}  "
-                         f"{_num(r['omega_rad_s'], '11.2f')}  {_pct(r['throttle']):>8}{limit}")
-    if trim["feasible"]:
-        a = trim["torque_authority_N_m"]
-        authority = ("" if not all(math.isfinite(v) for v in a.values()) else
-                     f"; torque authority at hover: roll {a['roll']:.3g}, "
-                     f"pitch {a['pitch']:.3g}, yaw {a['yaw']:.3g} N*m")
-        lines.append(f"  thrust-to-weight {trim['thrust_to_weight']:.3f}{authority}")
-    if report.get("controller") is not None:
-        from reedtool.report.lee_text import controller_lines
-
-        lines += controller_lines(report["controller"])
-    if sim is not None:
-        from reedtool.sim.verdict import tuning_line
-
-        c = sim["config"]
-        if sim["gains"].get("controller") != "rotors-lee":
-            lines.append(f"tuning: {tuning_line(sim['gains'])}")
-        lines.append(f"sim: {sim['status'].upper()}: {sim['message']}")
-        lines.append(f"  start {c['offset_m']} m off, roll {c['roll_rad']:g} pitch "
-                     f"{c['pitch_rad']:g} yaw {c['yaw_rad']:g} rad; {c['duration_s']:g} s at "
-                     f"{c['rate_hz']:g} Hz ({c['integrator']}; engine {sim['engine']})")
-        lines.append(f"  max error {sim['max_position_error_m']:.3f} m, "
-                     f"{sim['max_attitude_error_deg']:.1f} deg; final "
-                     f"{100 * sim['final_position_error_m']:.2f} cm, "
-                     f"{sim['final_attitude_error_deg']:.2f} deg; max throttle "
-                     f"{_pct(sim['max_throttle'])}")
-        if sim["passed"]:
-            speeds = ", ".join(f"{w:.2f}" for w in sim["final_omega_rad_s"].values())
-            lines.append(f"  final rotor speeds {speeds} rad/s")
-    if batch is not None:
-        s = batch["spreads"]
-        counts = ", ".join(f"{k} {v}" for k, v in sorted(batch["counts"].items()))
-        lines.append(f"batch: {batch['passed']}/{batch['samples']} passed "
-                     f"({100 * batch['pass_rate']:.1f}%, need "
-                     f"{100 * batch['min_pass_rate']:.0f}%): {counts}")
-        lines.append(f"  spreads: mass +-{100 * s['mass_rel']:g}%, COM +-{1000 * s['com_m']:g} mm, "
-                     f"inertia +-{100 * s['inertia_rel']:g}%, motor constant "
-                     f"+-{100 * s['motor_constant_rel']:g}%; seed {batch['seed']}"
-                     + (f"; from {batch['start_scale']:.3g} of the start (the recoverable margin)"
-                        if batch.get("start_scale", 1.0) != 1.0 else ""))
-        for w in batch["worst"]:
-            lines.append(f"  #{w['index']}: {w['status']}: {w['message']} "
-                         f"(mass {w['mass_kg']:.4g} kg, COM shift "
-                         f"{', '.join(f'{1000 * v:.1f}' for v in w['com_shift_m'])} mm)")
-    verdict = report.get("verdict")
-    if verdict is not None:
-        lines.append(f"verdict: {verdict['status'].upper()}: {verdict['message']}")
-    from reedtool.sim.verdict import final_line
-
-    lines.append(final_line(report.get("status", ""), report["passed"],
-                            report.get("require", "flies"), report.get("message", "")))
-    return "\n".join(lines)
-
-
-def _write_csv(path: Path, series: dict, force: bool) -> None:
-    from reedtool.io.fileio import atomic_write_text, is_stdout, write_stdout
-
-    buffer = io.StringIO()
-    writer = csv.writer(buffer, lineterminator="\n")
-    keys = list(series)
-    writer.writerow(keys)
-    for row in zip(*(series[k] for k in keys)):
-        writer.writerow([f"{float(v):.9g}" for v in row])
-    if is_stdout(path):
-        write_stdout(buffer.getvalue())
-    else:
-        atomic_write_text(path, buffer.getvalue(), force=force)
-
-
-def _num(value, spec: str) -> str:
-    return format(value, spec) if value is not None and math.isfinite(value) else "n/a".rjust(
-        int(spec.split(".")[0]))
-
-
-def _pct(value) -> str:
-    return f"{100 * value:.1f}%" if value is not None and math.isfinite(value) else "n/a"

@@ -44,18 +44,21 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
     model, request = one_model_request("layout", inputs, package_paths, model_name,
                                        launch_file, ignore)
     note_input(model)
-    from reedtool.workflows.assemble import load_robot_for
-    from reedtool.workflows.diagram import write_diagram
-    from reedtool.workflows.validation import judge
-    from reedtool.report.validation_note import validation_text
+    from reedtool.workflows.diagram import draw_layout
 
-    robot, _ = load_robot_for(model, request)
-    verdict = judge(model, robot, request, "layout")
-    refused = bool(verdict.refusing) and not ignore_validation
-    click.echo(validation_text(str(model), verdict.refusing, verdict.reported, refused,
-                               "drawing it", ignore_validation), nl=False)
-    if refused:
+    drawn = draw_layout(model, request, output, force, ignore_validation=ignore_validation,
+                        on_validation=_show_validation(model, ignore_validation))
+    if not drawn:
         return 1
-    write_diagram(robot, output, verdict.errors, force)
     click.echo(f"wrote {output}")
     return 0
+
+
+def _show_validation(model: Path, ignore_validation: bool):
+    """validate's errors and what was done about them, before the picture is drawn."""
+    def show(verdict, refused: bool) -> None:
+        from reedtool.report.validation_note import validation_text
+
+        click.echo(validation_text(str(model), verdict.refusing, verdict.reported, refused,
+                                   "drawing it", ignore_validation), nl=False)
+    return show

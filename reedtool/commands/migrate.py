@@ -7,14 +7,11 @@ the differences listed, 2 on input errors (an existing output directory without 
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import click
 
 from reedtool.commands.params import model_inputs, one_model_request
-
-SCHEMA = "reedtool.migrate/1"
 
 
 @click.command(name="migrate")
@@ -64,59 +61,7 @@ def command(inputs: tuple[str, ...], package_paths: tuple[Path, ...],
     result = migrate(MigrateRequest(model, output_dir, request, name, velocity_control,
                                     autopilot, force, urdf,
                                     copy_outside_files=copy_outside_files))
-    if fmt == "json":
-        from reedtool.report.json_format import envelope
+    from reedtool.report.migrate_text import render_json, render_text
 
-        click.echo(json.dumps({**envelope(SCHEMA), **result.to_dict()}, indent=2,
-                              allow_nan=False))
-    else:
-        click.echo(render_text(result))
+    click.echo(render_json(result) if fmt == "json" else render_text(result))
     return 0 if result.proof.equal else 1
-
-
-def render_text(result) -> str:
-    rows, proof = result.rows, result.proof
-    lines = [f"migrate {result.source} -> {result.target} ({len(result.files)} files)"]
-    for action in ("mapped", "folded", "dropped", "unknown"):
-        chosen = [r for r in rows if r.action == action]
-        if not chosen:
-            continue
-        title = {"unknown": "kept out (no gz counterpart known)"}.get(action, action)
-        lines.append(f"{title}:")
-        for row in chosen:
-            arrow = f" -> {row.output}" if row.output else ""
-            lines.append(f"  {row.source}: {row.element}{arrow}")
-            lines.append(f"      {row.why}")
-            if row.carried:
-                lines.append("      carried: " + ", ".join(f"{k} {v}" for k, v in
-                                                           row.carried.items()))
-    counted = ", ".join(f"{k} {v}" for k, v in proof.compared.items())
-    lines.append(f"proof (read back, compared to {proof.to_dict()['rel_tol']:g} relative): "
-                 f"{counted}")
-    side = proof.side_by_side
-    if "mass" in side:
-        a, b = side["mass"]["original"], side["mass"]["port"]
-        lines.append(f"  mass {a['mass_kg']:.9g} kg -> {b['mass_kg']:.9g} kg")
-    for rotor in side.get("rotors", []):
-        lines.append(f"  rotor {rotor['rotor']}: {rotor['number_from'][0]} "
-                     f"{rotor['number'][0]} -> {rotor['number_from'][1]} {rotor['number'][1]}, "
-                     f"{rotor['direction'][0]} -> {rotor['direction'][1]}")
-    if "trim" in side:
-        a, b = side["trim"]["original"], side["trim"]["port"]
-        lines.append(f"  trim: {a['message']} | port: {b['message']}")
-    if "hover" in side:
-        a, b = side["hover"]["original"], side["hover"]["port"]
-        lines.append(f"  hover-test: original {a['status']}, port {b['status']}")
-    for note in proof.notes:
-        lines.append(f"  note: {note}")
-    carried = [f for f in side.get("findings", {}).get("port", []) if " error:" in f]
-    if carried:
-        lines.append("  the port carries the original's errors (Gazebo Sim may refuse it; "
-                     "fix the source and migrate again):")
-        lines += [f"    {finding}" for finding in carried]
-    if proof.equal:
-        lines.append("EQUAL: the port reads back as the original")
-    else:
-        lines.append(f"DIFFERENT ({len(proof.differences)}):")
-        lines += [f"  {d}" for d in proof.differences]
-    return "\n".join(lines)

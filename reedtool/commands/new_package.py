@@ -2,135 +2,11 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from pathlib import Path, PurePosixPath
+from pathlib import Path
 
 import click
 
 from reedtool.generate.airframes import FRAMES
-
-
-@dataclass
-class NewPackageResult:
-    target: Path
-    files: list[PurePosixPath]
-    backup: Path | None
-    context: dict
-    mesh: object | None = None     # the CAD body (generate.cad_body.CadBody)
-
-
-def template_sets(kind: str, ros: int, sim: str = "classic") -> list[str]:
-    """Later sets override files of earlier ones with the same output path.
-
-    A gz-sim package shares nothing with the RotorS (`common/<kind>`, `ros2/<kind>`) sets:
-    its own set `ros2/gz/<kind>` replaces them, and overrides package.xml, CMakeLists.txt
-    and README.md of the `any` sets.
-    """
-    if sim == "gz":
-        return ["common/any", f"ros{ros}/any", f"ros{ros}/gz/{kind}"]
-    return ["common/any", f"common/{kind}", f"ros{ros}/any", f"ros{ros}/{kind}"]
-
-
-def model_path(spec) -> PurePosixPath:
-    """The file to expand, validate and hover-test in a generated package."""
-    if spec.kind == "multirotor" and spec.sim == "classic":
-        return PurePosixPath("urdf", "mav_generic_odometry_sensor.gazebo")
-    return PurePosixPath("urdf", f"{spec.name}.urdf.xacro")
-
-
-def mesh_lines(body, spec) -> list[str]:
-    """What new-package assumed about the body mesh, as import-stl says it, and where the
-    CAD body put the COM and the rotors."""
-    from reedtool.physics.mesh_import import assumption_lines
-    from reedtool.generate.cad_body import cad_lines
-
-    imported = body.imported
-    size = imported.size_m
-    return ([f"body mesh {imported.source}: {imported.file_format}"]
-            + [f"  {line}" for line in assumption_lines(imported)]
-            + [f"  note: {note}" for note in imported.notes]
-            + [f"  size: {size[0]:.4g} x {size[1]:.4g} x {size[2]:.4g} m (x, y, z in FLU)"]
-            + cad_lines(body, spec))
-
-
-def new_package(spec, output_dir: Path, *, force: bool = False, mesh_units: str = "auto",
-                mesh_frame: str | None = None, autopilot: str | None = None,
-                center: str | None = None) -> NewPackageResult:
-    """Render the package for `spec` into output_dir/spec.name, all or nothing.
-
-    `autopilot` ('px4' | 'ardupilot') adds the autopilot's rotor table, written from the
-    same frame as the model (reedtool.generate.autopilot).
-    """
-    from reedtool.generate.autopilot import autopilot_context, autopilot_files, prepare_spec
-    from reedtool.generate.render import RenderedFile, check_target, render_tree, write_tree
-
-    spec = prepare_spec(spec, autopilot)
-
-    target = Path(output_dir) / spec.name
-    check_target(target.absolute(), force)   # fail before any expensive work
-    body_props = mesh_data = body = None
-    if spec.mesh is not None:
-        from reedtool.io.stl import stl_bytes
-        from reedtool.generate.cad_body import load_cad_body
-
-        body = load_cad_body(spec, units=mesh_units, frame=mesh_frame, centre=center)
-        body_props = body.props
-        mesh_data = stl_bytes(body.imported.triangles_m,
-                              header=f"reedtool body of {spec.name}: metres, FLU, CAD origin")
-    elif center is not None:
-        from reedtool.errors import ReedtoolError
-
-        raise ReedtoolError("--center places rotors on a CAD body: it needs --mesh",
-                            hint="drop --center, or pass the body with --mesh")
-    from reedtool.generate.package_spec import template_context
-
-    context = template_context(spec, body_props)
-    context.update(autopilot_context(spec, autopilot))
-    files = render_tree(template_sets(spec.kind, spec.ros, spec.sim), context)
-    if mesh_data is not None:
-        files.append(RenderedFile(PurePosixPath("meshes", context["mesh_file"]), mesh_data, 0o644))
-    files += autopilot_files(spec, autopilot, files)
-    backup = write_tree(target, files, force=force)
-    return NewPackageResult(target, sorted(f.path for f in files), backup, context, body)
-
-
-def _summary(result: NewPackageResult, spec) -> list[str]:
-    ctx = result.context
-    sim = ", gz-sim" if spec.sim == "gz" else ""
-    lines = [f"created {result.target} ({len(result.files)} files, ROS {spec.ros}{sim}, "
-             f"{spec.frame.title})"]
-    if result.backup is not None:
-        lines.append(f"previous contents kept in {result.backup}")
-    if result.mesh is not None:
-        lines.extend(mesh_lines(result.mesh, spec))
-    if spec.kind == "multirotor":
-        lines.append(f"mass {ctx['p']['mass']} kg body, {ctx['total_mass_kg']} kg total; "
-                     f"max thrust / weight {ctx['thrust_to_weight']}")
-        for r in ctx["rotors"]:
-            lines.append(f"  motor {r['motor_number']}  {r['suffix']:<20} "
-                         f"({', '.join(r['position_m'])}) m  {r['direction']}")
-        from reedtool.generate.package_spec import propulsion_lines
-
-        lines.extend(propulsion_lines(spec))
-    else:
-        lines.append(f"mass {ctx['p']['mass']} kg body, {ctx['total_mass_kg']} kg total; "
-                     f"{len(ctx['wheels'])} wheels, {ctx['drive'].replace('_', '-')} on cmd_vel")
-    model = model_path(spec)
-    autopilot = next((f for f in result.files if f.parts[0] == "ardupilot" or (
-        f.parts[0] == "px4" and ("airframes" in f.parts or f.name.startswith("airframe")))), None)
-    option = {"px4": "--airframe", "ardupilot": "--autopilot-params"}
-    check = f" {option[autopilot.parts[0]]} {result.target / autopilot}" if autopilot else ""
-    lines.append("next:")
-    lines.append(f"  reedtool validate {result.target / model}{check}")
-    if spec.kind == "multirotor":
-        lines.append(f"  reedtool hover-test {result.target / model}")
-    if spec.sim == "gz":
-        lines.append(f"  ros2 launch {spec.name} {spec.name}.launch.py   (after colcon build)")
-    if any(f.parts[:2] == ("px4", "README.md") for f in result.files):
-        lines.append(f"  PX4 SITL: {result.target / 'px4' / 'README.md'}")
-    elif any(f.parts[0] == "ardupilot" for f in result.files):
-        lines.append(f"  ArduPilot SITL: {result.target / 'README.md'} (sim_vehicle.py -f JSON)")
-    return lines
 
 
 @click.command(name="new-package")
@@ -187,12 +63,14 @@ def command(name, frame, ros, sim, spec_file, mass, arm_length, mesh, mesh_units
     `reedtool validate` and `hover-test` as generated.
     """
     from reedtool.generate.package_spec import build_spec
+    from reedtool.report.new_package_text import summary_lines
+    from reedtool.workflows.new_package import new_package
 
     spec = build_spec(name, frame=frame, ros=int(ros) if ros else None, spec_file=spec_file,
                       flags={"mass": mass, "arm_length": arm_length}, mesh=mesh, sim=sim,
                       drive={"motor": motor, "prop": prop, "battery": battery})
     result = new_package(spec, output_dir, force=force, mesh_units=mesh_units,
                          mesh_frame=mesh_frame, autopilot=autopilot, center=center)
-    for line in _summary(result, spec):
+    for line in summary_lines(result, spec):
         click.echo(line)
     return 0

@@ -59,3 +59,22 @@ def _com(robot):
         return com if np.all(np.isfinite(com)) else None
     except ReedtoolError:
         return None
+
+
+def draw_layout(model: Path, request, output: Path, force: bool, *,
+                ignore_validation: bool = False, on_validation=None) -> bool:
+    """`layout` as one call: the model loaded and judged by validate's refusal policy,
+    `on_validation(verdict, refused)` told (for the caller to show the errors), then, unless
+    refused, the picture written with the rotors the errors name in red. True when drawn."""
+    from reedtool.workflows.assemble import load_robot_for
+    from reedtool.workflows.validation import judge
+
+    robot, _ = load_robot_for(model, request)
+    verdict = judge(model, robot, request, "layout")
+    refused = bool(verdict.refusing) and not ignore_validation
+    if on_validation is not None:
+        on_validation(verdict, refused)
+    if refused:
+        return False
+    write_diagram(robot, output, verdict.errors, force)
+    return True

@@ -96,24 +96,41 @@ def check_model_path(model: Path, request: ModelRequest, *, controllers=(),
 # The computing commands run validate's rules first (the model's configuration, then
 # --select/--ignore). An error in what a command builds on makes its result meaningless,
 # so it refuses the model (exit 1, the errors listed; --ignore CODE or --ignore-validation
-# flies it anyway). Every other error is reported beside the result. The groups, by rule
-# code prefix (the longest prefix wins, as in --select; "-CODE" takes a code out):
-REFUSAL_GROUPS: dict[str, tuple[str, ...]] = {
+# flies it anyway). Every other error is reported beside the result. The groups are read
+# from the rule registry: a rule family (its title in checks.registry.FAMILIES) less the
+# rules named, or the rules named.
+
+
+@dataclass(frozen=True)
+class RefusalGroup:
+    family: str | None = None                  # every rule of this family ...
+    leave_out: frozenset[str] = frozenset()    # ... except these
+    codes: frozenset[str] = frozenset()        # (or exactly these rules)
+
+    def holds(self, rule) -> bool:
+        if self.family is not None:
+            return rule.family == self.family and rule.code not in self.leave_out
+        return rule.code in self.codes
+
+
+REFUSAL_GROUPS: dict[str, RefusalGroup] = {
     # The tree Gazebo and Pinocchio build: unreadable or non-finite numbers, links, joints,
     # limits, geometry sizes, links Gazebo drops. The mesh files (S115 unresolved, S130
-    # format, S131 escaping URI) are the look and the collisions, not the dynamics.
-    # libsdformat's refusals of names, frame references and materials (S160-S171) stop
-    # Gazebo, not the computation: reedtool read the tree (an unreadable frame is S101's).
-    "structure": ("S1", "-S115", "-S130", "-S131", "-S140", "-S16", "-S170", "-S171"),
+    # format, S131 escaping URI) are the look and the collisions, not the dynamics; S140 is
+    # an argument the model never declares. libsdformat's refusals of names, frame
+    # references and materials (S160-S171) stop Gazebo, not the computation: reedtool read
+    # the tree (an unreadable frame is S101's).
+    "structure": RefusalGroup("Structure", frozenset(
+        {"S115", "S130", "S131", "S140", *(f"S{n}" for n in range(160, 172))})),
     # The masses and inertias every number is computed from. I210 (a mesh in the wrong
     # unit) is a mesh's size, not a declared mass.
-    "mass": ("I2", "-I210"),
+    "mass": RefusalGroup("Inertia", frozenset({"I210"})),
     # A rotor as written is not a rotor: no direction, no usable constants, its plugin
     # names nothing, it does not turn, it spins against its blades. Motor numbering (R301,
     # R302) and the MAVLink rotor count (R312) are the flight stack's wiring; yaw balance,
     # rank, trim and thrust-to-weight (R304, R305, R307, R308) are what hover-test and
     # authority compute and report themselves.
-    "rotors": ("R303", "R313", "R314", "R315", "R316", "R318"),
+    "rotors": RefusalGroup(codes=frozenset({"R303", "R313", "R314", "R315", "R316", "R318"})),
 }
 # An impossible tensor (I202 not positive definite, I203 the triangle inequality) is about
 # the link's own tensor. Where that tensor is smaller than the inertia spread hover-test's
@@ -133,16 +150,10 @@ COMMAND_NEEDS: dict[str, tuple[str, ...]] = {
 
 def refuses(code: str, groups: Sequence[str]) -> bool:
     """Does an error of rule `code` make a result built on `groups` meaningless?"""
-    for group in groups:
-        best, take = -1, False
-        for prefix in REFUSAL_GROUPS[group]:
-            exclude = prefix.startswith("-")
-            stem = prefix.lstrip("-")
-            if code.startswith(stem) and len(stem) > best:
-                best, take = len(stem), not exclude
-        if take:
-            return True
-    return False
+    from reedtool.checks.registry import get_rule
+
+    rule = get_rule(code)
+    return rule is not None and any(REFUSAL_GROUPS[group].holds(rule) for group in groups)
 
 
 @dataclass
