@@ -28,6 +28,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from reedtool.io.sdf_write import pose_text
+from reedtool.io.xml_numbers import float_text
 from reedtool.model import (
     MOTOR_PLUGINS,
     Collision,
@@ -450,20 +452,6 @@ def _resolve_link(name: str | None, fold, by_name) -> tuple[str | None, np.ndarr
     if key is None:
         return None, np.eye(4)
     return fold[key]
-
-
-def pose_text(T: np.ndarray) -> str:
-    """A 4x4 transform as SDF `<pose>` text: x y z roll pitch yaw, each as `float_text`."""
-    from reedtool.frames import matrix_to_rpy
-
-    values = [*T[:3, 3], *matrix_to_rpy(T[:3, :3])]
-    return " ".join(float_text(v) for v in values)
-
-
-def float_text(value: float) -> str:
-    """Shortest text that reads back as the same float; -0 written as 0."""
-    value = float(value)
-    return "0" if value == 0 else repr(value)
 
 
 def _gazebo_element(port: GzPort, reference: str | None, node: XmlNode, fold, by_name) -> None:
