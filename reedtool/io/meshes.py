@@ -1,6 +1,9 @@
 """Any mesh file as triangles, refused when nothing sensible can be computed from it.
 
-STL, COLLADA and OBJ are read here with light readers (numpy, lxml): `validate` needs their
+One loader table, `MESH_READERS` (suffix -> reader), and one return type, `MeshFile`: every
+caller (validate's mesh checks, inertia, the view and layout pictures, import-stl and
+new-package --mesh) reads meshes through `read_mesh`. STL, COLLADA and OBJ are read with
+light readers (numpy, lxml: io/stl.py, io/dae.py, io/obj.py): `validate` needs their
 extents and units and must not pay for trimesh/scipy. Other formats go through trimesh.
 """
 
@@ -8,17 +11,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
 from reedtool.errors import ReedtoolError
-from reedtool.io.stl import read_stl
 
 # What each simulator's mesh loader reads (gazebo classic: common::MeshManager; gz-sim:
 # gz-common's MeshManager, which adds glTF/GLB and FBX through assimp).
 CLASSIC_MESH_SUFFIXES = (".stl", ".dae", ".obj")
 GZ_MESH_SUFFIXES = CLASSIC_MESH_SUFFIXES + (".glb", ".gltf", ".fbx")
-LIGHT_SUFFIXES = (".stl", ".dae", ".obj")
 
 
 @dataclass
@@ -28,6 +30,8 @@ class MeshFile:
     format: str                     # stl-binary | stl-ascii | dae | obj | other
     unit_declared: bool = False     # the file states its unit (COLLADA)
     notes: list[str] = field(default_factory=list)
+    up_axis: str | None = None      # what the file declares (COLLADA), already applied
+    source: Path | None = None      # the file read
 
     @property
     def triangles_m(self) -> np.ndarray:
@@ -90,32 +94,28 @@ def read_mesh(path: str | Path) -> MeshFile:
     return found
 
 
-def _read_mesh(path: Path) -> MeshFile:
-    suffix = path.suffix.lower()
-    if suffix == ".stl":
-        stl = read_stl(path)
-        return MeshFile(stl.triangles, 1.0, f"stl-{stl.format}", notes=list(stl.notes))
-    if suffix == ".dae":
-        from reedtool.io.dae import read_dae
+def _read_stl(path: Path) -> MeshFile:
+    from reedtool.io.stl import read_stl
 
-        dae = read_dae(path)
-        return MeshFile(dae.triangles, dae.metres_per_unit, "dae", dae.unit_declared, dae.notes)
-    if suffix == ".obj":
-        from reedtool.io.obj import read_obj
-
-        return MeshFile(read_obj(path), 1.0, "obj")
-    return MeshFile(_load_with_trimesh(path), 1.0, "other")
+    stl = read_stl(path)
+    return MeshFile(stl.triangles, 1.0, f"stl-{stl.format}", notes=list(stl.notes))
 
 
-def load_triangles(path: str | Path) -> np.ndarray:
-    """Any mesh file as (n, 3, 3) triangles in metres as Gazebo reads it (COLLADA <unit>
-    applied, `<mesh scale>` not), checked for content mass properties can be computed from."""
-    triangles = read_mesh(path).triangles_m
-    check_triangles(triangles, path)
-    return triangles
+def _read_dae(path: Path) -> MeshFile:
+    from reedtool.io.dae import read_dae
+
+    dae = read_dae(path)
+    return MeshFile(dae.triangles, dae.metres_per_unit, "dae", dae.unit_declared, dae.notes,
+                    up_axis=dae.up_axis)
 
 
-def _load_with_trimesh(path: Path) -> np.ndarray:
+def _read_obj(path: Path) -> MeshFile:
+    from reedtool.io.obj import read_obj
+
+    return MeshFile(read_obj(path), 1.0, "obj")
+
+
+def _read_with_trimesh(path: Path) -> MeshFile:
     import trimesh
 
     from reedtool.io.fileio import MAX_MESH_BYTES, open_regular_input
@@ -128,7 +128,32 @@ def _load_with_trimesh(path: Path) -> np.ndarray:
                             file=path, hint="export it as STL") from exc
     faces = np.asarray(getattr(loaded, "faces", np.zeros((0, 3))), dtype=np.int64)
     vertices = np.asarray(getattr(loaded, "vertices", np.zeros((0, 3))), dtype=np.float64)
-    return vertices[faces] if len(faces) else np.zeros((0, 3, 3))
+    return MeshFile(vertices[faces] if len(faces) else np.zeros((0, 3, 3)), 1.0, "other")
+
+
+# The loader table: file suffix (lower case) -> reader. These are the light readers
+# validate runs; any other suffix is read by `OTHER_READER` (trimesh).
+MESH_READERS: dict[str, Callable[[Path], MeshFile]] = {
+    ".stl": _read_stl,
+    ".dae": _read_dae,
+    ".obj": _read_obj,
+}
+OTHER_READER: Callable[[Path], MeshFile] = _read_with_trimesh
+LIGHT_SUFFIXES = tuple(MESH_READERS)
+
+
+def _read_mesh(path: Path) -> MeshFile:
+    read = MESH_READERS.get(path.suffix.lower(), OTHER_READER)(path)
+    read.source = path
+    return read
+
+
+def load_triangles(path: str | Path) -> np.ndarray:
+    """Any mesh file as (n, 3, 3) triangles in metres as Gazebo reads it (COLLADA <unit>
+    applied, `<mesh scale>` not), checked for content mass properties can be computed from."""
+    triangles = read_mesh(path).triangles_m
+    check_triangles(triangles, path)
+    return triangles
 
 
 @dataclass
