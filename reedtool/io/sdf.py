@@ -66,7 +66,7 @@ from lxml import etree
 from reedtool.errors import ReedtoolError
 from reedtool.io.fileio import magnitude_problem
 from reedtool.frames import make_T, rpy_to_matrix
-from reedtool.io.meshes import machine_path
+from reedtool.resolve.references import machine_path
 from reedtool.resolve.resources import REMOTE_NOT_CHECKED, is_remote_uri, resolve_model_file_uri
 from reedtool.io.sdf_include import SourceFile, SourceMap, expand_includes
 from reedtool.io.sdf_refusals import document_refusals, parse_version
