@@ -46,9 +46,21 @@ def inertial_element(parent, mass_kg: float, T_link_com: np.ndarray, inertia_kg_
     node = _sub(parent, "inertial")
     origin_element(node, T_link_com, number)
     _sub(node, "mass", value=number(mass_kg))
-    I = np.asarray(inertia_kg_m2, dtype=float)
-    _sub(node, "inertia", **{key: number(I[i, j]) for key, (i, j) in INERTIA_KEYS})
+    _sub(node, "inertia", **inertia_attributes(inertia_kg_m2, number))
     return node
+
+
+def inertia_attributes(inertia_kg_m2, number: Number = float_text) -> dict[str, str]:
+    """The six attributes of <inertia> for a 3x3 tensor."""
+    I = np.asarray(inertia_kg_m2, dtype=float)
+    return {key: number(I[i, j]) for key, (i, j) in INERTIA_KEYS}
+
+
+def inertia_text(inertia_kg_m2) -> str:
+    """<inertia .../> as a person reads it (ten digits, round-off entries as 0), spliced
+    into a user's xacro file in the layout xacro files use (a space before `/>`)."""
+    attributes = inertia_attributes(clean_tensor(inertia_kg_m2), short_text)
+    return "<inertia " + " ".join(f'{key}="{value}"' for key, value in attributes.items()) + " />"
 
 
 def inertial_text(mass_kg: float, com_m, inertia_kg_m2, indent: str = "  ") -> str:

@@ -500,10 +500,9 @@ def inertial_xml(props: MassProperties, indent: str = "  ") -> str:
 
 def inertia_element(inertia_kg_m2) -> str:
     """An <inertia .../> element for a tensor (in the link axes), as inertial_xml writes it."""
-    I = clean_tensor(inertia_kg_m2)
-    return (f"<inertia ixx=\"{fmt_number(I[0, 0])}\" ixy=\"{fmt_number(I[0, 1])}\" "
-            f"ixz=\"{fmt_number(I[0, 2])}\" iyy=\"{fmt_number(I[1, 1])}\" "
-            f"iyz=\"{fmt_number(I[1, 2])}\" izz=\"{fmt_number(I[2, 2])}\" />")
+    from reedtool.io.urdf_write import inertia_text
+
+    return inertia_text(inertia_kg_m2)
 
 
 # ------------------------------------------------- declared vs geometry, per link

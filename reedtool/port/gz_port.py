@@ -262,7 +262,7 @@ class GzPort:
     # Sensors a port renames and moves on purpose: original name -> (name, link) in the
     # port (PX4's contract: its four on base_link, posed where they were).
     moved_sensors: dict[str, tuple[str, str]] = field(default_factory=dict)
-    # Mesh URIs whose file lies outside the model's packages -> why (io.meshes.outside_reason);
+    # Mesh URIs whose file lies outside the model's packages -> why (resolve.references.outside_reason);
     # they are referenced where they are, not copied, unless copy_outside_files.
     outside_files: dict[str, str] = field(default_factory=dict)
     copy_outside_files: bool = False
