@@ -14,10 +14,9 @@ import numpy as np
 from lxml import etree
 
 from reedtool.io.xml_numbers import float_text, pose_values, vector_text
+from reedtool.model import inertia_values
 
 SDF_VERSION = "1.9"
-INERTIA_KEYS = (("ixx", (0, 0)), ("ixy", (0, 1)), ("ixz", (0, 2)), ("iyy", (1, 1)),
-                ("iyz", (1, 2)), ("izz", (2, 2)))
 
 
 def sub(parent, tag: str, text: object | None = None, **attrib: str):
@@ -40,9 +39,8 @@ def inertial_element(parent, mass_kg: float, T_link_com: np.ndarray, inertia_kg_
     sub(node, "pose", pose_text(T_link_com))
     sub(node, "mass", float_text(mass_kg))
     tensor = sub(node, "inertia")
-    I = np.asarray(inertia_kg_m2, dtype=float)
-    for key, (i, j) in INERTIA_KEYS:
-        sub(tensor, key, float_text(I[i, j]))
+    for key, value in inertia_values(inertia_kg_m2).items():
+        sub(tensor, key, float_text(value))
     return node
 
 

@@ -20,13 +20,12 @@ from lxml import etree
 
 from reedtool.io.limits import is_no_limit, urdf_limit_text
 from reedtool.io.xml_numbers import clean_tensor, float_text, pose_values, short_text, vector_text
+from reedtool.model import inertia_values
 
 Number = Callable[[float], str]
 # What a mesh is called in the written file (None: the shape is left out).
 MeshFilename = Callable[[object], "str | None"]
 
-INERTIA_KEYS = (("ixx", (0, 0)), ("ixy", (0, 1)), ("ixz", (0, 2)), ("iyy", (1, 1)),
-                ("iyz", (1, 2)), ("izz", (2, 2)))
 LIMITED_TYPES = ("revolute", "prismatic", "continuous")
 
 
@@ -52,8 +51,7 @@ def inertial_element(parent, mass_kg: float, T_link_com: np.ndarray, inertia_kg_
 
 def inertia_attributes(inertia_kg_m2, number: Number = float_text) -> dict[str, str]:
     """The six attributes of <inertia> for a 3x3 tensor."""
-    I = np.asarray(inertia_kg_m2, dtype=float)
-    return {key: number(I[i, j]) for key, (i, j) in INERTIA_KEYS}
+    return {key: number(value) for key, value in inertia_values(inertia_kg_m2).items()}
 
 
 def inertia_text(inertia_kg_m2) -> str:

@@ -39,6 +39,7 @@ from reedtool.model import (
     SourceLoc,
     Visual,
     XmlNode,
+    inertia_values,
 )
 from reedtool.port.gz_sensors import SENSOR_KINDS, sensor_kind, sensor_plugin_why, split_name
 
@@ -353,10 +354,8 @@ def _structure(robot: Robot):
         carried = {}
         if link.inertial is not None:
             carried["mass"] = float_text(link.inertial.mass_kg)
-            I = link.inertial.inertia_kg_m2
-            carried.update({key: float_text(I[i, j]) for key, (i, j) in (
-                ("ixx", (0, 0)), ("ixy", (0, 1)), ("ixz", (0, 2)), ("iyy", (1, 1)),
-                ("iyz", (1, 2)), ("izz", (2, 2)))})
+            carried.update({key: float_text(value) for key, value in
+                            inertia_values(link.inertial.inertia_kg_m2).items()})
         rows.append(PortRow(link.loc, f"link {link.name}", "mapped", f"link {link.name}",
                             "posed relative to its parent link" if parent else "the root link",
                             carried, target_key=("link", link.name)))
