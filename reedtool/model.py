@@ -93,6 +93,8 @@ class Collision:
 
 
 INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+INERTIA_INDEX = {"ixx": (0, 0), "ixy": (0, 1), "ixz": (0, 2), "iyy": (1, 1), "iyz": (1, 2),
+                 "izz": (2, 2)}
 
 
 def inertia_tensor(values: dict[str, float]) -> np.ndarray:
@@ -100,6 +102,12 @@ def inertia_tensor(values: dict[str, float]) -> np.ndarray:
     return np.array([[values["ixx"], values["ixy"], values["ixz"]],
                      [values["ixy"], values["iyy"], values["iyz"]],
                      [values["ixz"], values["iyz"], values["izz"]]], dtype=float)
+
+
+def inertia_values(inertia_kg_m2) -> dict[str, float]:
+    """URDF/SDF's six numbers of a 3x3 tensor (keys INERTIA_KEYS): inertia_tensor's inverse."""
+    I = np.asarray(inertia_kg_m2, dtype=float)
+    return {key: float(I[INERTIA_INDEX[key]]) for key in INERTIA_KEYS}
 
 
 @dataclass(eq=False)  # identity: fields hold numpy arrays

@@ -210,3 +210,22 @@ def body_count(path: Path | str, model_dirs=()) -> int:
 
 # Drake logs every ignored <plugin>/<sensor> as a warning; the tests care about refusals.
 logging.getLogger("drake").setLevel(logging.ERROR)
+
+
+def mass_properties_text(text: str) -> dict[str, tuple[float, object, object]]:
+    """{link name: (mass, COM in the link frame, 3x3 inertia about the COM in link axes)}
+    as Drake builds its plant from SDF text through libsdformat (the world body left out)."""
+    import numpy as np
+
+    parser, plant = _parser(())
+    parser.AddModelsFromString(text, "sdf")
+    plant.Finalize()
+    out = {}
+    for index in range(1, plant.num_bodies()):
+        body = plant.get_body(type(plant.world_body().index())(index))
+        M = body.default_spatial_inertia()
+        c = np.asarray(M.get_com())
+        mass = M.get_mass()
+        I_Bo = M.CalcRotationalInertia().CopyToFullMatrix3()
+        out[body.name()] = (mass, c, I_Bo - mass * (c @ c * np.eye(3) - np.outer(c, c)))
+    return out

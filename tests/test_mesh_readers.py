@@ -168,3 +168,52 @@ def test_dae_nested_nodes_and_library_node_instances():
     assert len(dae.triangles) == 24
     # Nested node transforms of whole numbers: a few ulps; default rel 1e-6 is a ceiling.
     assert extent(dae.triangles_m) == pytest.approx([5.0, 1.0, 1.0])
+
+
+# ------------------------------------------------------------ one loader table
+
+def test_the_loader_table_reads_what_gazebo_classic_loads_and_says_what_was_declared(tmp_path):
+    """Every format Gazebo Classic loads has a light reader in the table; one return type
+    says what the file declared (COLLADA's unit and up axis) and which file it was."""
+    from mesh_helpers import write_stl
+
+    from reedtool.io.meshes import CLASSIC_MESH_SUFFIXES, LIGHT_SUFFIXES, MESH_READERS, MeshFile
+
+    assert set(CLASSIC_MESH_SUFFIXES) <= set(MESH_READERS) and LIGHT_SUFFIXES == tuple(MESH_READERS)
+    box = box_triangles((1, 2, 3))
+    files = {"stl": write_stl(tmp_path / "b.stl", box), "obj": write_obj(tmp_path / "b.obj", box),
+             "dae": write_dae(tmp_path / "b.dae", box_triangles((1000, 2000, 3000)), meter=0.001,
+                              up_axis="Z_UP")}
+    for kind, path in files.items():
+        read = read_mesh(path)
+        assert isinstance(read, MeshFile) and read.source == path
+        # The same 1 x 2 x 3 m box, in metres as Gazebo sizes it: mm * 0.001, a few ulps.
+        assert extent(read.triangles_m) == pytest.approx([1, 2, 3], rel=1e-12), kind
+    dae = read_mesh(files["dae"])
+    assert (dae.unit_declared, dae.metres_per_unit, dae.up_axis) == (True, 0.001, "Z_UP")
+    assert read_mesh(files["stl"]).up_axis is None       # STL declares no axis
+
+
+def test_no_module_reads_a_mesh_file_past_the_table():
+    """Only io/meshes.py (through its table) and the format readers it names open mesh
+    files: a second path would read the same file differently (units, refusals, cache)."""
+    import ast
+
+    readers = {"read_stl", "parse_stl", "read_dae", "parse_dae", "read_obj", "parse_obj",
+               "load_mesh", "load"}
+    allowed = {Path("reedtool/io/meshes.py"), Path("reedtool/io/stl.py"),
+               Path("reedtool/io/dae.py"), Path("reedtool/io/obj.py")}
+    found = []
+    for path in sorted((ROOT / "reedtool").rglob("*.py")):
+        relative = path.relative_to(ROOT)
+        if relative in allowed:
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.module in (
+                    "reedtool.io.stl", "reedtool.io.dae", "reedtool.io.obj"):
+                found += [f"{relative}: imports {a.name}" for a in node.names
+                          if a.name in readers]
+            if isinstance(node, ast.Attribute) and node.attr in ("load", "load_mesh") \
+                    and isinstance(node.value, ast.Name) and node.value.id == "trimesh":
+                found.append(f"{relative}:{node.lineno}: trimesh.{node.attr}")
+    assert found == []

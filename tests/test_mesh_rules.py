@@ -224,7 +224,7 @@ def test_seed_001_inertias_exit_1_from_validate_and_inertia():
 
 
 def test_workspace_dirs_are_not_system_dirs():
-    from reedtool.io.meshes import uri_problem
+    from reedtool.resolve.references import uri_problem
 
     for uri in ("file:///root/ws/src/pkg/meshes/a.stl", "/var/lib/jenkins/ws/meshes/a.dae",
                 "file:///opt/ros/noetic/share/pkg/meshes/a.dae", "/usr/share/pkg/a.obj"):

@@ -303,7 +303,8 @@ class CheckContext:
         key = str(mesh.path)
         if key not in self._mesh_files:
             from reedtool.errors import ReedtoolError
-            from reedtool.io.meshes import LIGHT_SUFFIXES, read_mesh, uri_problem
+            from reedtool.io.meshes import LIGHT_SUFFIXES, read_mesh
+            from reedtool.resolve.references import uri_problem
 
             if mesh.path.suffix.lower() not in LIGHT_SUFFIXES or not mesh.path.is_file() \
                     or uri_problem(mesh.uri, mesh.path):

@@ -243,7 +243,7 @@ def file_uri_absolute(ctx: CheckContext) -> Iterator[Issue]:
 
     Severity (warning, suspicious): the model loads here; elsewhere it does not.
     """
-    from reedtool.io.meshes import machine_path, uri_problem
+    from reedtool.resolve.references import machine_path, uri_problem
     from reedtool.checks.structure import mesh_shapes
 
     hint = ("copy the file into the package and name it package://PKG/... or "

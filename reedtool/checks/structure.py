@@ -334,7 +334,8 @@ def mesh_shapes(ctx: CheckContext) -> Iterator[tuple]:
 
 def _refused(ctx: CheckContext, mesh: Mesh) -> bool:
     """Reported by S131 or S130: no point saying it is also missing or unreadable."""
-    from reedtool.io.meshes import format_problem, uri_problem
+    from reedtool.io.meshes import format_problem
+    from reedtool.resolve.references import uri_problem
 
     return bool(uri_problem(mesh.uri, mesh.path) or format_problem(mesh.uri, ctx.simulator))
 
@@ -510,7 +511,8 @@ def mesh_format_unsupported(ctx: CheckContext) -> Iterator[Issue]:
 
     Severity (error, refused): the simulator's mesh loader does not read the format.
     """
-    from reedtool.io.meshes import format_problem, uri_problem
+    from reedtool.io.meshes import format_problem
+    from reedtool.resolve.references import uri_problem
 
     for link, kind, shape, mesh in mesh_shapes(ctx):
         if uri_problem(mesh.uri, mesh.path):
@@ -534,7 +536,7 @@ def mesh_uri_escapes(ctx: CheckContext) -> Iterator[Issue]:
     Severity (warning): Gazebo follows the path and loads the model on this machine; the
     reference is suspicious, not refused.
     """
-    from reedtool.io.meshes import uri_problem
+    from reedtool.resolve.references import uri_problem
 
     for link, kind, shape, mesh in mesh_shapes(ctx):
         problem = uri_problem(mesh.uri, mesh.path)

@@ -70,3 +70,14 @@ def sdf_limit_text(tag: str, value: float | None) -> str | None:
             else 1.0
         return f"{sign * SDF_NO_POSITION_LIMIT:g}"
     return "0" if value == 0 else repr(float(value))
+
+
+def urdf_limit_text(tag: str, value: float | None, number=repr) -> str | None:
+    """The text URDF writes for a joint limit attribute, or None to leave it out (absent in
+    the source: urdfdom reads 0 for lower/upper, as it did there). urdfdom refuses `inf`, so
+    "no limit" is written as sdformat's -+1e16, which both readers take as none."""
+    if value is None or math.isnan(value):
+        return None
+    if abs(value) >= NO_LIMIT_BEYOND:
+        return f"{math.copysign(SDF_NO_POSITION_LIMIT, value):g}"
+    return number(value)

@@ -1,6 +1,9 @@
 """Any mesh file as triangles, refused when nothing sensible can be computed from it.
 
-STL, COLLADA and OBJ are read here with light readers (numpy, lxml): `validate` needs their
+One loader table, `MESH_READERS` (suffix -> reader), and one return type, `MeshFile`: every
+caller (validate's mesh checks, inertia, the view and layout pictures, import-stl and
+new-package --mesh) reads meshes through `read_mesh`. STL, COLLADA and OBJ are read with
+light readers (numpy, lxml: io/stl.py, io/dae.py, io/obj.py): `validate` needs their
 extents and units and must not pay for trimesh/scipy. Other formats go through trimesh.
 """
 
@@ -8,17 +11,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
 from reedtool.errors import ReedtoolError
-from reedtool.io.stl import read_stl
 
 # What each simulator's mesh loader reads (gazebo classic: common::MeshManager; gz-sim:
 # gz-common's MeshManager, which adds glTF/GLB and FBX through assimp).
 CLASSIC_MESH_SUFFIXES = (".stl", ".dae", ".obj")
 GZ_MESH_SUFFIXES = CLASSIC_MESH_SUFFIXES + (".glb", ".gltf", ".fbx")
-LIGHT_SUFFIXES = (".stl", ".dae", ".obj")
 
 
 @dataclass
@@ -28,6 +30,8 @@ class MeshFile:
     format: str                     # stl-binary | stl-ascii | dae | obj | other
     unit_declared: bool = False     # the file states its unit (COLLADA)
     notes: list[str] = field(default_factory=list)
+    up_axis: str | None = None      # what the file declares (COLLADA), already applied
+    source: Path | None = None      # the file read
 
     @property
     def triangles_m(self) -> np.ndarray:
@@ -90,32 +94,28 @@ def read_mesh(path: str | Path) -> MeshFile:
     return found
 
 
-def _read_mesh(path: Path) -> MeshFile:
-    suffix = path.suffix.lower()
-    if suffix == ".stl":
-        stl = read_stl(path)
-        return MeshFile(stl.triangles, 1.0, f"stl-{stl.format}", notes=list(stl.notes))
-    if suffix == ".dae":
-        from reedtool.io.dae import read_dae
+def _read_stl(path: Path) -> MeshFile:
+    from reedtool.io.stl import read_stl
 
-        dae = read_dae(path)
-        return MeshFile(dae.triangles, dae.metres_per_unit, "dae", dae.unit_declared, dae.notes)
-    if suffix == ".obj":
-        from reedtool.io.obj import read_obj
-
-        return MeshFile(read_obj(path), 1.0, "obj")
-    return MeshFile(_load_with_trimesh(path), 1.0, "other")
+    stl = read_stl(path)
+    return MeshFile(stl.triangles, 1.0, f"stl-{stl.format}", notes=list(stl.notes))
 
 
-def load_triangles(path: str | Path) -> np.ndarray:
-    """Any mesh file as (n, 3, 3) triangles in metres as Gazebo reads it (COLLADA <unit>
-    applied, `<mesh scale>` not), checked for content mass properties can be computed from."""
-    triangles = read_mesh(path).triangles_m
-    check_triangles(triangles, path)
-    return triangles
+def _read_dae(path: Path) -> MeshFile:
+    from reedtool.io.dae import read_dae
+
+    dae = read_dae(path)
+    return MeshFile(dae.triangles, dae.metres_per_unit, "dae", dae.unit_declared, dae.notes,
+                    up_axis=dae.up_axis)
 
 
-def _load_with_trimesh(path: Path) -> np.ndarray:
+def _read_obj(path: Path) -> MeshFile:
+    from reedtool.io.obj import read_obj
+
+    return MeshFile(read_obj(path), 1.0, "obj")
+
+
+def _read_with_trimesh(path: Path) -> MeshFile:
     import trimesh
 
     from reedtool.io.fileio import MAX_MESH_BYTES, open_regular_input
@@ -128,7 +128,32 @@ def _load_with_trimesh(path: Path) -> np.ndarray:
                             file=path, hint="export it as STL") from exc
     faces = np.asarray(getattr(loaded, "faces", np.zeros((0, 3))), dtype=np.int64)
     vertices = np.asarray(getattr(loaded, "vertices", np.zeros((0, 3))), dtype=np.float64)
-    return vertices[faces] if len(faces) else np.zeros((0, 3, 3))
+    return MeshFile(vertices[faces] if len(faces) else np.zeros((0, 3, 3)), 1.0, "other")
+
+
+# The loader table: file suffix (lower case) -> reader. These are the light readers
+# validate runs; any other suffix is read by `OTHER_READER` (trimesh).
+MESH_READERS: dict[str, Callable[[Path], MeshFile]] = {
+    ".stl": _read_stl,
+    ".dae": _read_dae,
+    ".obj": _read_obj,
+}
+OTHER_READER: Callable[[Path], MeshFile] = _read_with_trimesh
+LIGHT_SUFFIXES = tuple(MESH_READERS)
+
+
+def _read_mesh(path: Path) -> MeshFile:
+    read = MESH_READERS.get(path.suffix.lower(), OTHER_READER)(path)
+    read.source = path
+    return read
+
+
+def load_triangles(path: str | Path) -> np.ndarray:
+    """Any mesh file as (n, 3, 3) triangles in metres as Gazebo reads it (COLLADA <unit>
+    applied, `<mesh scale>` not), checked for content mass properties can be computed from."""
+    triangles = read_mesh(path).triangles_m
+    check_triangles(triangles, path)
+    return triangles
 
 
 @dataclass
@@ -183,65 +208,7 @@ def check_triangles(triangles: np.ndarray, source: str | Path) -> MeshCheck:
     return MeshCheck(len(triangles), zero_area, total_area, extent)
 
 
-# ------------------------------------------------------------ mesh references
-
-# Where no model's mesh belongs: reading them is a leak (a model shared as a package that
-# makes the simulator open /etc/passwd), and they hold no mesh anyway. Deliberately short:
-# workspaces do live under /root, /var/lib/jenkins, /opt or /usr/share.
-SYSTEM_DIRS = ("/etc", "/proc", "/sys", "/dev", "/boot", "/bin", "/sbin", "/usr/bin",
-               "/usr/sbin")
-
-
-def _package_relative(text: str) -> tuple[bool, str | None]:
-    """(whether `text` is a `package://` or `model://` path, the path within the package
-    when it climbs out of it with `..` or starts at `/`, else None)."""
-    import posixpath
-
-    for scheme in ("package://", "model://"):
-        if text.startswith(scheme):
-            _name, _, rel = text[len(scheme):].partition("/")
-            normal = posixpath.normpath(rel) if rel else ""
-            climbs = normal == ".." or normal.startswith("../") or rel.startswith("/")
-            return True, rel if climbs else None
-    return False, None
-
-
-def uri_problem(uri: str, path: Path | None = None) -> str | None:
-    """Why a mesh reference must not be followed, or None.
-
-    A `package://` or `model://` path that climbs out of its package with `..`, and any
-    reference (`file://`, absolute, or what a package path resolves to) inside a system
-    directory.
-    """
-    import posixpath
-    from urllib.parse import unquote, urlparse
-
-    text = unquote(uri.strip())
-    _package_path, climbing = _package_relative(text)
-    if climbing is not None:
-        return f"the path climbs out of its package ('{climbing}')"
-    if text.startswith("file://"):
-        text = urlparse(text).path
-    candidates = [posixpath.normpath(text)] if text.startswith("/") else []
-    if path is not None:
-        candidates.append(posixpath.normpath(str(path)))
-    for candidate in candidates:
-        for system in SYSTEM_DIRS:
-            if candidate == system or candidate.startswith(system + "/"):
-                return f"it points into the system directory {system}"
-    return None
-
-
-def machine_path(uri: str) -> str | None:
-    """The absolute path an absolute `file://` URI or plain absolute path names, else None
-    (`package://`, `model://`, relative paths and URLs travel with the model)."""
-    from urllib.parse import unquote, urlparse
-
-    text = unquote(uri.strip())
-    if text.startswith("file://"):
-        text = urlparse(text).path
-    return text if text.startswith("/") else None
-
+# ------------------------------------------------------------ formats Gazebo loads
 
 def format_problem(uri: str, simulator: str) -> str | None:
     """Why Gazebo cannot load this mesh file format, or None.
@@ -260,46 +227,3 @@ def format_problem(uri: str, simulator: str) -> str | None:
         return f"{which} does not load {suffix} meshes (gz-sim does)"
     return (f"{which} does not load {suffix} files (it loads "
             f"{', '.join(s.lstrip('.').upper() for s in allowed)})")
-
-
-# ------------------------------------------------------------ files from outside
-
-# What marks the root of a model's own files: a ROS package or a Gazebo model directory.
-PACKAGE_MARKERS = ("package.xml", "model.config")
-
-
-def package_root(file: str | Path) -> Path | None:
-    """The ROS package or Gazebo model directory holding `file` (the nearest ancestor with
-    a package.xml or model.config), None when there is none."""
-    for directory in Path(file).resolve().parents:
-        if any((directory / marker).is_file() for marker in PACKAGE_MARKERS):
-            return directory
-    return None
-
-
-def outside_reason(uri: str, path: Path | None, referencing_file: str | Path,
-                   default_root: Path) -> str | None:
-    """Why the mesh file `path` (resolved from `uri`, named in `referencing_file`) lies
-    outside the model's packages, or None when it is one of the model's own files.
-
-    `package://` and `model://` references stay inside the package they name unless they
-    climb out of it with `..`; any other reference (absolute, `file://`, relative) is
-    inside when the file lies in the package or model directory of the file naming it,
-    else in `default_root` (the model directory the user gave)."""
-    from urllib.parse import unquote
-
-    if path is None:
-        return None
-    text = unquote(uri.strip())
-    package_path, climbing = _package_relative(text)
-    if climbing is not None:
-        return f"'{uri}' climbs out of its package"
-    if package_path:
-        return None
-    root = package_root(referencing_file) or Path(default_root).resolve()
-    real = Path(path).resolve()
-    if real == root or root in real.parents:
-        return None
-    how = "an absolute reference" if text.startswith(("file://", "/")) else \
-        "a relative path that climbs out"
-    return f"{how} to {real}, outside the model's package {root}"

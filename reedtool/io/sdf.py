@@ -59,15 +59,14 @@ import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 from lxml import etree
 
 from reedtool.errors import ReedtoolError
 from reedtool.io.fileio import magnitude_problem
-from reedtool.frames import make_T, matrix_to_rpy, rpy_to_matrix
-from reedtool.io.meshes import machine_path
+from reedtool.frames import make_T, rpy_to_matrix
+from reedtool.resolve.references import machine_path
 from reedtool.resolve.resources import REMOTE_NOT_CHECKED, is_remote_uri, resolve_model_file_uri
 from reedtool.io.sdf_include import SourceFile, SourceMap, expand_includes
 from reedtool.io.sdf_refusals import document_refusals, parse_version
@@ -77,6 +76,7 @@ from reedtool.io.tolerant_xml import (
     parse_tolerant,
     tolerated_message,
 )
+from reedtool.io.urdf_write import equivalent_urdf
 from reedtool.model import (
     INERTIA_KEYS,
     Box,
@@ -770,66 +770,3 @@ class _ModelReader:
         if sdf_type == "continuous" or (sdf_type == "revolute" and unbounded(lower, upper)):
             return "continuous", limit if limit_el is not None else None
         return sdf_type, limit
-
-
-# ------------------------------------------------------------ equivalent URDF
-
-def _fmt(values) -> str:
-    return " ".join(f"{float(v):.12g}" for v in values)
-
-
-def _origin(T: np.ndarray) -> str:
-    return f'<origin xyz="{_fmt(T[:3, 3])}" rpy="{_fmt(matrix_to_rpy(T[:3, :3]))}"/>'
-
-
-def _geometry_xml(geometry) -> str | None:
-    if isinstance(geometry, Box):
-        return f'<box size="{_fmt(geometry.size_m)}"/>'
-    if isinstance(geometry, Cylinder):
-        return f'<cylinder radius="{geometry.radius_m:.12g}" length="{geometry.length_m:.12g}"/>'
-    if isinstance(geometry, Sphere):
-        return f'<sphere radius="{geometry.radius_m:.12g}"/>'
-    if isinstance(geometry, Mesh) and geometry.path is not None:
-        return f'<mesh filename={quoteattr(str(geometry.path))} scale="{_fmt(geometry.scale)}"/>'
-    return None
-
-
-def _limit_number(value: float | None) -> float:
-    return 1e16 if value is None or not math.isfinite(value) else value
-
-
-def equivalent_urdf(robot: Robot) -> str:
-    """A URDF with the same links, inertials, primitive geometry and joints as `robot`."""
-    lines = [f"<robot name={quoteattr(robot.name)}>"]
-    for link in robot.links:
-        lines.append(f"  <link name={quoteattr(link.name)}>")
-        if link.inertial is not None:
-            I = link.inertial.inertia_kg_m2
-            lines.append(
-                f"    <inertial>{_origin(link.inertial.T_link_com)}"
-                f'<mass value="{link.inertial.mass_kg:.12g}"/>'
-                f'<inertia ixx="{I[0, 0]:.12g}" ixy="{I[0, 1]:.12g}" ixz="{I[0, 2]:.12g}" '
-                f'iyy="{I[1, 1]:.12g}" iyz="{I[1, 2]:.12g}" izz="{I[2, 2]:.12g}"/></inertial>')
-        for tag, shapes in (("visual", link.visuals), ("collision", link.collisions)):
-            for shape in shapes:
-                geometry = _geometry_xml(shape.geometry)
-                if geometry:
-                    lines.append(f"    <{tag}>{_origin(shape.T_link_geom)}"
-                                 f"<geometry>{geometry}</geometry></{tag}>")
-        lines.append("  </link>")
-    for joint in robot.joints:
-        if joint.parent is None or joint.child is None:
-            continue
-        lines.append(f"  <joint name={quoteattr(joint.name)} type={quoteattr(joint.type)}>"
-                     f"<parent link={quoteattr(joint.parent)}/>"
-                     f"<child link={quoteattr(joint.child)}/>"
-                     f'{_origin(joint.T_parent_joint)}<axis xyz="{_fmt(joint.axis)}"/>')
-        if joint.limit is not None and joint.type in ("revolute", "prismatic", "continuous"):
-            lim = joint.limit
-            bounds = "" if joint.type == "continuous" else \
-                f'lower="{_limit_number(lim.lower):.12g}" upper="{_limit_number(lim.upper):.12g}" '
-            lines.append(f'    <limit {bounds}effort="{_limit_number(lim.effort):.12g}" '
-                         f'velocity="{_limit_number(lim.velocity):.12g}"/>')
-        lines.append("  </joint>")
-    lines.append("</robot>")
-    return "\n".join(lines) + "\n"

@@ -14,32 +14,24 @@ from pathlib import Path
 
 import numpy as np
 
-INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
-_INDEX = {"ixx": (0, 0), "ixy": (0, 1), "ixz": (0, 2), "iyy": (1, 1), "iyz": (1, 2),
-          "izz": (2, 2)}
+from reedtool.model import INERTIA_INDEX, INERTIA_KEYS
+
 _ATTR = re.compile(r'([A-Za-z_:][\w:.-]*)\s*=\s*"([^"]*)"')
 _INERTIA = re.compile(r"<inertia\b([^>]*?)/>", re.S)
 _PROPERTY = re.compile(r'<xacro:property\b([^>]*?)(/?)>', re.S)
-
-
-def package_root(path: Path) -> Path | None:
-    """The nearest directory at or above `path` that holds a package.xml."""
-    for directory in [Path(path).resolve().parent, *Path(path).resolve().parents]:
-        if (directory / "package.xml").is_file():
-            return directory
-    return None
 
 
 def users_file(candidate: str | Path, model: str | Path) -> bool:
     """`candidate` is in the model's own package (its directory tree when it has none),
     and not inside reedtool's install."""
     import reedtool
+    from reedtool.resolve.packages import enclosing_package
 
     candidate = Path(candidate).resolve()
     install = Path(reedtool.__file__).resolve().parent
     if candidate.is_relative_to(install):
         return False
-    root = package_root(Path(model)) or Path(model).resolve().parent
+    root = enclosing_package(Path(model)) or Path(model).resolve().parent
     return candidate.is_relative_to(root)
 
 
@@ -72,7 +64,7 @@ def inertia_elements_matching(text: str, tensor_kg_m2, rtol: float = 1e-6) -> li
         values = _numbers(match.group(1))
         if values is None:
             continue
-        if all(abs(values[key] - tensor[_INDEX[key]]) <= rtol * scale for key in INERTIA_KEYS):
+        if all(abs(values[key] - tensor[INERTIA_INDEX[key]]) <= rtol * scale for key in INERTIA_KEYS):
             found.append(Span(match.start(), match.end(), _line(text, match.start())))
     return found
 

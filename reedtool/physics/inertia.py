@@ -16,6 +16,7 @@ from typing import Iterable, Iterator
 import numpy as np
 
 from reedtool.errors import ReedtoolError
+from reedtool.io.xml_numbers import clean_tensor, short_text as fmt_number  # noqa: F401 - re-exported
 from reedtool.model import Box, Cylinder, Link, Mesh, Robot, Sphere
 
 # ------------------------------------------------------------ the value object
@@ -491,44 +492,20 @@ def relative_difference(declared, reference) -> float:
 
 
 # ------------------------------------------------------------- URDF text
+# The numbers and <inertial> a person reads or pastes: written by io/urdf_write.py.
 
-def fmt_number(value: float) -> str:
-    """Shortest text that round-trips to 10 significant digits (no '-0', no '1e-05' surprises)."""
-    value = float(value)
-    if value == 0.0:
-        return "0"
-    return f"{value:.10g}"
-
-
-def clean_tensor(inertia_kg_m2, rel: float = 1e-12) -> np.ndarray:
-    """Symmetrised tensor with round-off-sized entries (relative to its largest) set to 0."""
-    I = np.asarray(inertia_kg_m2, dtype=float)
-    I = (I + I.T) / 2.0
-    scale = float(np.max(np.abs(I))) if I.size else 0.0
-    return np.where(np.abs(I) <= rel * scale, 0.0, I) + 0.0   # + 0.0 turns -0.0 into 0.0
-
-
-def inertial_xml(props: MassProperties, indent: str = "  ", rpy: str = "0 0 0") -> str:
+def inertial_xml(props: MassProperties, indent: str = "  ") -> str:
     """An <inertial> element: mass, COM origin and the tensor about the COM in link axes."""
-    I = clean_tensor(props.inertia_kg_m2)
-    xyz = " ".join(fmt_number(v) for v in props.com_m)
-    return (
-        f"{indent}<inertial>\n"
-        f"{indent}  <origin xyz=\"{xyz}\" rpy=\"{rpy}\"/>\n"
-        f"{indent}  <mass value=\"{fmt_number(props.mass_kg)}\"/>\n"
-        f"{indent}  <inertia ixx=\"{fmt_number(I[0, 0])}\" ixy=\"{fmt_number(I[0, 1])}\" "
-        f"ixz=\"{fmt_number(I[0, 2])}\" iyy=\"{fmt_number(I[1, 1])}\" "
-        f"iyz=\"{fmt_number(I[1, 2])}\" izz=\"{fmt_number(I[2, 2])}\"/>\n"
-        f"{indent}</inertial>"
-    )
+    from reedtool.io.urdf_write import inertial_text
+
+    return inertial_text(props.mass_kg, props.com_m, props.inertia_kg_m2, indent=indent)
 
 
 def inertia_element(inertia_kg_m2) -> str:
     """An <inertia .../> element for a tensor (in the link axes), as inertial_xml writes it."""
-    I = clean_tensor(inertia_kg_m2)
-    return (f"<inertia ixx=\"{fmt_number(I[0, 0])}\" ixy=\"{fmt_number(I[0, 1])}\" "
-            f"ixz=\"{fmt_number(I[0, 2])}\" iyy=\"{fmt_number(I[1, 1])}\" "
-            f"iyz=\"{fmt_number(I[1, 2])}\" izz=\"{fmt_number(I[2, 2])}\" />")
+    from reedtool.io.urdf_write import inertia_text
+
+    return inertia_text(inertia_kg_m2)
 
 
 # ------------------------------------------------- declared vs geometry, per link

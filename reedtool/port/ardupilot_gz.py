@@ -28,7 +28,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from reedtool.errors import ReedtoolError
-from reedtool.port.gz_port import Element, GzPort, float_text
+from reedtool.io.xml_numbers import float_text
+from reedtool.port.gz_port import Element, GzPort
 
 ARDUPILOT_PLUGIN = ("ArduPilotPlugin", "ArduPilotPlugin")
 LIFT_DRAG = ("gz-sim-lift-drag-system", "gz::sim::systems::LiftDrag")

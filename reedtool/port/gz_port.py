@@ -28,6 +28,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from reedtool.io.sdf_write import pose_text
+from reedtool.io.xml_numbers import float_text
 from reedtool.model import (
     MOTOR_PLUGINS,
     Collision,
@@ -37,6 +39,7 @@ from reedtool.model import (
     SourceLoc,
     Visual,
     XmlNode,
+    inertia_values,
 )
 from reedtool.port.gz_sensors import SENSOR_KINDS, sensor_kind, sensor_plugin_why, split_name
 
@@ -260,7 +263,7 @@ class GzPort:
     # Sensors a port renames and moves on purpose: original name -> (name, link) in the
     # port (PX4's contract: its four on base_link, posed where they were).
     moved_sensors: dict[str, tuple[str, str]] = field(default_factory=dict)
-    # Mesh URIs whose file lies outside the model's packages -> why (io.meshes.outside_reason);
+    # Mesh URIs whose file lies outside the model's packages -> why (resolve.references.outside_reason);
     # they are referenced where they are, not copied, unless copy_outside_files.
     outside_files: dict[str, str] = field(default_factory=dict)
     copy_outside_files: bool = False
@@ -351,10 +354,8 @@ def _structure(robot: Robot):
         carried = {}
         if link.inertial is not None:
             carried["mass"] = float_text(link.inertial.mass_kg)
-            I = link.inertial.inertia_kg_m2
-            carried.update({key: float_text(I[i, j]) for key, (i, j) in (
-                ("ixx", (0, 0)), ("ixy", (0, 1)), ("ixz", (0, 2)), ("iyy", (1, 1)),
-                ("iyz", (1, 2)), ("izz", (2, 2)))})
+            carried.update({key: float_text(value) for key, value in
+                            inertia_values(link.inertial.inertia_kg_m2).items()})
         rows.append(PortRow(link.loc, f"link {link.name}", "mapped", f"link {link.name}",
                             "posed relative to its parent link" if parent else "the root link",
                             carried, target_key=("link", link.name)))
@@ -450,20 +451,6 @@ def _resolve_link(name: str | None, fold, by_name) -> tuple[str | None, np.ndarr
     if key is None:
         return None, np.eye(4)
     return fold[key]
-
-
-def pose_text(T: np.ndarray) -> str:
-    """A 4x4 transform as SDF `<pose>` text: x y z roll pitch yaw, each as `float_text`."""
-    from reedtool.frames import matrix_to_rpy
-
-    values = [*T[:3, 3], *matrix_to_rpy(T[:3, :3])]
-    return " ".join(float_text(v) for v in values)
-
-
-def float_text(value: float) -> str:
-    """Shortest text that reads back as the same float; -0 written as 0."""
-    value = float(value)
-    return "0" if value == 0 else repr(value)
 
 
 def _gazebo_element(port: GzPort, reference: str | None, node: XmlNode, fold, by_name) -> None:

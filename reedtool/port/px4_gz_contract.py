@@ -306,38 +306,32 @@ def px4_world_sdf(world_name: str) -> bytes:
     spherical coordinates and the magnetic field of PX4's default world, no vehicle."""
     from lxml import etree
 
-    root = etree.Element("sdf", version="1.9")
+    from reedtool.io.sdf_write import (
+        SDF_VERSION,
+        ground_plane_element,
+        physics_element,
+        sdf_bytes,
+        sub,
+        sun_element,
+    )
+
+    root = etree.Element("sdf", version=SDF_VERSION)
     root.append(etree.Comment(
         f" {world_name}: a world for PX4 SITL, written by reedtool. PX4 spawns the vehicle "
         f"(PX4_SIM_MODEL) into it; PX4_GZ_WORLD={world_name}. "))
-    world = etree.SubElement(root, "world", name=world_name)
-    physics = etree.SubElement(world, "physics", name="4ms", type="ignored")
-    # PX4's default world steps 4 ms, the rate its IMU and lockstep expect (250 Hz).
-    etree.SubElement(physics, "max_step_size").text = "0.004"
-    etree.SubElement(physics, "real_time_factor").text = "1.0"
-    etree.SubElement(world, "gravity").text = "0 0 -9.8"
-    etree.SubElement(world, "magnetic_field").text = MAGNETIC_FIELD_T
-    etree.SubElement(world, "atmosphere", type="adiabatic")
+    world = sub(root, "world", name=world_name)
+    physics_element(world)      # PX4's default world steps 4 ms (its IMU, lockstep: 250 Hz)
+    sub(world, "gravity", "0 0 -9.8")
+    sub(world, "magnetic_field", MAGNETIC_FIELD_T)
+    sub(world, "atmosphere", type="adiabatic")
     for filename, name in WORLD_SYSTEMS:
-        etree.SubElement(world, "plugin", filename=filename, name=name)
-    light = etree.SubElement(world, "light", type="directional", name="sun")
-    etree.SubElement(light, "cast_shadows").text = "true"
-    etree.SubElement(light, "pose").text = "0 0 10 0 0 0"
-    etree.SubElement(light, "diffuse").text = "0.8 0.8 0.8 1"
-    etree.SubElement(light, "direction").text = "-0.5 0.1 -0.9"
-    ground = etree.SubElement(world, "model", name="ground_plane")
-    etree.SubElement(ground, "static").text = "true"
-    link = etree.SubElement(ground, "link", name="link")
-    for kind in ("collision", "visual"):
-        element = etree.SubElement(link, kind, name=kind)
-        plane = etree.SubElement(etree.SubElement(element, "geometry"), "plane")
-        etree.SubElement(plane, "normal").text = "0 0 1"
-        etree.SubElement(plane, "size").text = "100 100"
-    spherical = etree.SubElement(world, "spherical_coordinates")
+        sub(world, "plugin", filename=filename, name=name)
+    sun_element(world)
+    ground_plane_element(world)
+    spherical = sub(world, "spherical_coordinates")
     for tag, text in SPHERICAL_COORDINATES:
-        etree.SubElement(spherical, tag).text = text
-    etree.indent(root, space="  ")
-    return etree.tostring(root, xml_declaration=True, encoding="utf-8", pretty_print=True)
+        sub(spherical, tag, text)
+    return sdf_bytes(root)
 
 
 def readme_text(name: str, tool: str) -> str:

@@ -20,9 +20,19 @@ import numpy as np
 from lxml import etree
 
 from reedtool.io.limits import sdf_limit_text
-from reedtool.port.gz_port import Element, GzPort, PortRow, float_text, pose_text
-
-SDF_VERSION = "1.9"
+from reedtool.io.sdf_write import (
+    SDF_VERSION,
+    geometry_element,
+    ground_plane_element,
+    inertial_element,
+    physics_element,
+    pose_text,
+    sdf_bytes,
+    sub,
+    sun_element,
+)
+from reedtool.io.xml_numbers import float_text
+from reedtool.port.gz_port import Element, GzPort, PortRow
 
 
 @dataclass
@@ -47,13 +57,6 @@ def to_xml(element: Element, parent=None):
     return node
 
 
-def _sub(parent, tag: str, text: object | None = None, **attrib: str):
-    node = etree.SubElement(parent, tag, attrib)
-    if text is not None:
-        node.text = str(text)
-    return node
-
-
 def _inertial(parent, inertials) -> None:
     """One <inertial>: the part as written, or the folded parts combined about their COM."""
     from reedtool.physics.inertia import combine_inertials
@@ -70,32 +73,7 @@ def _inertial(parent, inertials) -> None:
         T_link_com = np.eye(4)
         T_link_com[:3, 3] = total.com_m
         inertia, mass = total.inertia_kg_m2, total.mass_kg
-    node = _sub(parent, "inertial")
-    _sub(node, "pose", pose_text(T_link_com))
-    _sub(node, "mass", float_text(mass))
-    tensor = _sub(node, "inertia")
-    for key, (i, j) in (("ixx", (0, 0)), ("ixy", (0, 1)), ("ixz", (0, 2)), ("iyy", (1, 1)),
-                        ("iyz", (1, 2)), ("izz", (2, 2))):
-        _sub(tensor, key, float_text(inertia[i, j]))
-
-
-def _geometry(parent, geometry, mesh_uris: dict[str, str]) -> None:
-    from reedtool.model import Box, Cylinder, Mesh, Sphere
-
-    node = _sub(parent, "geometry")
-    if isinstance(geometry, Box):
-        _sub(_sub(node, "box"), "size", " ".join(float_text(v) for v in geometry.size_m))
-    elif isinstance(geometry, Cylinder):
-        cylinder = _sub(node, "cylinder")
-        _sub(cylinder, "radius", float_text(geometry.radius_m))
-        _sub(cylinder, "length", float_text(geometry.length_m))
-    elif isinstance(geometry, Sphere):
-        _sub(_sub(node, "sphere"), "radius", float_text(geometry.radius_m))
-    elif isinstance(geometry, Mesh):
-        mesh = _sub(node, "mesh")
-        _sub(mesh, "uri", mesh_uris[geometry.uri])
-        if not np.array_equal(geometry.scale, np.ones(3)):
-            _sub(mesh, "scale", " ".join(float_text(v) for v in geometry.scale))
+    inertial_element(parent, mass, T_link_com, inertia)
 
 
 def _reference_in_place(uri: str, path: Path, target_dir) -> str:
@@ -176,10 +154,10 @@ class _Scopes:
         if scope not in self.nodes:
             parent = scope_of(scope)
             parent_node = self.node(parent, T_model_first)
-            node = _sub(parent_node, "model", name=local_name(scope, parent))
+            node = sub(parent_node, "model", name=local_name(scope, parent))
             T_parent_scope = np.linalg.inv(self.T_model_scope[parent]) @ T_model_first
             if not np.array_equal(T_parent_scope, np.eye(4)):
-                _sub(node, "pose", pose_text(T_parent_scope))
+                sub(node, "pose", pose_text(T_parent_scope))
             self.nodes[scope] = node
             self.T_model_scope[scope] = T_model_first
         return self.nodes[scope]
@@ -242,7 +220,7 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
     root = etree.Element("sdf", version=SDF_VERSION)
     root.append(etree.Comment(f" {port.name}: ported from {source} by reedtool migrate. "
                               "Constants as the source wrote them; see the migrate report. "))
-    model = _sub(root, "model", name=port.name)
+    model = sub(root, "model", name=port.name)
     T_model_link = _link_poses(port)
     scopes = _Scopes(model, T_model_link)
     written: list[tuple[Element, object]] = []
@@ -250,15 +228,15 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
     for link in port.links:
         scope = scope_of(link.name)
         parent_node = scopes.node(scope, T_model_link[link.name])
-        node = _sub(parent_node, "link", name=local_name(link.name, scope))
+        node = sub(parent_node, "link", name=local_name(link.name, scope))
         nodes[("link", link.name)] = node
         if link.parent is not None and scope_of(link.parent) == scope:
-            _sub(node, "pose", pose_text(link.T_parent_link),
+            sub(node, "pose", pose_text(link.T_parent_link),
                  relative_to=local_name(link.parent, scope))
         elif link.parent is not None or scope:
             T = scopes.pose_in_scope(scope, link.name)
             if not np.array_equal(T, np.eye(4)):
-                _sub(node, "pose", pose_text(T))
+                sub(node, "pose", pose_text(T))
         _inertial(node, link.inertials)
         for kind, shapes in (("collision", link.collisions), ("visual", link.visuals)):
             names: set[str] = set()
@@ -268,10 +246,10 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
                 name = shape.name if shape.name and shape.name not in names else f"{kind}_{index}"
                 name = flat_name(name)
                 names.add(name)
-                element = _sub(node, kind, name=name)
+                element = sub(node, kind, name=name)
                 if not np.array_equal(T_link_geom, np.eye(4)):
-                    _sub(element, "pose", pose_text(T_link_geom))
-                _geometry(element, shape.geometry, mesh_uris)
+                    sub(element, "pose", pose_text(T_link_geom))
+                geometry_element(element, shape.geometry, lambda mesh: mesh_uris[mesh.uri])
         for sensor in link.sensors:
             written.append((sensor, to_xml(sensor, node)))
     for frame in port.frames:
@@ -284,8 +262,8 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
         else:
             name = local_name(frame.name, scope)
         attached = local_name(frame.attached_to, scope)
-        node = _sub(scopes.nodes[scope], "frame", name=name, attached_to=attached)
-        _sub(node, "pose", pose_text(frame.T_link_frame), relative_to=attached)
+        node = sub(scopes.nodes[scope], "frame", name=name, attached_to=attached)
+        sub(node, "pose", pose_text(frame.T_link_frame), relative_to=attached)
     for joint in port.joints:
         scope = scope_of(joint.name)
         if scope in scopes.nodes and _within(joint.parent, scope) and _within(joint.child, scope):
@@ -294,29 +272,29 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
             scope = _common_scope(joint.parent, joint.child)
             name = flat_name(local_name(joint.name, scope))
         sdf_type = {"continuous": "revolute"}.get(joint.type, joint.type)
-        node = _sub(scopes.nodes[scope], "joint", name=name, type=sdf_type)
+        node = sub(scopes.nodes[scope], "joint", name=name, type=sdf_type)
         nodes[("joint", joint.name)] = node
-        _sub(node, "parent", local_name(joint.parent, scope))
-        _sub(node, "child", local_name(joint.child, scope))
+        sub(node, "parent", local_name(joint.parent, scope))
+        sub(node, "child", local_name(joint.child, scope))
         child = local_name(joint.child, scope)
         moved = joint.T_child_jointframe is not None and \
             not np.array_equal(joint.T_child_jointframe, np.eye(4))
         if moved:
             # The joint frame where the source put it (the axis line passes there); the
             # axis stays in the child link frame, as the plan holds it.
-            _sub(node, "pose", pose_text(joint.T_child_jointframe), relative_to=child)
+            sub(node, "pose", pose_text(joint.T_child_jointframe), relative_to=child)
         if joint.type != "fixed":
-            axis = _sub(node, "axis")
-            _sub(axis, "xyz", " ".join(float_text(v) for v in joint.axis),
+            axis = sub(node, "axis")
+            sub(axis, "xyz", " ".join(float_text(v) for v in joint.axis),
                  **({"expressed_in": child} if moved else {}))
-            limit = _sub(axis, "limit")
+            limit = sub(axis, "limit")
             values = (None, None, None, None) if joint.limit is None else joint.limit
             if joint.type == "continuous":      # no position limit; effort/velocity kept
                 values = (None, None, *values[2:])
             for tag, value in zip(("lower", "upper", "effort", "velocity"), values):
                 text = sdf_limit_text(tag, value)
                 if text is not None:
-                    _sub(limit, tag, text)
+                    sub(limit, tag, text)
     for plugin in [*port.plugins, *extra_plugins]:
         scope = _plugin_scope(plugin, scopes.nodes)
         written.append((plugin, to_xml(_unscoped(plugin, scope) if scope else plugin,
@@ -326,8 +304,7 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
     if scoped:
         # libsdformat refuses these from SDF 1.8 on: never write a port Gazebo will not load.
         raise RuntimeError(f"the port would name an element {scoped[0]!r}: a reedtool bug")
-    etree.indent(root, space="  ")
-    data = etree.tostring(root, xml_declaration=True, encoding="utf-8", pretty_print=True)
+    data = sdf_bytes(root)
     reread = etree.fromstring(data)
     tree = root.getroottree()
     lines = {id(element): reread.xpath(tree.getpath(node))[0].sourceline
@@ -339,56 +316,41 @@ def model_sdf(port: GzPort, source: str, mesh_uris: dict[str, str],
 
 def model_config(port: GzPort, source: str) -> bytes:
     root = etree.Element("model")
-    _sub(root, "name", port.name)
-    _sub(root, "version", "1.0")
-    _sub(root, "sdf", "model.sdf", version=SDF_VERSION)
-    _sub(root, "description", f"{port.name}, ported from {source} by reedtool migrate.")
-    etree.indent(root, space="  ")
-    return etree.tostring(root, xml_declaration=True, encoding="utf-8", pretty_print=True)
+    sub(root, "name", port.name)
+    sub(root, "version", "1.0")
+    sub(root, "sdf", "model.sdf", version=SDF_VERSION)
+    sub(root, "description", f"{port.name}, ported from {source} by reedtool migrate.")
+    return sdf_bytes(root)
 
 
 def world_sdf(port: GzPort) -> bytes:
     """A world with the systems the model needs and the model included (model://<name>:
     put the output directory on GZ_SIM_RESOURCE_PATH)."""
     root = etree.Element("sdf", version=SDF_VERSION)
-    world = _sub(root, "world", name=f"{port.name}_world")
-    physics = _sub(world, "physics", name="4ms", type="ignored")
-    # 4 ms steps, as gz-sim's own multicopter examples use with these motor models.
-    _sub(physics, "max_step_size", "0.004")
-    _sub(physics, "real_time_factor", "1.0")
-    _sub(world, "gravity", "0 0 -9.80665")
+    world = sub(root, "world", name=f"{port.name}_world")
+    physics_element(world)
+    sub(world, "gravity", "0 0 -9.80665")
     for filename, name in port.world_systems:
-        _sub(world, "plugin", filename=filename, name=name)
+        sub(world, "plugin", filename=filename, name=name)
     if any(sensor.attrib.get("type") == "navsat" for link in port.links
            for sensor in link.sensors):
         # gz-sim's NavSat system publishes nothing without it.
         from reedtool.port.gz_port import DEFAULT_HOME
 
         latitude, longitude, elevation = port.home or DEFAULT_HOME
-        where = _sub(world, "spherical_coordinates")
-        _sub(where, "surface_model", "EARTH_WGS84")
-        _sub(where, "world_frame_orientation", "ENU")
-        _sub(where, "latitude_deg", float_text(latitude))
-        _sub(where, "longitude_deg", float_text(longitude))
-        _sub(where, "elevation", float_text(elevation))
-        _sub(where, "heading_deg", "0")
-    light = _sub(world, "light", type="directional", name="sun")
-    _sub(light, "cast_shadows", "true")
-    _sub(light, "pose", "0 0 10 0 0 0")
-    _sub(light, "diffuse", "0.8 0.8 0.8 1")
-    _sub(light, "direction", "-0.5 0.1 -0.9")
-    ground = _sub(world, "model", name="ground_plane")
-    _sub(ground, "static", "true")
-    link = _sub(ground, "link", name="link")
-    for kind in ("collision", "visual"):
-        plane = _sub(_sub(_sub(link, kind, name=kind), "geometry"), "plane")
-        _sub(plane, "normal", "0 0 1")
-        _sub(plane, "size", "100 100")
-    include = _sub(world, "include")
-    _sub(include, "uri", f"model://{port.name}")
-    _sub(include, "pose", "0 0 0.3 0 0 0")
-    etree.indent(root, space="  ")
-    return etree.tostring(root, xml_declaration=True, encoding="utf-8", pretty_print=True)
+        where = sub(world, "spherical_coordinates")
+        sub(where, "surface_model", "EARTH_WGS84")
+        sub(where, "world_frame_orientation", "ENU")
+        sub(where, "latitude_deg", float_text(latitude))
+        sub(where, "longitude_deg", float_text(longitude))
+        sub(where, "elevation", float_text(elevation))
+        sub(where, "heading_deg", "0")
+    sun_element(world)
+    ground_plane_element(world)
+    include = sub(world, "include")
+    sub(include, "uri", f"model://{port.name}")
+    sub(include, "pose", "0 0 0.3 0 0 0")
+    return sdf_bytes(root)
 
 
 def port_files(port: GzPort, source: str, extra_plugins: list[Element] = (),

@@ -1,2 +1,3 @@
 """Where a name points: `$(find pkg)` and `package://`, `model://` and include URIs, and
-`name:=value` arguments, resolved without ROS or Gazebo installed."""
+`name:=value` arguments, resolved without ROS or Gazebo installed; and where a file
+reference may point (references.py)."""

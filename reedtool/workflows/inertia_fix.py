@@ -117,3 +117,29 @@ def apply_fix_xacro(model: Path, comparisons) -> tuple[list[str], set[str]]:
     edits, printed = plan_edits(model, comparisons, texts)
     notes, fixed = write_edits(edits, texts)
     return (notes + printed or ["--fix: nothing to change"]), fixed
+
+
+def apply_fix_urdf(model: Path, comparisons) -> list[str]:
+    """A .urdf's own <inertial> elements rewritten with the geometry's (io/urdf_edit), a
+    numbered backup kept."""
+    from reedtool.io.urdf_edit import rewrite_inertials
+
+    todo = [(c, c.corrected()) for c in comparisons]
+    todo = [(c, props) for c, props in todo if props is not None]
+    if not todo:
+        return ["--fix: nothing to change"]
+    for c, _props in todo:
+        if c.loc.line is None or Path(c.loc.file).resolve() != model.resolve():
+            raise ReedtoolError(f"cannot locate the <inertial> of link '{c.link}'", file=model)
+    backup = rewrite_inertials(model, [(c.link, c.loc.line, props) for c, props in todo])
+    return [f"--fix: rewrote <inertial> of {', '.join(c.link for c, _ in todo)} in {model} "
+            f"(backup: {backup})"]
+
+
+def apply_fix(model: Path, comparisons) -> tuple[list[str], set[str], bool]:
+    """inertia --fix: the notes to print, the links whose xacro tensor was fixed, and
+    whether the model is a .urdf (fixed in place) rather than a xacro tree."""
+    if model.suffix.lower() == ".urdf":
+        return apply_fix_urdf(model, comparisons), set(), True
+    notes, fixed = apply_fix_xacro(model, comparisons)
+    return notes, fixed, False

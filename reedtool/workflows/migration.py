@@ -230,7 +230,7 @@ def _name_the_target(proof, staged: Path, target: Path) -> None:
 
 def outside_files(port: GzPort, model: Path) -> dict[str, str]:
     """Mesh URI -> why its file lies outside the model's packages (io.meshes)."""
-    from reedtool.io.meshes import outside_reason
+    from reedtool.resolve.references import outside_reason
 
     default_root = Path(model) if Path(model).is_dir() else Path(model).parent
     out = {}

@@ -79,7 +79,7 @@ def withhold_outside_meshes(robot, model: Path) -> list[str]:
     """Leave out of the picture every mesh file outside the model's packages (an absolute
     file:// URI, a path climbing out with ..): the page or GLB would carry a copy of it.
     Returns the URIs withheld; each is drawn as not shown, with the reason in the notes."""
-    from reedtool.io.meshes import outside_reason
+    from reedtool.resolve.references import outside_reason
     from reedtool.model import Mesh
 
     default_root = Path(model) if Path(model).is_dir() else Path(model).parent
