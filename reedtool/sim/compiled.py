@@ -388,7 +388,7 @@ if numba is not None:
                     om_i[j] = _next_speed(T_i[j], ik, om_i[j], fu, fd, False, lu, ld, top)
 
     @njit(cache=True, error_model="numpy")
-    def _w_body(W, dt, g, i_max, J0, J0inv):
+    def _w_body(W, dt, g, i_max, J0, dt_J0inv):
         """translation_and_rates, the integral and cot_ratio's series (row _AQ; row _HH
         its argument); returns how many vehicles need cot_ratio's other branch."""
         half_dt = 0.5 * dt
@@ -401,7 +401,7 @@ if numba is not None:
                                          W[(_M + 1) * BLOCK + j], W[(_M + 2) * BLOCK + j],
                                          s0, s1, s2)
             px, py, pz, vx, vy, vz, wx, wy, wz = _translation_and_rates(
-                dt, g, W[_MASS * BLOCK + j], J0, J0inv, W[(_S + 0) * BLOCK + j],
+                dt, g, W[_MASS * BLOCK + j], J0, dt_J0inv, W[(_S + 0) * BLOCK + j],
                 W[(_S + 1) * BLOCK + j], W[(_S + 2) * BLOCK + j],
                 (W[(_R + 0) * BLOCK + j], W[(_R + 1) * BLOCK + j], W[(_R + 2) * BLOCK + j],
                  W[(_R + 3) * BLOCK + j], W[(_R + 4) * BLOCK + j], W[(_R + 5) * BLOCK + j],
@@ -465,9 +465,9 @@ if numba is not None:
         same arithmetic as _fly, vehicle for vehicle; vehicles that end are parked at a
         level hover, as the numpy batch parks them, and no longer judged. Lanes past the
         block's vehicles fly copies of its first vehicle and are not reported."""
-        dt, g, lead, i_max, pos, axis, tmap, cd, cr, J0a, J0inva, inv_k, up, down, lead_up, \
+        dt, g, lead, i_max, pos, axis, tmap, cd, cr, J0a, dt_J0inva, inv_k, up, down, lead_up, \
             lead_down, omega_max = nominal
-        J0, J0inv = _nine(J0a), _nine(J0inva)
+        J0, dt_J0inv = _nine(J0a), _nine(dt_J0inva)
         ctl = (*_nine(ctl[0:9]), *_nine(ctl[9:18]))
         n_steps, every = int(cfg[12]), int(cfg[13])
         sample_dt = every * dt
@@ -618,14 +618,14 @@ if numba is not None:
             # ---- advance one step: wrench at the current speeds, then the speeds respond
             _w_wrench(W, n, pos, axis, tmap, cd, cr)
             _w_motors(W, n, inv_k, up, down, lead, lead_up, lead_down, omega_max)
-            if _w_body(W, dt, g, i_max, J0, J0inv) > 0:
+            if _w_body(W, dt, g, i_max, J0, dt_J0inv) > 0:
                 for j in range(BLOCK):
                     hh = W[_HH * BLOCK + j]
                     if not hh < equations.SERIES_HH_MAX:
                         w0, w1, w2 = (W[(_W + 0) * BLOCK + j], W[(_W + 1) * BLOCK + j],
                                       W[(_W + 2) * BLOCK + j])
-                        W[_AQ * BLOCK + j] = _cot_ratio(
-                            hh, math.sqrt(w0 * w0 + w1 * w1 + w2 * w2), half_dt)
+                        W[_AQ * BLOCK + j] = _cot_ratio(hh, w0 * w0 + w1 * w1 + w2 * w2,
+                                                        half_dt)
             _w_attitude(W)
         for j in range(B):
             out_i[j, 0] = reason[j]
@@ -652,12 +652,12 @@ if numba is not None:
         more than MAX_BLOCK_ROTORS rotors one by one on _fly."""
         N = mass.shape[0]
         if k.shape[1] > MAX_BLOCK_ROTORS:
-            dt, g, lead, i_max, pos, axis, tmap, cd, cr, J0, J0inv, inv_k, up, down, \
+            dt, g, lead, i_max, pos, axis, tmap, cd, cr, J0, dt_J0inv, inv_k, up, down, \
                 lead_up, lead_down, omega_max = nominal
             rec = np.empty((0, 0))
             for j in prange(N):
                 veh = (dt, g, mass[j], lead, i_max, pos, axis, tmap, cd, cr, k[j], shift[j],
-                       S[j], J0, J0inv, inv_k, up, down, lead_up, lead_down, omega_max)
+                       S[j], J0, dt_J0inv, inv_k, up, down, lead_up, lead_down, omega_max)
                 _fly(cfg, ctl, pinv, thrust_max, veh, state0, out_f[j], out_i[j], final[j],
                      rec, pos_rec[j])
             return

@@ -76,28 +76,30 @@ def root_or_zero(x):
     return math.sqrt(x) if x > 0.0 else 0.0
 
 
-# |w| / tan(h), h = |w| dt / 2, by its series in hh = h^2 below SERIES_HH_MAX (to ~1e-16,
-# and free of a call, so a block of vehicles computes it in SIMD lanes).
-SERIES_HH_MAX = 0.01
+# |w| / tan(h), h = |w| dt / 2, by its series in hh = h^2 below SERIES_HH_MAX (|w| below
+# 20 rad/s at 1 kHz; the first omitted term is below 1e-19 of the sum, so it is the
+# function to the last bit, and free of a call: a block of vehicles computes it in SIMD
+# lanes, and a Python step in fewer operations than tan).
+SERIES_HH_MAX = 1e-4
 
 
 @select
 def cot_series(hh, two_over_dt):
-    """(2 / dt) h cot h = |w| / tan h for small h, hh = h^2 (the Taylor series of h cot h)."""
-    return two_over_dt * (1.0 - hh * (1.0 / 3.0 + hh * (1.0 / 45.0 + hh * (
-        2.0 / 945.0 + hh * (1.0 / 4725.0 + hh * (2.0 / 93555.0))))))
+    """(2 / dt) h cot h = |w| / tan h for small h, hh = h^2 (h cot h's Taylor series)."""
+    return two_over_dt * (1.0 - hh * (1.0 / 3.0 + hh * (1.0 / 45.0 + hh * (2.0 / 945.0))))
 
 
 @select
-def cot_exact(rate, half_dt):
-    """|w| / tan(|w| dt / 2); 1 for no rotation (the step is then the identity)."""
-    return rate / math.tan(half_dt * rate) if half_dt * rate != 0.0 else 1.0
+def cot_exact(rate_sq, half_dt):
+    """|w| / tan(|w| dt / 2) from |w|^2; 1 for no rotation (the step is then the identity)."""
+    return (math.sqrt(rate_sq) / math.tan(half_dt * math.sqrt(rate_sq))
+            if half_dt * math.sqrt(rate_sq) != 0.0 else 1.0)
 
 
 @select
-def cot_ratio(hh, rate, half_dt):
-    """|w| / tan(h), the scalar part of q's step direction (hh = h^2, rate = |w|)."""
-    return cot_series(hh, 1.0 / half_dt) if hh < SERIES_HH_MAX else cot_exact(rate, half_dt)
+def cot_ratio(hh, rate_sq, half_dt):
+    """|w| / tan(h), the scalar part of q's step direction (hh = h^2, rate_sq = |w|^2)."""
+    return cot_series(hh, 1.0 / half_dt) if hh < SERIES_HH_MAX else cot_exact(rate_sq, half_dt)
 
 
 @select
@@ -351,11 +353,12 @@ def body_wrench(pos, axis, tmap, cd, cr, k, shift, omega, R00, R01, R02, R10, R1
 
 # ------------------------------------------------------------------ rigid body
 
-def translation_and_rates(dt, g, mass, J0, J0inv, S0, S1, S2, R, F0, F1, F2, M0, M1, M2,
+def translation_and_rates(dt, g, mass, J0, dt_J0inv, S0, S1, S2, R, F0, F1, F2, M0, M1, M2,
                           px, py, pz, vx, vy, vz, wx, wy, wz):
     """Semi-implicit Euler for p, v and w: v from the force at the start of the step, p
     from the new v; J w' = tau - w x J w with J = S J0 S (S = diag(S0, S1, S2), a
-    perturbed vehicle's). R: the 9 entries of the attitude. Returns p, v, w."""
+    perturbed vehicle's; dt_J0inv = dt J0^-1). R: the 9 entries of the attitude. Returns
+    p, v, w."""
     R00, R01, R02, R10, R11, R12, R20, R21, R22 = (R[0], R[1], R[2], R[3], R[4], R[5], R[6],
                                                    R[7], R[8])
     fm = dt / mass
@@ -374,9 +377,9 @@ def translation_and_rates(dt, g, mass, J0, J0inv, S0, S1, S2, R, F0, F1, F2, M0,
     h0 = (M0 - (wy * Jw2 - wz * Jw1)) / S0
     h1 = (M1 - (wz * Jw0 - wx * Jw2)) / S1
     h2 = (M2 - (wx * Jw1 - wy * Jw0)) / S2
-    wx = wx + (J0inv[0] * h0 + J0inv[1] * h1 + J0inv[2] * h2) * (dt / S0)
-    wy = wy + (J0inv[3] * h0 + J0inv[4] * h1 + J0inv[5] * h2) * (dt / S1)
-    wz = wz + (J0inv[6] * h0 + J0inv[7] * h1 + J0inv[8] * h2) * (dt / S2)
+    wx = wx + (dt_J0inv[0] * h0 + dt_J0inv[1] * h1 + dt_J0inv[2] * h2) / S0
+    wy = wy + (dt_J0inv[3] * h0 + dt_J0inv[4] * h1 + dt_J0inv[5] * h2) / S1
+    wz = wz + (dt_J0inv[6] * h0 + dt_J0inv[7] * h1 + dt_J0inv[8] * h2) / S2
     return px + dt * vx, py + dt * vy, pz + dt * vz, vx, vy, vz, wx, wy, wz
 
 
@@ -391,7 +394,7 @@ def attitude_step(qw, qx, qy, qz, wx, wy, wz, a):
     return nw * inv_q, nx * inv_q, ny * inv_q, nz * inv_q
 
 
-def rigid_body(dt, g, mass, J0, J0inv, S, R, F0, F1, F2, M0, M1, M2, px, py, pz, vx, vy,
+def rigid_body(dt, g, mass, J0, dt_J0inv, S, R, F0, F1, F2, M0, M1, M2, px, py, pz, vx, vy,
                vz, qw, qx, qy, qz, wx, wy, wz):
     """One semi-implicit Euler step under the body wrench: p, v, w (translation_and_rates),
     then q through the exact exponential map of the new w. Returns p, v, q, w.
@@ -399,11 +402,11 @@ def rigid_body(dt, g, mass, J0, J0inv, S, R, F0, F1, F2, M0, M1, M2, px, py, pz,
     Why this integrator (dynamics.py): the command is held over the step, it costs one
     force evaluation, and its fixed point is the continuous equilibrium (hover = trim)."""
     px, py, pz, vx, vy, vz, wx, wy, wz = translation_and_rates(
-        dt, g, mass, J0, J0inv, S[0], S[1], S[2], R, F0, F1, F2, M0, M1, M2, px, py, pz, vx,
+        dt, g, mass, J0, dt_J0inv, S[0], S[1], S[2], R, F0, F1, F2, M0, M1, M2, px, py, pz, vx,
         vy, vz, wx, wy, wz)
     half_dt = 0.5 * dt
     rate_sq = wx * wx + wy * wy + wz * wz
-    a = cot_ratio(half_dt * half_dt * rate_sq, math.sqrt(rate_sq), half_dt)
+    a = cot_ratio(half_dt * half_dt * rate_sq, rate_sq, half_dt)
     qw, qx, qy, qz = attitude_step(qw, qx, qy, qz, wx, wy, wz, a)
     return px, py, pz, vx, vy, vz, qw, qx, qy, qz, wx, wy, wz
 
@@ -418,8 +421,8 @@ def integral(i_max, dt, ix, iy, iz, ex, ey, ez):
 
 # The state x: p 0:3, v 3:6, q 6:10, w 10:13, integral 13:16, rotor speeds 16:16+n.
 # The vehicle `veh` (per vehicle where a batch perturbs it: mass, S, shift, k):
-#   dt g mass lead i_max pos axis tmap cd cr k shift S J0 J0inv inv_k up down lead_up
-#   lead_down omega_max   (J0, J0inv row-major; inv_k and omega_max the controller's).
+#   dt g mass lead i_max pos axis tmap cd cr k shift S J0 dt_J0inv inv_k up down lead_up
+#   lead_down omega_max   (J0 and dt J0^-1 row-major; inv_k and omega_max the controller's).
 STATE_SIZE = 16
 
 
@@ -441,7 +444,7 @@ def advance_state(veh, x, T, R, e):
     """x one step on: the wrench at the current rotor speeds, the speeds' response to the
     thrusts T, the rigid body under that wrench, the integral of the error e. R is x's
     rotation (control_state's)."""
-    dt, g, mass, lead, i_max, pos, axis, tmap, cd, cr, k, shift, S, J0, J0inv, inv_k, up, \
+    dt, g, mass, lead, i_max, pos, axis, tmap, cd, cr, k, shift, S, J0, dt_J0inv, inv_k, up, \
         down, lead_up, lead_down, omega_max = veh
     n = len(k)
     F0, F1, F2, M0, M1, M2 = body_wrench(pos, axis, tmap, cd, cr, k, shift, x[16:16 + n],
@@ -451,6 +454,6 @@ def advance_state(veh, x, T, R, e):
         x[16 + i] = next_speed(T[i], inv_k[i], x[16 + i], up[i], down[i], lead, lead_up[i],
                                lead_down[i], omega_max[i])
     (x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], x[8], x[9], x[10], x[11],
-     x[12]) = rigid_body(dt, g, mass, J0, J0inv, S, R, F0, F1, F2, M0, M1, M2, x[0], x[1],
+     x[12]) = rigid_body(dt, g, mass, J0, dt_J0inv, S, R, F0, F1, F2, M0, M1, M2, x[0], x[1],
                          x[2], x[3], x[4], x[5], x[6], x[7], x[8], x[9], x[10], x[11], x[12])
     x[13], x[14], x[15] = integral(i_max, dt, x[13], x[14], x[15], e[0], e[1], e[2])

@@ -23,7 +23,7 @@ class Inputs:
     pinv: np.ndarray          # (4 n,) the allocation's pseudo-inverse, row per rotor
     thrust_max: np.ndarray    # (n,)
     setpoint: np.ndarray      # (3,)
-    nominal: tuple            # dt g lead i_max pos axis tmap cd cr J0 J0inv inv_k up down
+    nominal: tuple            # dt g lead i_max pos axis tmap cd cr J0 dt_J0inv inv_k up down
                               # lead_up lead_down omega_max (shared by every vehicle)
     mass: np.ndarray          # (N,)
     S: np.ndarray             # (N, 3)
@@ -32,10 +32,10 @@ class Inputs:
 
     def vehicle(self, j: int = 0) -> tuple:
         """equations' `veh` for vehicle j."""
-        dt, g, lead, i_max, pos, axis, tmap, cd, cr, J0, J0inv, inv_k, up, down, lead_up, \
+        dt, g, lead, i_max, pos, axis, tmap, cd, cr, J0, dt_J0inv, inv_k, up, down, lead_up, \
             lead_down, omega_max = self.nominal
         return (dt, g, float(self.mass[j]), lead, i_max, pos, axis, tmap, cd, cr, self.k[j],
-                self.shift[j], self.S[j], J0, J0inv, inv_k, up, down, lead_up, lead_down,
+                self.shift[j], self.S[j], J0, dt_J0inv, inv_k, up, down, lead_up, lead_down,
                 omega_max)
 
 
@@ -65,7 +65,7 @@ def inputs(params, gains: ControllerGains, config: HoverConfig, plant=None,
                _c(np.asarray(plant.force_map).T.ravel()),
                _c(np.asarray(plant.torque_map).T.ravel()),
                _c(params.rotor_drag_coefficient), _c(params.rolling_moment_coefficient),
-               _c(J0.ravel()), _c(np.linalg.inv(J0).ravel()), _c(1.0 / gains.motor_constant),
+               _c(J0.ravel()), _c(dt * np.linalg.inv(J0).ravel()), _c(1.0 / gains.motor_constant),
                _c(up), _c(down),
                *(_c(f) for f in (lead or (np.ones(n), np.ones(n)))),
                _c(gains.omega_max_rad_s))

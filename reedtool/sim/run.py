@@ -18,8 +18,7 @@ import numpy as np
 from reedtool.io.json_values import finite_or_none
 from reedtool.sim import ExitStatus, HoverConfig
 from reedtool.sim.batch import describe, hover_speeds
-from reedtool.sim.controller import (ControllerDesign, ControllerGains,
-                                     most_out_of_range_one, prioritised_one)
+from reedtool.sim.controller import ControllerDesign, ControllerGains
 from reedtool.sim.dynamics import quat_from_rpy
 from reedtool.sim.params import VehicleParams
 from reedtool.sim.scalar import compile_vehicle
@@ -100,8 +99,7 @@ def simulate_hover(params: VehicleParams, config: HoverConfig = HoverConfig(),
 
         fly = vehicle_flyer(params, gains, config, setpoint)
     else:
-        fly = compile_vehicle(params, gains, config, setpoint, most_out_of_range_one,
-                              _prioritised)
+        fly = compile_vehicle(params, gains, config, setpoint)
 
     # ---- the disturbed start: rotors at the trim speeds, at rest
     p0 = tuple(sp + off for sp, off in zip(setpoint, config.offset_m))
@@ -151,15 +149,6 @@ def simulate_hover(params: VehicleParams, config: HoverConfig = HoverConfig(),
 _EVENTS = {"non-finite": ExitStatus.DIVERGED, "flipped": ExitStatus.CRASHED,
            "ground": ExitStatus.CRASHED, "yaw-spin": ExitStatus.YAW_SPIN,
            "drifted": ExitStatus.DIVERGED, "rate": ExitStatus.DIVERGED}
-
-
-def _prioritised(rows: list[tuple], thrust_max: list[float], f: float, t0: float, t1: float,
-                 t2: float) -> list[float]:
-    """controller.prioritised_one (the one desaturation of the per-vehicle engines) as the
-    generated step calls it: the thrusts returned as a list."""
-    thrust = [0.0] * len(rows)
-    prioritised_one(rows, thrust_max, f, t0, t1, t2, thrust)
-    return thrust
 
 
 def sample_series(rec: list[tuple], rotor_names: tuple[str, ...]) -> dict[str, np.ndarray]:
