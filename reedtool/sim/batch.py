@@ -20,23 +20,10 @@ import numpy as np
 
 from reedtool.io.json_values import finite_or_none
 from reedtool.sim import STATUS_CODES, STATUS_FROM_CODE, ExitStatus, HoverConfig
-from reedtool.sim.controller import (
-    ControllerDesign,
-    ControllerGains,
-    allocation_kernel,
-    control_kernel,
-)
-from reedtool.sim.dynamics import (
-    Plant,
-    PlantKernel,
-    State,
-    body_wrench_kernel,
-    quat_from_rpy,
-    rates_buffer,
-    rigid_body_kernel,
-    rotation_kernel,
-)
-from reedtool.sim.motor import speed_command, speed_filter_factors
+from reedtool.sim import columns, equations
+from reedtool.sim.controller import ControllerDesign, ControllerGains
+from reedtool.sim.dynamics import Plant, State, quat_from_rpy
+from reedtool.sim.motor import speed_command
 from reedtool.sim.params import VehicleParams
 
 # Why a run ended, beyond its ExitStatus (index into REASONS).
@@ -164,55 +151,27 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
         raise ValueError("a speed command flies from the speeds it starts with")
     if gains is None and command is None:
         gains = ControllerGains.from_params(params, design)
-    kernel = PlantKernel(plant)
     N, n = plant.n_vehicles, params.n_rotors
     dt = config.dt_s
     state, setpoint = initial_state(params, gains, config, N, initial_omega_rad_s)
-    # Position error, velocity and integral of the position error share one (9, N) block,
-    # so the PID is one matrix product; state.v and `integral` are views into it.
-    evi = np.zeros((9, N))
-    evi[3:6] = state.v
-    state.v = evi[3:6]
-    p_err, integral = evi[0:3], evi[6:9]
-    w5 = rates_buffer(state.w)          # body rates, wrapped for the cross products
-    state.w = w5[0:3]
+    # The state as rows of one array, in equations' layout; `state` views into it.
+    X = np.zeros((16 + n, N))
+    X[0:3], X[3:6], X[6:10], X[10:13], X[16:] = state.p, state.v, state.q, state.w, state.omega
+    state = State(p=X[0:3], v=X[3:6], q=X[6:10], w=X[10:13], omega=X[16:])
+    rows = list(X)
     omega_park = state.omega[:, 0].copy()
     q_park = np.array([1.0, 0.0, 0.0, 0.0])
-    # Per-rotor constants as full (n, N) arrays: broadcasting (n, 1) costs more than the
-    # arithmetic at these sizes.
-    def per_rotor(values: np.ndarray) -> np.ndarray:
-        return np.repeat(np.asarray(values, dtype=float)[:, None], N, axis=1)
-
-    up, down = (per_rotor(f) for f in speed_filter_factors(
-        dt, params.time_constant_up_s, params.time_constant_down_s))
-    omega_max = per_rotor(params.omega_max_rad_s if command is not None
-                          else gains.omega_max_rad_s)
-    lead = None
-    if command is None:
-        inv_k_hat = per_rotor(1.0 / gains.motor_constant)
-        lead = gains.motor_lead_factors(dt)
-        if lead is not None:
-            lead_up, lead_down = (per_rotor(f) for f in lead)
-        thrust_max = per_rotor(gains.motor_constant * gains.omega_max_rad_s ** 2)
-        i_max = gains.max_integral_m_s
-    p_col = np.repeat(setpoint[:, None], N, axis=1)    # full: no broadcasting per step
-
-    # The step's stages, each bound once to the arrays it works on (see the kernels).
+    control, advance = columns.build(
+        params, gains if gains is not None else ControllerGains.from_params(params, design),
+        config, plant, speed_command=command is not None)
+    omega_max = np.repeat(np.asarray(params.omega_max_rad_s if command is not None
+                                     else gains.omega_max_rad_s, dtype=float)[:, None], N,
+                          axis=1)
     R9 = np.empty((9, N))
     R = R9.reshape(3, 3, N)
-    wrench, thrust_cmd, body = np.empty((4, N)), np.empty((n, N)), np.empty((8, N))
-    rotate = rotation_kernel(state.q, np.empty((11, N)), R9)
-    omega_cmd = np.empty((n, N))
-    if command is None:
-        compute_wrench = control_kernel(gains, evi, R9, state.w, wrench)
-        allocate = allocation_kernel(gains.allocation_pinv, wrench, thrust_max, thrust_cmd)
-    else:
+    if command is not None:
+        omega_cmd = np.empty((n, N))
         speed_command_step = command(state, R9, setpoint, omega_cmd)
-    evaluate_body_wrench = body_wrench_kernel(plant, kernel, state.omega, state.v, w5, R9, body)
-    advance_body = rigid_body_kernel(plant, kernel, state.p, state.v, state.q, w5, R9, body, dt)
-    omega = state.omega
-    spinning_up = np.empty((n, N), dtype=bool)
-    mul, add, sub, sqrt = np.multiply, np.add, np.subtract, np.sqrt
 
     status = np.zeros(N, dtype=np.int64)
     reason = np.zeros(N, dtype=np.int64)
@@ -235,124 +194,90 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
     report_every = max(1, n_steps // 100)
     recorded: list[np.ndarray] = []
     reported = 0
+    p_col = np.repeat(setpoint[:, None], N, axis=1)
 
-    for step in range(n_steps + 1):
-        t = step * dt
-        rotate()
-        sub(state.p, p_col, p_err)
-        last = step == n_steps
-        sample = step % every == 0 or last
-        if command is None:
-            compute_wrench()
-            saturated, worst_rotor = allocate(sample)
-        else:
-            saturated, worst_rotor = speed_command_step(step, sample)
-        if sample:
-            # ---- judge every running vehicle on the state at time t
-            running = status == 0
-            pos = np.sqrt((p_err * p_err).sum(axis=0))
-            if record:
-                recorded.append(np.where(running, pos, np.nan))
-            R22 = R[2, 2]
-            # Attitude error: the angle from the level hover attitude at the setpoint
-            # heading (what the trim assumes), i.e. the rotation angle of R itself.
-            trace = R[0, 0] + R[1, 1] + R22
-            cos_att = np.minimum(np.maximum(0.5 * (trace - 1.0), -1.0), 1.0)
-            throttle = (state.omega / omega_max).max(axis=0)
-            # Only running vehicles update their record (ufunc `where=`: in place; masked
-            # calls cost several times the plain ones, so only when some have ended).
-            if running.all():
-                np.fmax(max_pos, pos, out=max_pos)
-                np.fmin(min_cos_att, cos_att, out=min_cos_att)
-                np.fmax(max_throttle, throttle, out=max_throttle)
-                np.copyto(final_pos, pos)
-                np.copyto(final_cos, cos_att)
+    # where() computes both sides of a select: the unused one may warn (sqrt of a
+    # negative thrust command, a tumbling vehicle's tangent); the judge ends what is
+    # not finite.
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        for step in range(n_steps + 1):
+            t = step * dt
+            last = step == n_steps
+            sample = step % every == 0 or last
+            if command is None:
+                out = control(*rows)
+                R_rows, e_rows, u = out[0:9], out[9:12], out[12:12 + n]
+                saturated, worst_rotor = out[12 + n], out[13 + n]
             else:
+                R_rows, e_rows = equations.rotation(*rows[6:10]), ()
+            for k in range(9):
+                R9[k] = R_rows[k]
+            if command is not None:
+                saturated, worst_rotor = speed_command_step(step, sample)
+                u = list(omega_cmd)
+            if sample:
+                # ---- judge every running vehicle on the state at time t
+                p_err = state.p - p_col
+                running = status == 0
+                pos = np.sqrt((p_err * p_err).sum(axis=0))
+                if record:
+                    recorded.append(np.where(running, pos, np.nan))
+                R22 = R[2, 2]
+                # Attitude error: the angle from the level hover attitude at the setpoint
+                # heading (what the trim assumes), i.e. the rotation angle of R itself.
+                trace = R[0, 0] + R[1, 1] + R22
+                cos_att = np.minimum(np.maximum(0.5 * (trace - 1.0), -1.0), 1.0)
+                throttle = (state.omega / omega_max).max(axis=0)
+                # Only running vehicles update their record.
                 np.fmax(max_pos, pos, out=max_pos, where=running)
                 np.fmin(min_cos_att, cos_att, out=min_cos_att, where=running)
                 np.fmax(max_throttle, throttle, out=max_throttle, where=running)
                 np.copyto(final_pos, pos, where=running)
                 np.copyto(final_cos, cos_att, where=running)
-            within = (pos <= config.position_tol_m) & (cos_att >= cos_tol)
-            np.copyto(last_out, t, where=running & ~within)
-            # Saturated streaks: start, rotor furthest out at the start, longest so far.
-            if saturated is None:           # no rotor of any vehicle out of range
-                sat_since.fill(np.nan)
-            else:
-                np.copyto(sat_since, t, where=saturated & np.isnan(sat_since))
-                np.copyto(sat_since, np.nan, where=~saturated)
-                np.copyto(sat_rotor, worst_rotor, where=saturated & (sat_since == t))
-                longer = running & saturated & (t - sat_since > sat_longest)
-                np.copyto(sat_longest, t - sat_since, where=longer)
-                np.copyto(sat_longest_rotor, sat_rotor, where=longer)
-            w = state.w
-            if (np.isfinite(state.p).all() and np.isfinite(w).all()
-                    and np.isfinite(state.q).all()):
-                # The usual case, cheaply: no vehicle (running or parked) hit any event.
-                rate_xy = np.sqrt(w[0] * w[0] + w[1] * w[1])
-                quiet = (R22.min() >= 0.0 and state.p[2].min() >= 0.0
-                         and np.abs(w[2]).max() <= config.yaw_spin_rad_s
-                         and pos.max() <= config.divergence_distance_m
-                         and rate_xy.max() <= config.diverged_rate_rad_s)
-            else:
-                quiet = False
-            if quiet:
-                ended = None
-            else:
+                within = (pos <= config.position_tol_m) & (cos_att >= cos_tol)
+                np.copyto(last_out, t, where=running & ~within)
+                # Saturated streaks: start, rotor furthest out at the start, longest so far.
+                if saturated is None:           # no rotor of any vehicle out of range
+                    sat_since.fill(np.nan)
+                else:
+                    np.copyto(sat_since, t, where=saturated & np.isnan(sat_since))
+                    np.copyto(sat_since, np.nan, where=~saturated)
+                    np.copyto(sat_rotor, worst_rotor, where=saturated & (sat_since == t))
+                    longer = running & saturated & (t - sat_since > sat_longest)
+                    np.copyto(sat_longest, t - sat_since, where=longer)
+                    np.copyto(sat_longest_rotor, sat_rotor, where=longer)
                 ended = _judge_events(config, status, reason, reason_value, end_time,
                                       running, t, state, R, pos)
-            if last:
-                settled = (status == 0) & within & (last_out + sample_dt
-                                                    <= config.duration_s - config.hold_s + 1e-9)
-                status[settled] = STATUS_CODES[ExitStatus.PASSED]
-                reason[settled] = _R["settled"]
-                # Not settled with the rotors long at their limits: say so, it is the cause.
-                starved = (status == 0) & (sat_longest >= config.saturation_limit_s - 1e-9)
-                status[starved] = STATUS_CODES[ExitStatus.SATURATED]
-                reason[starved] = _R["saturated"]
-                reason_value[starved] = sat_longest_rotor[starved]
-                rest = status == 0
-                status[rest] = STATUS_CODES[ExitStatus.NOT_SETTLED]
-                reason[rest] = _R["not-settled"]
-                break
-            if ended is not None and ended.any():
-                # Park finished vehicles at a level hover so they stay finite and cheap.
-                state.p[:, ended] = setpoint[:, None]
-                state.v[:, ended] = 0.0
-                state.q[:, ended] = q_park[:, None]
-                state.w[:, ended] = 0.0
-                state.omega[:, ended] = omega_park[:, None]
-                integral[:, ended] = 0.0
-                if (status != 0).all():
+                if last:
+                    settled = (status == 0) & within & (
+                        last_out + sample_dt <= config.duration_s - config.hold_s + 1e-9)
+                    status[settled] = STATUS_CODES[ExitStatus.PASSED]
+                    reason[settled] = _R["settled"]
+                    # Not settled with the rotors long at their limits: say so, it is the cause.
+                    starved = (status == 0) & (sat_longest >= config.saturation_limit_s - 1e-9)
+                    status[starved] = STATUS_CODES[ExitStatus.SATURATED]
+                    reason[starved] = _R["saturated"]
+                    reason_value[starved] = sat_longest_rotor[starved]
+                    rest = status == 0
+                    status[rest] = STATUS_CODES[ExitStatus.NOT_SETTLED]
+                    reason[rest] = _R["not-settled"]
                     break
-        # ---- advance all vehicles one step
-        # The allocation keeps thrusts within [0, k w_max^2], so no clamp (a `command`
-        # has written omega_cmd within [0, w_max] itself).
-        if command is None:
-            mul(thrust_cmd, inv_k_hat, omega_cmd)
-            sqrt(omega_cmd, omega_cmd)
-        if lead is not None:
-            # The controller's lead on slow motors (ControllerGains.motor_lead_factors).
-            np.greater(omega_cmd, omega, spinning_up)
-            sub(omega_cmd, omega, omega_cmd)
-            mul(omega_cmd, np.where(spinning_up, lead_up, lead_down), omega_cmd)
-            add(omega_cmd, omega, omega_cmd)
-            np.minimum(omega_cmd, omega_max, out=omega_cmd)
-            np.maximum(omega_cmd, 0.0, out=omega_cmd)
-        evaluate_body_wrench()
-        advance_body()
-        np.greater(omega_cmd, omega, spinning_up)
-        sub(omega, omega_cmd, omega)
-        mul(omega, np.where(spinning_up, up, down), omega)
-        add(omega, omega_cmd, omega)
-        if command is None:
-            mul(p_err, dt, p_err)
-            add(integral, p_err, integral)
-            np.minimum(integral, i_max, out=integral)
-            np.maximum(integral, -i_max, out=integral)
-        if progress is not None and step - reported >= report_every:
-            progress(step - reported)
-            reported = step
+                if ended.any():
+                    # Park finished vehicles at a level hover so they stay finite and cheap.
+                    X[0:3, ended] = setpoint[:, None]
+                    X[3:6, ended] = 0.0
+                    X[6:10, ended] = q_park[:, None]
+                    X[10:16, ended] = 0.0
+                    X[16:, ended] = omega_park[:, None]
+                    if (status != 0).all():
+                        break
+            # ---- advance all vehicles one step (equations.advance_state, or
+            # advance_plant under a speed command)
+            for k, row in enumerate(advance(*rows, *u, *R_rows, *e_rows)):
+                X[k] = row
+            if progress is not None and step - reported >= report_every:
+                progress(step - reported)
+                reported = step
     if progress is not None and n_steps > reported:
         progress(n_steps - reported)
 

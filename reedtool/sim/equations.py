@@ -272,16 +272,27 @@ def control(ctl, pinv, thrust_max, ex, ey, ez, vx, vy, vz, ix, iy, iz,
 
 # ------------------------------------------------------------------ motors
 
-def next_speed(thrust_N, inv_k, omega, up, down, lead, lead_up, lead_down, omega_max):
-    """One rotor's speed after a step (RotorS' motor model): the speed command for
-    `thrust_N` (the allocation keeps it within [0, k omega_max^2]), the controller's lead
-    on it when `lead` (ControllerGains.motor_lead_factors, clamped to [0, omega_max]),
-    then the first-order lag, exp(-dt / tau) per step (`up` spinning up, `down` down)."""
+def speed_command(thrust_N, inv_k, omega, lead, lead_up, lead_down, omega_max):
+    """A rotor's speed command for `thrust_N` (the allocation keeps it within
+    [0, k omega_max^2]), with the controller's lead on it when `lead`
+    (ControllerGains.motor_lead_factors, clamped to [0, omega_max])."""
     cmd = root_or_zero(thrust_N * inv_k)
     if lead:
         cmd = clamp(omega + (cmd - omega) * pick_rising(cmd, omega, lead_up, lead_down),
                     0.0, omega_max)
+    return cmd
+
+
+def lag(cmd, omega, up, down):
+    """RotorS' first-order speed response over one step, exact for a command held over
+    it: exp(-dt / tau) per step, `up` spinning up and `down` spinning down."""
     return cmd + (omega - cmd) * pick_rising(cmd, omega, up, down)
+
+
+def next_speed(thrust_N, inv_k, omega, up, down, lead, lead_up, lead_down, omega_max):
+    """One rotor's speed after a step under the thrust `thrust_N`."""
+    return lag(speed_command(thrust_N, inv_k, omega, lead, lead_up, lead_down, omega_max),
+               omega, up, down)
 
 
 # ------------------------------------------------------------------ rotor wrench
@@ -440,20 +451,31 @@ def control_state(ctl, pinv, thrust_max, sp, x, R, e, T):
                    R00, R01, R02, R10, R11, R12, R20, R21, R22, x[10], x[11], x[12], T)
 
 
-def advance_state(veh, x, T, R, e):
-    """x one step on: the wrench at the current rotor speeds, the speeds' response to the
-    thrusts T, the rigid body under that wrench, the integral of the error e. R is x's
-    rotation (control_state's)."""
-    dt, g, mass, lead, i_max, pos, axis, tmap, cd, cr, k, shift, S, J0, dt_J0inv, inv_k, up, \
-        down, lead_up, lead_down, omega_max = veh
+def advance_plant(veh, x, cmd, R):
+    """x's vehicle one step on under the rotor speed commands cmd: the wrench at the
+    current rotor speeds, the speeds' lag towards cmd, the rigid body under that wrench.
+    R is x's rotation."""
+    dt, g, mass, lead, i_max, pos, axis, tmap, cd, cr, k, shift, S, J0, dt_J0inv, inv_k, \
+        up, down, lead_up, lead_down, omega_max = veh
     n = len(k)
     F0, F1, F2, M0, M1, M2 = body_wrench(pos, axis, tmap, cd, cr, k, shift, x[16:16 + n],
                                          R[0], R[1], R[2], R[3], R[4], R[5], R[6], R[7],
                                          R[8], x[3], x[4], x[5], x[10], x[11], x[12])
     for i in range(n):
-        x[16 + i] = next_speed(T[i], inv_k[i], x[16 + i], up[i], down[i], lead, lead_up[i],
-                               lead_down[i], omega_max[i])
+        x[16 + i] = lag(cmd[i], x[16 + i], up[i], down[i])
     (x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], x[8], x[9], x[10], x[11],
      x[12]) = rigid_body(dt, g, mass, J0, dt_J0inv, S, R, F0, F1, F2, M0, M1, M2, x[0], x[1],
                          x[2], x[3], x[4], x[5], x[6], x[7], x[8], x[9], x[10], x[11], x[12])
+
+
+def advance_state(veh, x, T, R, e):
+    """x one step on under the controller's thrusts T (overwritten by the rotors' speed
+    commands): advance_plant, and the integral of the error e. R is x's rotation
+    (control_state's)."""
+    dt, g, mass, lead, i_max, pos, axis, tmap, cd, cr, k, shift, S, J0, dt_J0inv, inv_k, \
+        up, down, lead_up, lead_down, omega_max = veh
+    for i in range(len(k)):
+        T[i] = speed_command(T[i], inv_k[i], x[16 + i], lead, lead_up[i], lead_down[i],
+                             omega_max[i])
+    advance_plant(veh, x, T, R)
     x[13], x[14], x[15] = integral(i_max, dt, x[13], x[14], x[15], e[0], e[1], e[2])

@@ -293,10 +293,54 @@ def _copy(node: ast.AST) -> ast.AST:
     return ast.parse(ast.unparse(node), mode="eval").body
 
 
-def select_text(name: str, args: list[str]) -> str:
+class _Columns(ast.NodeTransformer):
+    """A select's expression over arrays of vehicles: `a if c else b` -> where(c, a, b)
+    (both sides are computed: the generated batch ignores the warnings of the unused
+    one), `or` -> logical_or."""
+
+    def visit_IfExp(self, node):
+        node = self.generic_visit(node)
+        return ast.Call(func=ast.Name(id="where", ctx=ast.Load()),
+                        args=[node.test, node.body, node.orelse], keywords=[])
+
+    def visit_BoolOp(self, node):
+        node = self.generic_visit(node)
+        name = "logical_or" if isinstance(node.op, ast.Or) else "logical_and"
+        out = node.values[0]
+        for value in node.values[1:]:
+            out = ast.Call(func=ast.Name(id=name, ctx=ast.Load()), args=[out, value],
+                           keywords=[])
+        return out
+
+
+def select_text(name: str, args: list[str], columns: bool = False) -> str:
+    """A select's expression with `args` put in; `columns`: over arrays (_Columns)."""
     names, expr = _select_expression(name)
     values = {n: ast.parse(a, mode="eval").body for n, a in zip(names, args)}
-    return "(" + ast.unparse(_Inline(values).visit(_copy(expr))) + ")"
+    tree = _Inline(values).visit(_copy(expr))
+    if columns:
+        tree = _Columns().visit(tree)
+    return "(" + ast.unparse(tree) + ")"
+
+
+def guarded_columns(step, mask, heads, T):
+    """A guarded step over a batch: `step` itself, vehicle by vehicle, where `mask` (its
+    guard) holds. Returns (mask, each vehicle's result (0 elsewhere), T)."""
+    import numpy as np
+
+    N = len(mask)
+    T = np.array([np.broadcast_to(t, (N,)) for t in T], dtype=float)
+    result = np.zeros(N, dtype=np.int64)
+    cols = np.flatnonzero(mask)
+    per_column = [h if isinstance(h, tuple) else np.broadcast_to(h, (N,))[cols].tolist()
+                  for h in heads]
+    fixed = [isinstance(h, tuple) for h in heads]
+    columns = T[:, cols].T.tolist()
+    for c, column in enumerate(columns):
+        _, result[cols[c]] = step(*(h if f else h[c] for h, f in zip(per_column, fixed)),
+                                  column)
+    T[:, cols] = np.array(columns).T
+    return mask, result, list(T)
 
 
 class Writer:
@@ -304,8 +348,11 @@ class Writer:
     `lines()`. Constants that are not numbers (a pseudo-inverse's rows) go into
     `namespace` under generated names."""
 
-    def __init__(self, namespace: dict):
+    def __init__(self, namespace: dict, columns: bool = False):
+        """`columns`: the values are arrays over vehicles (selects as `where`, guarded
+        steps vehicle by vehicle: guarded_columns)."""
         self.namespace = namespace
+        self.columns = columns
         self.outputs: list[tuple[str, object]] = []
         self.fixed: dict[int, str] = {}
         self.fixed_results: dict[int, tuple[str, str]] = {}
@@ -448,7 +495,7 @@ class Writer:
             return f"{name}({', '.join(ref(a) for a in args)})"
         if node.op == "select":
             name, *args = node.args
-            return select_text(name, [ref(a) for a in args])[1:-1]
+            return select_text(name, [ref(a) for a in args], self.columns)[1:-1]
         a, b = node.args
         return f"{ref(a)} {node.op} {ref(b)}"
 
@@ -472,6 +519,19 @@ class Writer:
         self._t_names[node.serial] = names
         self._result_names[node.serial] = {"changed": changed, "result": result}
         self.namespace[name] = step
+        if self.columns:
+            guards = [select_text(guard, [t, literal(limits[i])], True)
+                      for i, t in enumerate(names)]
+            mask = guards[0]
+            for g in guards[1:]:
+                mask = f"logical_or({mask}, {g})"
+            self.namespace["guarded_columns"] = guarded_columns
+            return [f"_mask = {mask}",
+                    "if _mask.any():",
+                    f"    {changed}, {result}, ({', '.join(names)},) = guarded_columns(",
+                    f"        {name}, _mask, ({', '.join(heads)},), ({', '.join(names)},))",
+                    "else:",
+                    f"    {changed}, {result} = None, None"]
         return [f"if {test}:",
                 f"    _T = [{', '.join(names)}]",
                 f"    {changed}, {result} = {name}({', '.join(heads)}, _T)",

@@ -1,0 +1,98 @@
+"""The numpy batch's step, traced from the flight equations over arrays of vehicles.
+
+`equations.control_state` and `equations.advance_state` (or `advance_plant`, under a
+speed command of another controller) traced once (`trace`) with the nominal vehicle's
+numbers as constants and what a robustness batch perturbs per vehicle (mass, inertia
+scale, COM shift, motor constants) as named arrays: each traced operation becomes one
+numpy operation on (N,) arrays, a select becomes `where`, the desaturation runs as the
+function itself on the vehicles whose guard holds. The same trace, with everything a
+constant, is the float engine's step (`scalar`), so the two fly the same arithmetic.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reedtool.sim import layout
+from reedtool.sim.trace import Trace, Writer, leaf
+
+STATE = ("px", "py", "pz", "vx", "vy", "vz", "qw", "qx", "qy", "qz", "wx", "wy", "wz",
+         "ix", "iy", "iz")
+ROTATION = ("R00", "R01", "R02", "R10", "R11", "R12", "R20", "R21", "R22")
+ERROR = ("ex", "ey", "ez")
+
+
+def _constants(x):
+    if isinstance(x, bool):
+        return x
+    if isinstance(x, tuple):
+        return tuple(_constants(v) for v in x)
+    if hasattr(x, "shape") and x.shape != ():
+        return tuple(float(v) for v in x)
+    return float(x)
+
+
+def _function(name: str, args: list[str], lines: list[str], returns: list[str]) -> str:
+    body = "\n".join("    " + line for line in lines)
+    return (f"def {name}({', '.join(args)}):\n{body}\n"
+            f"    return ({', '.join(returns)},)\n")
+
+
+def build(params, gains, config, plant, speed_command: bool = False) -> tuple:
+    """(control, advance) for the vehicles of `plant` flown by `gains`.
+
+    control(*x) -> (R (9), e (3), T (n), saturated (N,) bool or None, worst rotor or None)
+    for the state rows x (equations' layout); None under a speed command. advance(*x,
+    *u, *R, *e) -> the next state's rows, u the thrusts (or under a speed command: u the
+    rotor speed commands, and no e).
+    """
+    the = layout.inputs(params, gains, config, plant)
+    n = params.n_rotors
+    names = [*STATE, *(f"om{i}" for i in range(n))]
+    namespace: dict = {"sqrt": np.sqrt, "tan": np.tan, "where": np.where,
+                       "logical_or": np.logical_or, "logical_and": np.logical_and}
+    per_vehicle = {"mass": the.mass, **{f"S{a}": the.S[:, a] for a in range(3)},
+                   **{f"sh{a}": the.shift[:, a] for a in range(3)},
+                   **{f"k{i}": the.k[:, i] for i in range(n)}}
+    namespace.update({name: np.ascontiguousarray(v) for name, v in per_vehicle.items()})
+    dt, g, lead, i_max, pos, axis, tmap, cd, cr, J0, dt_J0inv, inv_k, up, down, lead_up, \
+        lead_down, omega_max = _constants(the.nominal)
+    veh = (dt, g, leaf("mass"), lead, i_max, pos, axis, tmap, cd, cr,
+           [leaf(f"k{i}") for i in range(n)], [leaf(f"sh{a}") for a in range(3)],
+           [leaf(f"S{a}") for a in range(3)], J0, dt_J0inv, inv_k, up, down, lead_up,
+           lead_down, omega_max)
+    control = None
+    if not speed_command:
+        trace = Trace()
+        x = [leaf(name) for name in names]
+        R, e, T = [0.0] * 9, [0.0] * 3, [0.0] * n
+        ctl, pinv, thrust_max, sp = (_constants(v) for v in (the.ctl, the.pinv,
+                                                              the.thrust_max, the.setpoint))
+        saturated, worst = trace.control_state(ctl, pinv, thrust_max, sp, x, R, e, T)
+        writer = Writer(namespace, columns=True)
+        for call in trace.guarded:
+            writer.name_results(call, "saturated", "worst")
+        outputs = [*zip(ROTATION, R), *zip(ERROR, e), *((f"T{i}", t) for i, t in enumerate(T)),
+                   ("saturated", saturated), ("worst", worst)]
+        for target, value in outputs:
+            writer.assign(target, value)
+        source = _function("control", names, writer.lines(), [t for t, _ in outputs])
+        exec(compile(source, "<reedtool.sim.columns control>", "exec"), namespace)
+        control = namespace["control"]
+    trace = Trace()
+    x = [leaf(name) for name in names]
+    u = [leaf(f"u{i}") for i in range(n)]
+    R = [leaf(name) for name in ROTATION]
+    if speed_command:
+        trace.advance_plant(veh, x, u, R)
+        args = [*names, *(f"u{i}" for i in range(n)), *ROTATION]
+    else:
+        trace.advance_state(veh, x, u, R, [leaf(name) for name in ERROR])
+        args = [*names, *(f"u{i}" for i in range(n)), *ROTATION, *ERROR]
+    writer = Writer(namespace, columns=True)
+    for target, value in zip(names, x):
+        writer.assign(target, value)
+    source = _function("advance", args, writer.lines(), names)
+    exec(compile(source, "<reedtool.sim.columns advance>", "exec"), namespace)
+    return control, namespace["advance"]
+
