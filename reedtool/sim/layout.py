@@ -47,8 +47,8 @@ def _c(x) -> np.ndarray:
 def inputs(params, gains: ControllerGains, config: HoverConfig, plant=None,
            setpoint_m=None) -> Inputs:
     """The equations' numbers for `params` flown by `gains` as `config` says; the plant's
-    per-vehicle values from `plant` (default: the nominal vehicle). Thrust and torque maps
-    come from the plant (tests swap them to model a rotor spinning the wrong way)."""
+    from `plant` (default: the nominal vehicle), its thrust and torque maps included
+    (tests swap them to model a rotor spinning the wrong way)."""
     from reedtool.sim.dynamics import Plant
 
     plant = plant if plant is not None else Plant.from_params(params, 1)
@@ -60,11 +60,11 @@ def inputs(params, gains: ControllerGains, config: HoverConfig, plant=None,
     ctl = [gains.kp_1_s2, gains.kd_1_s, gains.ki_1_s3, gains.kR_1_s2, gains.kw_1_s,
            gains.max_horizontal_accel_m_s2, gains.max_vertical_accel_m_s2, gains.mass_kg,
            gains.g_m_s2, *np.asarray(gains.inertia_kg_m2, dtype=float).ravel()]
-    nominal = (float(dt), float(params.g_m_s2), lead is not None,
-               float(gains.max_integral_m_s), _c(np.ravel(params.rotor_position_m)),
+    nominal = (float(dt), float(plant.g_m_s2), lead is not None,
+               float(gains.max_integral_m_s), _c(np.ravel(plant.rotor_position_m)),
                _c(np.asarray(plant.force_map).T.ravel()),
                _c(np.asarray(plant.torque_map).T.ravel()),
-               _c(params.rotor_drag_coefficient), _c(params.rolling_moment_coefficient),
+               _c(plant.rotor_drag_coefficient), _c(plant.rolling_moment_coefficient),
                _c(J0.ravel()), _c(dt * np.linalg.inv(J0).ravel()), _c(1.0 / gains.motor_constant),
                _c(up), _c(down),
                *(_c(f) for f in (lead or (np.ones(n), np.ones(n)))),

@@ -2,10 +2,9 @@
 
 For a single vehicle numpy's per-call overhead (about half a microsecond per operation on
 tiny arrays) dominates, so the array engine in `batch` runs a 10 s flight in seconds.
-`scalar` generates the step for the vehicle at hand (same equations as the array engine:
-motor model, rigid body, controller); this module runs it and judges the flight every
-`config.sample_every` steps. tests/test_sim.py holds the two engines to the same
-trajectory, so the transcription cannot drift from the reference.
+`scalar` generates the step for the vehicle at hand, traced from the flight equations
+(`equations`) as the array engine's is; this module runs it (or the compiled engine) and
+makes the verdict of the judged flight.
 """
 
 from __future__ import annotations
@@ -83,8 +82,8 @@ def simulate_hover(params: VehicleParams, config: HoverConfig = HoverConfig(),
                    initial_omega_rad_s: np.ndarray | None = None) -> HoverRun:
     """Fly `params` from the disturbed start for config.duration_s and judge the hover.
 
-    `engine`: "numpy" (the reference: the generated float step) or "numba" (the compiled
-    kernel of `compiled`, same equations and the same Flight). `gains` and
+    `engine`: "numpy" (the generated float step, no compiler needed) or "numba" (the
+    compiled kernel of `compiled`: the same equations, the same Flight). `gains` and
     `initial_omega_rad_s` override the designed controller and the trim speeds at the
     start (sim.failure: the flight after a rotor fails).
     """
