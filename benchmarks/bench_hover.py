@@ -189,6 +189,9 @@ def main() -> None:
     parser.add_argument("--vehicles", type=int, default=10000)
     parser.add_argument("--duration", type=float, default=10.0)
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--numpy-vehicles", type=int, default=1000,
+                        help="vehicles of the numpy batch (its rate hardly depends on the "
+                             "count beyond a thousand, its run time does)")
     parser.add_argument("--numpy-batch-duration", type=float, default=1.0,
                         help="simulated seconds of the numpy batch (its rate hardly depends "
                              "on the duration, its run time does)")
@@ -224,11 +227,11 @@ def main() -> None:
         print(f"{label}, numba: {statistics.median(numba_x):10.3g} x real time; "
               f"numba / numpy {statistics.median(numba_x) / statistics.median(numpy_x):.1f}")
 
-    steps = args.vehicles * short.n_steps
-    times, _, _ = paired(1, lambda: robustness_batch(params, args.vehicles, short, Spreads(),
-                                                     seed=0, engine="numpy"))
+    steps = args.numpy_vehicles * short.n_steps
+    times, _, _ = paired(1, lambda: robustness_batch(params, args.numpy_vehicles, short,
+                                                     Spreads(), seed=0, engine="numpy"))
     numpy_rate = steps / times[0]
-    print(f"batch of {args.vehicles}, numpy ({short.duration_s:g} s): "
+    print(f"batch of {args.numpy_vehicles}, numpy ({short.duration_s:g} s): "
           f"{numpy_rate / 1e6:10.3g} M vehicle-steps/s")
     if compiled.available():
         steps = args.vehicles * config.n_steps
