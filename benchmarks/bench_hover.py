@@ -7,7 +7,7 @@ the code. Every figure here is measured next to a yardstick, repeat by repeat, a
 target is scaled by the yardstick's rate in that repeat:
 
 - the yardstick (`yardstick`) is a fixed pure-Python float loop written like the
-  generated single-vehicle step, timed in CPU seconds right before each repeat;
+  traced single-vehicle step, timed in CPU seconds right before each repeat;
 - YARDSTICK_REF_M is its rate where the issue-29 targets held; "target here" is the
   target scaled by (yardstick now / YARDSTICK_REF_M), a duration inversely, and "ratio"
   compares the figure with it (>= 1: met), median and spread over the repeats.
@@ -22,33 +22,32 @@ warm cache, <= 0.6 s, timed as processes (CPU seconds of each child) with
 `--engine numpy` and an empty `python -c pass` beside it.
 
 YARDSTICK_REF_M = 1.43 is the yardstick rate at which the numpy engine's single vehicle
-reads 332x (the middle of the 320-344x measured before issue 29), the median over 12
-interleaved pairs: that step is byte-identical to the one measured then (scalar.py's
-source for this quad diffs empty against commit 0ae1443), so it calibrates the yardstick
-and the numba figures are held to it.
+read 332x (the middle of the 320-344x measured before issue 29), the median over 12
+interleaved pairs, with the step a hand-written generator wrote then (commit 0ae1443):
+it calibrates the yardstick, and every figure is held to it.
 
-Whole-process pairs (A B A B, median of the pair ratios A/B and their spread), issue 29:
-- numpy single vehicle, 8 flights of 10 s, the code before issue 29 / commit 0ae1443
-  (the 320-344x era): CPU 1.09 (0.96-1.15): the engine had not slowed, "162x" was load;
-- numba batch, 10,000 vehicles x 5 s, same pair: CPU 1.06 (0.87-1.16): not slowed;
-- `hover-test examples/reed_quad_x --engine numba`, after / before issue 29 (7 pairs):
-  wall 0.78 (0.72-1.34), 1.16 s against 1.40 s median; peak memory 271 against 289 MiB
-  (numba's start-up no longer imports scipy.linalg);
-- the same command, numba / numpy engine (5 pairs): before 1.92 (1.80-2.64, loaded);
-  after 1.94 wall (1.66-2.05) at 1.10 s against 0.55 s: numba's import (~0.3 s) and
-  cache load (~0.2 s) alone exceed 0.6 s minus the command's own 0.5 s, so one vehicle
-  flies on numpy by default (sim.choose_engine).
+Whole-process pairs before the equations became one source (A B A B, median of the pair
+ratios A/B and their spread): the "slip" of issue 29 (162x, 25 M) was load, not code
+(numpy single vehicle CPU 1.09 (0.96-1.15) against commit 0ae1443; numba batch 1.06
+(0.87-1.16)); the block kernel's per-rotor stages then vectorised (numba batch of
+10,000 x 5 s: 0.51 of the wall time).
 
-- numba batch, 10,000 vehicles x 5 s, after / before issue 29 (5 pairs): CPU 0.53
-  (0.49-0.65), wall 0.51 (0.48-0.66): the block kernel's per-rotor loops now vectorise
-  (compiled._w_motors); the report of 2,000 perturbed vehicles is byte-identical.
-
-This script after issue 29's work on sim/ (load ~2.6, 5 repeats; ratio to the scaled
-target, median and spread): numpy single vehicle 142x, ratio 1.02 (0.62-1.54); numba
-batch 34.9 M vehicle-steps/s per thread's CPU second (30.6 M on the wall clock at that
-load), ratio 1.66 (1.44-3.82), 40x the numpy batch; the numba command 1.44 s CPU, ratio
-1.12 (0.84-1.86), +0.70 s over the numpy command's 0.75 s (before: ratio 0.80 for the
-batch, 1.10 for the command, in a run at load ~2).
+After issue 29 item 1 (sim/equations.py the one source; the float step and the numpy
+batch traced from it, numba compiling it), this script at load ~5, 5 repeats:
+- numpy single vehicle 189x real time, ratio 1.01 (0.84-2.24) to the scaled 320x; in
+  pairs against the hand-written generator of before, about 1.1x its CPU time (the
+  trace computes the rolling moments and yaw reactions rotor by rotor);
+- numba batch of 10,000 x 10 s: 36.9 M vehicle-steps per thread's CPU second (10.5 M on
+  the wall clock at that load), ratio 1.62 (1.36-2.85) to the scaled 47 M; the
+  hand-laid block kernel it replaces read 38-39 M in the same conditions;
+- numpy batch of 1,000 x 1.5 s: 0.28 M vehicle-steps/s (the desaturation runs per
+  saturated vehicle: most of this flight's first 0.3 s);
+- the whole `hover-test --engine numba` command, one vehicle: 1.15 s CPU, ratio 0.86
+  (0.66-2.12) to the scaled 0.6 s: numba's import (~0.3 s) and cache load (~0.25 s)
+  alone exceed what 0.6 s leaves beside the command's own ~0.5 s (`--engine numpy`: 0.52
+  s), so one vehicle flies on numpy by default (sim.choose_engine). As whole processes in
+  pairs (median wall, load ~5): one vehicle 2.10 s numba against 1.05 s numpy;
+  `--samples 2` 1.90 s numba against 7.17 s numpy.
 """
 
 from __future__ import annotations
