@@ -22,7 +22,7 @@ from reedtool.sim import STATUS_CODES, STATUS_FROM_CODE, ExitStatus, HoverConfig
 from reedtool.sim import columns, equations
 from reedtool.sim.controller import ControllerDesign, ControllerGains
 from reedtool.sim.dynamics import Plant, State, quat_from_rpy
-from reedtool.sim.motor import speed_command
+from reedtool.sim.layout import hover_speeds
 from reedtool.sim.params import VehicleParams
 
 # Why a run ended, beyond its ExitStatus (index into REASONS).
@@ -112,12 +112,6 @@ def initial_state(params: VehicleParams, gains: ControllerGains, config: HoverCo
                   q=np.repeat(q0[:, None], N, axis=1), w=np.zeros((3, N)),
                   omega=np.repeat(omega0[:, None], N, axis=1))
     return state, setpoint
-
-
-def hover_speeds(params: VehicleParams, gains: ControllerGains) -> np.ndarray:
-    """The controller's allocation of [m*g, 0, 0, 0]: the minimum-norm trim speeds."""
-    thrust = gains.allocation_pinv @ np.array([params.weight_N, 0.0, 0.0, 0.0])
-    return speed_command(thrust, gains.motor_constant, gains.omega_max_rad_s)
 
 
 def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),

@@ -707,8 +707,8 @@ def _settings(config: HoverConfig, setpoint) -> np.ndarray:
 def _start(params, gains, config: HoverConfig) -> tuple[np.ndarray, np.ndarray]:
     """(state0, parked state) as batch.initial_state makes them: the disturbed start at
     rest with the rotors at the controller's trim speeds."""
-    from reedtool.sim.batch import hover_speeds
     from reedtool.sim.dynamics import quat_from_rpy
+    from reedtool.sim.layout import hover_speeds
 
     setpoint = np.array([0.0, 0.0, config.hover_altitude_m])
     p0 = setpoint + np.asarray(config.offset_m, dtype=float)

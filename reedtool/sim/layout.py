@@ -39,6 +39,15 @@ class Inputs:
                 omega_max)
 
 
+def hover_speeds(params, gains: ControllerGains) -> np.ndarray:
+    """The controller's allocation of [m*g, 0, 0, 0]: the minimum-norm trim speeds every
+    engine starts from."""
+    from reedtool.sim.motor import speed_command
+
+    thrust = gains.allocation_pinv @ np.array([params.weight_N, 0.0, 0.0, 0.0])
+    return speed_command(thrust, gains.motor_constant, gains.omega_max_rad_s)
+
+
 def _c(x) -> np.ndarray:
     # fresh writable C arrays: numba types read-only or strided arrays apart (a recompile)
     return np.array(x, dtype=float, order="C", copy=True)

@@ -16,7 +16,8 @@ import numpy as np
 
 from reedtool.io.json_values import finite_or_none
 from reedtool.sim import ExitStatus, HoverConfig
-from reedtool.sim.batch import describe, hover_speeds
+from reedtool.sim.batch import describe
+from reedtool.sim.layout import hover_speeds
 from reedtool.sim.controller import ControllerDesign, ControllerGains
 from reedtool.sim.dynamics import quat_from_rpy
 from reedtool.sim.params import VehicleParams

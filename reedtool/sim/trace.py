@@ -12,8 +12,9 @@ one-line selects, whose `return` expression is written out with the arguments pu
 and the guarded steps (the desaturation), called as the functions themselves under
 their guard.
 
-`Trace.source` turns traced outputs into statements: each node used once is written
-inline in its user, each node used more than once gets a name.
+`Writer.lines` turns traced outputs into statements: each node used once is written
+inline in its user, each node used more than once gets a name. For arrays of vehicles
+(`columns`) the same statements run on numpy rows, selects written as `where`.
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ class Sym:
     the same values is the same Sym (hash-consing: an expression the equations compute
     twice, as the controller's and the rigid body's w x J w, is computed once)."""
 
-    __slots__ = ("op", "args", "name", "serial", "__weakref__")
+    __slots__ = ("op", "args", "name", "serial")
     _serial = itertools.count()
     _made: dict = {}
 
