@@ -4,8 +4,8 @@
 speed command of another controller) traced once (`trace`) with the nominal vehicle's
 numbers as constants and what a robustness batch perturbs per vehicle (mass, inertia
 scale, COM shift, motor constants) as named arrays: each traced operation becomes one
-numpy operation on (N,) arrays, a select becomes `where`, the desaturation runs as the
-function itself on the vehicles whose guard holds. The same trace, with everything a
+numpy operation on (N,) arrays, a select becomes `where`, and the desaturation is traced
+the same way and runs on the vehicles whose guard holds. The same trace, with everything a
 constant, is the float engine's step (`scalar`), so the two fly the same arithmetic.
 """
 
@@ -79,6 +79,19 @@ def build(params, gains, config, plant, speed_command: bool = False) -> tuple:
         source = _function("control", names, writer.lines(), [t for t, _ in outputs])
         exec(compile(source, "<reedtool.sim.columns control>", "exec"), namespace)
         control = namespace["control"]
+        # what equations.desaturate does where its guard holds, traced over columns
+        trace = Trace()
+        wrench = [leaf(name) for name in ("f", "t0", "t1", "t2")]
+        T = [leaf(f"T{i}") for i in range(n)]
+        worst = trace.most_out_of_range(list(T), thrust_max)
+        trace.prioritised(pinv, thrust_max, *wrench, T)
+        writer = Writer(namespace, columns=True)
+        for target, value in [("worst", worst), *((f"T{i}", t) for i, t in enumerate(T))]:
+            writer.assign(target, value)
+        source = _function("desaturate_columns", ["f", "t0", "t1", "t2",
+                                                  *(f"T{i}" for i in range(n))],
+                           writer.lines(), ["worst", *(f"T{i}" for i in range(n))])
+        exec(compile(source, "<reedtool.sim.columns desaturate>", "exec"), namespace)
     trace = Trace()
     x = [leaf(name) for name in names]
     u = [leaf(f"u{i}") for i in range(n)]

@@ -13,8 +13,9 @@ of floats or traced values in the generated one), and no numpy call. The engines
 
 Data-dependent choices are the `@select` functions: one `return a if cond else b`
 line each, which the tracers emit as that very expression (numba inlines it). The
-desaturation is the one branchy step; tracers call `desaturate` itself, guarded by its
-own `out_of_range` test, as the compiled engine runs it.
+desaturation acts only when a rotor is out of range (`@guarded_by` that test): the float
+engine calls `desaturate` itself under its guard, the batch traces its work into columns
+for the vehicles whose guard holds, the compiled engine runs it as written.
 
 Frames and units (docs/hover-test.md, "The simulation"): world z up, gravity -z; body
 axes the base link's, origin at the COM; state p, v (world, m, m/s), q = (w, x, y, z)
@@ -193,17 +194,44 @@ def pinv_thrusts(pinv, f, t0, t1, t2, T):
                             f, t0, t1, t2)
 
 
+@select
+def excess(b, hi):
+    """How far a thrust is outside [0, hi], relative to hi: max(-b, b - hi) / hi, as
+    Python's max evaluates it (negative inside the range)."""
+    return (b - hi if b - hi > -b else -b) / hi
+
+
+@select
+def index_if_above(x, best, i, index):
+    """`i` when x exceeds the best so far, else the index of the best (the first wins a
+    tie)."""
+    return i if x > best else index
+
+
+@select
+def tighter_fit(b, hi, fit):
+    """The scale that brings a thrust b above its maximum hi back to it, when tighter
+    than `fit` (the collective's scale over the rotors so far)."""
+    return hi / b if b > hi and hi / b < fit else fit
+
+
+@select
+def room(d, b, hi, scale):
+    """The smaller of `scale` and the fraction of a change d that keeps the thrust b
+    within [0, hi]."""
+    return (((hi - b) / d if (hi - b) / d < scale else scale) if d > 0.0
+            else ((-b / d if -b / d < scale else scale) if d < 0.0 else scale))
+
+
 def most_out_of_range(T, thrust_max):
     """The rotor whose thrust is furthest out of its range, relative to its maximum (the
     first on a tie): what a saturation streak reports."""
     worst = 0
     best = -math.inf
     for i in range(len(T)):
-        b, hi = T[i], thrust_max[i]
-        excess = (b - hi if b - hi > -b else -b) / hi      # max(-b, b - hi), as Python's
-        if excess > best:
-            best = excess
-            worst = i
+        x = excess(T[i], thrust_max[i])
+        worst = index_if_above(x, best, i, worst)
+        best = larger(x, best)
     return worst
 
 
@@ -211,34 +239,21 @@ def prioritised(pinv, thrust_max, f, t0, t1, t2, T) -> None:
     """The desaturation, into T: as PX4's mixer does, the collective thrust part first
     (scaled into range if it alone saturates), then as much of the roll/pitch part as
     fits, then of the yaw part; the torques keep their direction (clipping each rotor on
-    its own would couple roll into pitch and yaw and can limit-cycle)."""
+    its own would couple roll into pitch and yaw and can limit-cycle). Its choices are
+    selects, so a batch computes it in columns too."""
     n = len(T)
     fit = 1.0
-    any_over = False
     for i in range(n):
-        b = pinv[4 * i] * f
-        T[i] = b
-        if b > thrust_max[i]:
-            ratio = thrust_max[i] / b
-            if not any_over or ratio < fit:
-                fit = ratio
-            any_over = True
+        T[i] = pinv[4 * i] * f
+        fit = tighter_fit(T[i], thrust_max[i], fit)
     for i in range(n):
-        b = T[i] * fit if any_over else T[i]
-        T[i] = clamp(b, 0.0, thrust_max[i])
+        T[i] = clamp(T[i] * fit, 0.0, thrust_max[i])
     for stage in range(2):
         scale = math.inf
         for i in range(n):
             d = pinv[4 * i + 1] * t0 + pinv[4 * i + 2] * t1 if stage == 0 \
                 else pinv[4 * i + 3] * t2
-            if d > 0.0:
-                room = (thrust_max[i] - T[i]) / d
-                if room < scale:
-                    scale = room
-            elif d < 0.0:
-                room = -T[i] / d
-                if room < scale:
-                    scale = room
+            scale = room(d, T[i], thrust_max[i], scale)
         scale = clamp(scale, 0.0, 1.0)
         for i in range(n):
             d = pinv[4 * i + 1] * t0 + pinv[4 * i + 2] * t1 if stage == 0 \

@@ -325,23 +325,20 @@ def select_text(name: str, args: list[str], columns: bool = False) -> str:
 
 
 def guarded_columns(step, mask, heads, T):
-    """A guarded step over a batch: `step` itself, vehicle by vehicle, where `mask` (its
-    guard) holds. Returns (mask, each vehicle's result (0 elsewhere), T)."""
+    """A guarded step over a batch: `step(*heads, *T) -> (result, *T)`, the step traced
+    over columns, on the vehicles where `mask` (its guard) holds. Returns (mask, each
+    vehicle's result (0 elsewhere), T)."""
     import numpy as np
 
     N = len(mask)
-    T = np.array([np.broadcast_to(t, (N,)) for t in T], dtype=float)
+    T = [np.array(np.broadcast_to(t, (N,)), dtype=float) for t in T]
+    where = np.flatnonzero(mask)
+    out = step(*(np.broadcast_to(h, (N,))[where] for h in heads), *(t[where] for t in T))
     result = np.zeros(N, dtype=np.int64)
-    cols = np.flatnonzero(mask)
-    per_column = [h if isinstance(h, tuple) else np.broadcast_to(h, (N,))[cols].tolist()
-                  for h in heads]
-    fixed = [isinstance(h, tuple) for h in heads]
-    columns = T[:, cols].T.tolist()
-    for c, column in enumerate(columns):
-        _, result[cols[c]] = step(*(h if f else h[c] for h, f in zip(per_column, fixed)),
-                                  column)
-    T[:, cols] = np.array(columns).T
-    return mask, result, list(T)
+    result[where] = out[0]
+    for t, new in zip(T, out[1:]):
+        t[where] = new
+    return mask, result, T
 
 
 class Writer:
@@ -521,16 +518,19 @@ class Writer:
         self._result_names[node.serial] = {"changed": changed, "result": result}
         self.namespace[name] = step
         if self.columns:
+            # the step traced over columns (columns.build), on the guarded vehicles
             guards = [select_text(guard, [t, literal(limits[i])], True)
                       for i, t in enumerate(names)]
             mask = guards[0]
             for g in guards[1:]:
                 mask = f"logical_or({mask}, {g})"
             self.namespace["guarded_columns"] = guarded_columns
+            arrays = [h for h, given in zip(heads, head) if not isinstance(given, tuple)]
             return [f"_mask = {mask}",
                     "if _mask.any():",
                     f"    {changed}, {result}, ({', '.join(names)},) = guarded_columns(",
-                    f"        {name}, _mask, ({', '.join(heads)},), ({', '.join(names)},))",
+                    f"        {name}_columns, _mask, ({', '.join(arrays)},), "
+                    f"({', '.join(names)},))",
                     "else:",
                     f"    {changed}, {result} = None, None"]
         return [f"if {test}:",
