@@ -18,22 +18,13 @@ from test_sim import tilted_hex
 from reedtool.sim import HoverConfig, columns, equations, layout
 from reedtool.sim.batch import Spreads, perturbed_plant, sample_perturbations
 from reedtool.sim.controller import ControllerGains
-from reedtool.sim.scalar import ERROR, ROTATION, STATE, step_lines
+from reedtool.sim.layout import ERROR, ROTATION, as_constants, state_names
+from reedtool.sim.scalar import step_lines
 from reedtool.sim.params import symmetric_multirotor
 
 VEHICLES = {"quad": lambda: symmetric_multirotor(4), "tilted-hex": tilted_hex,
             "racing-lead": lambda: symmetric_multirotor(4, time_constant_up_s=0.08,
                                                         time_constant_down_s=0.12)}
-
-
-def floats(x):
-    if isinstance(x, bool):
-        return x
-    if isinstance(x, tuple):
-        return tuple(floats(v) for v in x)
-    if hasattr(x, "shape") and x.shape != ():
-        return tuple(float(v) for v in x)
-    return float(x)
 
 
 def random_states(n_rotors: int, count: int, seed: int) -> np.ndarray:
@@ -56,11 +47,11 @@ def by_the_equations(the, j: int, state: np.ndarray):
     n = len(the.thrust_max)
     x = [float(v) for v in state]
     R, e, T = [0.0] * 9, [0.0] * 3, [0.0] * n
-    saturated, worst = equations.control_state(floats(the.ctl), floats(the.pinv),
-                                               floats(the.thrust_max), floats(the.setpoint),
+    saturated, worst = equations.control_state(as_constants(the.ctl), as_constants(the.pinv),
+                                               as_constants(the.thrust_max), as_constants(the.setpoint),
                                                x, R, e, T)
     controlled = (*R, *e, *T, saturated, worst if saturated else 0)
-    equations.advance_state(floats(the.vehicle(j)), x, T, R, e)
+    equations.advance_state(as_constants(the.vehicle(j)), x, T, R, e)
     return controlled, tuple(x)
 
 
@@ -73,7 +64,7 @@ def test_traced_float_step_is_the_equations_bit_for_bit(name):
     namespace: dict = {}
     before, after = step_lines(params, gains, config, setpoint, namespace)
     n = params.n_rotors
-    names = [*STATE, *(f"om{i}" for i in range(n))]
+    names = state_names(n)
     controlled = [*ROTATION, *ERROR, *(f"T{i}" for i in range(n)), "saturated", "worst"]
     body = "\n".join("    " + line for line in [*before, f"c = ({', '.join(controlled)},)",
                                                  *after, f"return c, ({', '.join(names)},)"])

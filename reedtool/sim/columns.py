@@ -14,23 +14,8 @@ from __future__ import annotations
 import numpy as np
 
 from reedtool.sim import layout
+from reedtool.sim.layout import ERROR, ROTATION, as_constants, state_names
 from reedtool.sim.trace import Trace, Writer, leaf
-
-STATE = ("px", "py", "pz", "vx", "vy", "vz", "qw", "qx", "qy", "qz", "wx", "wy", "wz",
-         "ix", "iy", "iz")
-ROTATION = ("R00", "R01", "R02", "R10", "R11", "R12", "R20", "R21", "R22")
-ERROR = ("ex", "ey", "ez")
-
-
-def _constants(x):
-    if isinstance(x, bool):
-        return x
-    if isinstance(x, tuple):
-        return tuple(_constants(v) for v in x)
-    if hasattr(x, "shape") and x.shape != ():
-        return tuple(float(v) for v in x)
-    return float(x)
-
 
 def _function(name: str, args: list[str], lines: list[str], returns: list[str]) -> str:
     body = "\n".join("    " + line for line in lines)
@@ -48,7 +33,7 @@ def build(params, gains, config, plant, speed_command: bool = False) -> tuple:
     """
     the = layout.inputs(params, gains, config, plant)
     n = params.n_rotors
-    names = [*STATE, *(f"om{i}" for i in range(n))]
+    names = state_names(n)
     namespace: dict = {"sqrt": np.sqrt, "tan": np.tan, "where": np.where,
                        "logical_or": np.logical_or, "logical_and": np.logical_and}
     per_vehicle = {"mass": the.mass, **{f"S{a}": the.S[:, a] for a in range(3)},
@@ -56,7 +41,7 @@ def build(params, gains, config, plant, speed_command: bool = False) -> tuple:
                    **{f"k{i}": the.k[:, i] for i in range(n)}}
     namespace.update({name: np.ascontiguousarray(v) for name, v in per_vehicle.items()})
     dt, g, lead, i_max, pos, axis, tmap, cd, cr, J0, dt_J0inv, inv_k, up, down, lead_up, \
-        lead_down, omega_max = _constants(the.nominal)
+        lead_down, omega_max = as_constants(the.nominal)
     veh = (dt, g, leaf("mass"), lead, i_max, pos, axis, tmap, cd, cr,
            [leaf(f"k{i}") for i in range(n)], [leaf(f"sh{a}") for a in range(3)],
            [leaf(f"S{a}") for a in range(3)], J0, dt_J0inv, inv_k, up, down, lead_up,
@@ -66,7 +51,7 @@ def build(params, gains, config, plant, speed_command: bool = False) -> tuple:
         trace = Trace()
         x = [leaf(name) for name in names]
         R, e, T = [0.0] * 9, [0.0] * 3, [0.0] * n
-        ctl, pinv, thrust_max, sp = (_constants(v) for v in (the.ctl, the.pinv,
+        ctl, pinv, thrust_max, sp = (as_constants(v) for v in (the.ctl, the.pinv,
                                                               the.thrust_max, the.setpoint))
         saturated, worst = trace.control_state(ctl, pinv, thrust_max, sp, x, R, e, T)
         writer = Writer(namespace, columns=True)

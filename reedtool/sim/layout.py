@@ -17,6 +17,29 @@ from reedtool.sim.controller import ControllerGains
 from reedtool.sim.motor import speed_filter_factors
 
 
+# Names of the traced step's values (scalar, columns): the state in equations' layout,
+# the rotation and the position error control_state computes.
+STATE = ("px", "py", "pz", "vx", "vy", "vz", "qw", "qx", "qy", "qz", "wx", "wy", "wz",
+         "ix", "iy", "iz")
+ROTATION = ("R00", "R01", "R02", "R10", "R11", "R12", "R20", "R21", "R22")
+ERROR = ("ex", "ey", "ez")
+
+
+def state_names(n_rotors: int) -> list[str]:
+    return [*STATE, *(f"om{i}" for i in range(n_rotors))]
+
+
+def as_constants(x):
+    """The equations' numbers as Python floats and tuples of them (what a tracer folds)."""
+    if isinstance(x, bool):
+        return x
+    if isinstance(x, tuple):
+        return tuple(as_constants(v) for v in x)
+    if hasattr(x, "shape") and x.shape != ():
+        return tuple(float(v) for v in x)
+    return float(x)
+
+
 @dataclass(frozen=True)
 class Inputs:
     ctl: np.ndarray           # (18,) equations' CTL

@@ -22,13 +22,8 @@ import math
 from typing import Callable, NamedTuple
 
 from reedtool.sim import layout
+from reedtool.sim.layout import ERROR, ROTATION, STATE, as_constants, state_names
 from reedtool.sim.trace import Sym, Trace, Writer, leaf, literal
-
-STATE = ("px", "py", "pz", "vx", "vy", "vz", "qw", "qx", "qy", "qz", "wx", "wy", "wz",
-         "ix", "iy", "iz")
-ROTATION = ("R00", "R01", "R02", "R10", "R11", "R12", "R20", "R21", "R22")
-ERROR = ("ex", "ey", "ez")
-
 
 class Flight(NamedTuple):
     """What `fly` returns: how the run ended and what the judge tracked on the samples."""
@@ -65,17 +60,6 @@ def _compiled(source: str, n_rotors: int):
     return compile(source, f"<reedtool.sim.scalar step, {n_rotors} rotors>", "exec")
 
 
-def _constants(x):
-    """The equations' numbers as Python floats and tuples (what the tracer folds)."""
-    if isinstance(x, bool):
-        return x
-    if isinstance(x, tuple):
-        return tuple(_constants(v) for v in x)
-    if hasattr(x, "shape") and x.shape != ():
-        return tuple(float(v) for v in x)
-    return float(x)
-
-
 def step_lines(params, gains, config, setpoint_m, namespace: dict) -> tuple[list, list]:
     """(before, after): one step traced into statements, from the state named by STATE
     and om<i>. `before` runs equations.control_state (into ROTATION, ERROR, T<i>,
@@ -84,8 +68,8 @@ def step_lines(params, gains, config, setpoint_m, namespace: dict) -> tuple[list
     that are not numbers go into `namespace`."""
     the = layout.inputs(params, gains, config, setpoint_m=setpoint_m)
     n = params.n_rotors
-    names = [*STATE, *(f"om{i}" for i in range(n))]
-    ctl, pinv, thrust_max, sp = (_constants(v) for v in (the.ctl, the.pinv, the.thrust_max,
+    names = state_names(n)
+    ctl, pinv, thrust_max, sp = (as_constants(v) for v in (the.ctl, the.pinv, the.thrust_max,
                                                           the.setpoint))
     trace = Trace()
     x = [leaf(name) for name in names]
@@ -103,7 +87,7 @@ def step_lines(params, gains, config, setpoint_m, namespace: dict) -> tuple[list
         if isinstance(value, Sym) and value.op not in ("leaf", "out"):
             writer.name(value, target)
         writer.assign(target, value, early=True)
-    trace.advance_state(_constants(the.vehicle(0)), x, T, R, e)
+    trace.advance_state(as_constants(the.vehicle(0)), x, T, R, e)
     for target, value in zip(names, x):
         writer.assign(target, value)
     return writer.lines(split=True)
