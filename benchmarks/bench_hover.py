@@ -33,21 +33,22 @@ ratios A/B and their spread): the "slip" of issue 29 (162x, 25 M) was load, not 
 10,000 x 5 s: 0.51 of the wall time).
 
 After issue 29 item 1 (sim/equations.py the one source; the float step and the numpy
-batch traced from it, numba compiling it), this script at load ~5, 5 repeats:
-- numpy single vehicle 189x real time, ratio 1.01 (0.84-2.24) to the scaled 320x; in
-  pairs against the hand-written generator of before, about 1.1x its CPU time (the
-  trace computes the rolling moments and yaw reactions rotor by rotor);
-- numba batch of 10,000 x 10 s: 36.9 M vehicle-steps per thread's CPU second (10.5 M on
-  the wall clock at that load), ratio 1.62 (1.36-2.85) to the scaled 47 M; the
-  hand-laid block kernel it replaces read 38-39 M in the same conditions;
-- numpy batch of 1,000 x 1.5 s: 0.28 M vehicle-steps/s (the desaturation runs per
-  saturated vehicle: most of this flight's first 0.3 s);
-- the whole `hover-test --engine numba` command, one vehicle: 1.15 s CPU, ratio 0.86
-  (0.66-2.12) to the scaled 0.6 s: numba's import (~0.3 s) and cache load (~0.25 s)
-  alone exceed what 0.6 s leaves beside the command's own ~0.5 s (`--engine numpy`: 0.52
-  s), so one vehicle flies on numpy by default (sim.choose_engine). As whole processes in
-  pairs (median wall, load ~5): one vehicle 2.10 s numba against 1.05 s numpy;
-  `--samples 2` 1.90 s numba against 7.17 s numpy.
+batch traced from it, numba compiling it), this script, 5 repeats each, at load ~2.6
+(and ~5 in a first run):
+- numpy single vehicle 198x real time, ratio 0.98 (0.97-1.00) to the scaled 320x (1.01,
+  0.84-2.24, at load ~5); in pairs against the hand-written generator of before, about
+  1.1x its CPU time (the trace computes the rolling moments and yaw reactions rotor by
+  rotor, where the generator had factored them by hand);
+- numba batch of 10,000 x 10 s: 40.1 M vehicle-steps per thread's CPU second (19.8 M on
+  the wall clock), ratio 1.59 (1.26-2.03) to the scaled 47 M (1.62 at load ~5); the
+  hand-laid block kernel it replaces read 38-39 M beside it in pairs;
+- numpy batch of 1,000 x 1.5 s: 1.19 M vehicle-steps/s;
+- the whole `hover-test --engine numba` command, one vehicle: 1.00 s CPU, ratio 1.01
+  (0.77-1.07) to the scaled 0.6 s (0.86 at load ~5), 0.36 s more than `--engine numpy`
+  (0.63 s): numba's import (~0.3 s) and cache load (~0.25 s) are most of it, so one
+  vehicle flies on numpy by default (sim.choose_engine). As whole processes in pairs
+  (median wall): one vehicle 2.10 s numba against 1.05 s numpy (load ~5); `--samples 2`
+  1.29 s numba against 4.77 s numpy (load ~1.6).
 """
 
 from __future__ import annotations

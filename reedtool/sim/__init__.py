@@ -105,7 +105,7 @@ def choose_engine(requested: str, batch: bool) -> str:
     "Speed"): one vehicle flies 10 s in ~50 ms on numpy, less than numba's own start-up
     (importing numba and loading its cached kernel, ~0.55 s of CPU), so numpy finishes
     first (1.05 s against 2.10 s wall); a batch, even of 2 vehicles, is faster as a whole
-    on numba (1.90 s against 7.17 s), the numpy batch paying its per-step array overhead
+    on numba (1.29 s against 4.77 s), the numpy batch paying its per-step array overhead
     ~10,000 times.
     """
     if requested != "auto":
