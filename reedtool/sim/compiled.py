@@ -5,7 +5,12 @@ Optional (numba): without it, `available()` is False and the numpy engines (`run
 (`jitted`): the same Python functions the generated engines are traced from, so the
 compiled engine flies them by construction. What is written here is the loop around
 them and the judge of `batch.simulate_batch`: `_fly` flies one vehicle; `_fly_batch`
-flies each vehicle of a batch on `_fly`, spread over the cores (`prange`).
+flies blocks of BLOCK vehicles on `_fly_block`, spread over the cores (`prange`), each
+stage of a block one loop over its vehicles that calls an equation inlined (SIMD lanes).
+
+Rotor failures: every per-rotor quantity goes through the kernels as arrays indexed by
+rotor, and the rotor speed is advanced in one place (`equations.advance_plant`'s lag,
+`_w_motors` for a block); a per-rotor "alive" mask or failure time belongs there.
 """
 
 from __future__ import annotations
@@ -29,9 +34,6 @@ try:        # the extra; everything below the guard needs it
     from numba import njit, prange
 except ImportError:         # pragma: no cover - exercised where the extra is absent
     numba = None
-
-ENGINE_NUMPY = "numpy"
-ENGINE_COMPILED = "numba"
 
 
 def available() -> bool:
@@ -690,7 +692,6 @@ def _load_numba_typing() -> None:
         if sys.modules.get("scipy.linalg", 0) is None:
             del sys.modules["scipy.linalg"]
     arraymath._HAVE_BLAS = importlib.util.find_spec("scipy.linalg") is not None
-
 
 
 def _settings(config: HoverConfig, setpoint) -> np.ndarray:
