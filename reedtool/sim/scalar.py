@@ -160,8 +160,9 @@ def _source(params, gains, config, setpoint_m, namespace: dict) -> str:
         "    next_sample = 0",
         "    for step in range(n_steps + 1):",
         indent(before, 8),
-        "        if step == next_sample or step == n_steps:",
-        "            next_sample += every",
+        "        if step == next_sample:",      # every `every` steps, and the last
+        "            next_sample = next_sample + every if next_sample + every < n_steps "
+        "else n_steps",
         indent(judge, 12),
         indent(after, 8),
         "",
