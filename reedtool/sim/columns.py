@@ -3,7 +3,7 @@
 `equations.control_state` and `equations.advance_state` (or `advance_plant`, under a
 speed command of another controller) traced once (`trace`) with the nominal vehicle's
 numbers as constants and what a robustness batch perturbs per vehicle (mass, inertia
-scale, COM shift, motor constants) as named arrays: each traced operation becomes one
+scale, COM shift, motor constants) as named arrays where the vehicles differ: each traced operation becomes one
 numpy operation on (N,) arrays, a select becomes `where`, and the desaturation is traced
 the same way and runs on the vehicles whose guard holds. The same trace, with everything a
 constant, is the float engine's step (`scalar`), so the two fly the same arithmetic.
@@ -39,12 +39,20 @@ def build(params, gains, config, plant, speed_command: bool = False) -> tuple:
     per_vehicle = {"mass": the.mass, **{f"S{a}": the.S[:, a] for a in range(3)},
                    **{f"sh{a}": the.shift[:, a] for a in range(3)},
                    **{f"k{i}": the.k[:, i] for i in range(n)}}
-    namespace.update({name: np.ascontiguousarray(v) for name, v in per_vehicle.items()})
+    # A value every vehicle shares (all of them for a lone or unperturbed vehicle) is a
+    # constant, folded as the float engine folds it; the others are arrays.
+    value = {}
+    for name, v in per_vehicle.items():
+        if np.all(v == v[0]):
+            value[name] = float(v[0])
+        else:
+            namespace[name] = np.ascontiguousarray(v)
+            value[name] = leaf(name)
     dt, g, lead, i_max, pos, axis, tmap, cd, cr, J0, dt_J0inv, inv_k, up, down, lead_up, \
         lead_down, omega_max = as_constants(the.nominal)
-    veh = (dt, g, leaf("mass"), lead, i_max, pos, axis, tmap, cd, cr,
-           [leaf(f"k{i}") for i in range(n)], [leaf(f"sh{a}") for a in range(3)],
-           [leaf(f"S{a}") for a in range(3)], J0, dt_J0inv, inv_k, up, down, lead_up,
+    veh = (dt, g, value["mass"], lead, i_max, pos, axis, tmap, cd, cr,
+           [value[f"k{i}"] for i in range(n)], [value[f"sh{a}"] for a in range(3)],
+           [value[f"S{a}"] for a in range(3)], J0, dt_J0inv, inv_k, up, down, lead_up,
            lead_down, omega_max)
     control = None
     if not speed_command:
