@@ -7,7 +7,7 @@ the code. Every figure here is measured next to a yardstick, repeat by repeat, a
 target is scaled by the yardstick's rate in that repeat:
 
 - the yardstick (`yardstick`) is a fixed pure-Python float loop written like the
-  generated single-vehicle step, timed in CPU seconds right before each repeat;
+  traced single-vehicle step, timed in CPU seconds right before each repeat;
 - YARDSTICK_REF_M is its rate where the issue-29 targets held; "target here" is the
   target scaled by (yardstick now / YARDSTICK_REF_M), a duration inversely, and "ratio"
   compares the figure with it (>= 1: met), median and spread over the repeats.
@@ -22,33 +22,33 @@ warm cache, <= 0.6 s, timed as processes (CPU seconds of each child) with
 `--engine numpy` and an empty `python -c pass` beside it.
 
 YARDSTICK_REF_M = 1.43 is the yardstick rate at which the numpy engine's single vehicle
-reads 332x (the middle of the 320-344x measured before issue 29), the median over 12
-interleaved pairs: that step is byte-identical to the one measured then (scalar.py's
-source for this quad diffs empty against commit 0ae1443), so it calibrates the yardstick
-and the numba figures are held to it.
+read 332x (the middle of the 320-344x measured before issue 29), the median over 12
+interleaved pairs, with the step a hand-written generator wrote then (commit 0ae1443):
+it calibrates the yardstick, and every figure is held to it.
 
-Whole-process pairs (A B A B, median of the pair ratios A/B and their spread), issue 29:
-- numpy single vehicle, 8 flights of 10 s, the code before issue 29 / commit 0ae1443
-  (the 320-344x era): CPU 1.09 (0.96-1.15): the engine had not slowed, "162x" was load;
-- numba batch, 10,000 vehicles x 5 s, same pair: CPU 1.06 (0.87-1.16): not slowed;
-- `hover-test examples/reed_quad_x --engine numba`, after / before issue 29 (7 pairs):
-  wall 0.78 (0.72-1.34), 1.16 s against 1.40 s median; peak memory 271 against 289 MiB
-  (numba's start-up no longer imports scipy.linalg);
-- the same command, numba / numpy engine (5 pairs): before 1.92 (1.80-2.64, loaded);
-  after 1.94 wall (1.66-2.05) at 1.10 s against 0.55 s: numba's import (~0.3 s) and
-  cache load (~0.2 s) alone exceed 0.6 s minus the command's own 0.5 s, so one vehicle
-  flies on numpy by default (sim.choose_engine).
+Whole-process pairs before the equations became one source (A B A B, median of the pair
+ratios A/B and their spread): the "slip" of issue 29 (162x, 25 M) was load, not code
+(numpy single vehicle CPU 1.09 (0.96-1.15) against commit 0ae1443; numba batch 1.06
+(0.87-1.16)); the block kernel's per-rotor stages then vectorised (numba batch of
+10,000 x 5 s: 0.51 of the wall time).
 
-- numba batch, 10,000 vehicles x 5 s, after / before issue 29 (5 pairs): CPU 0.53
-  (0.49-0.65), wall 0.51 (0.48-0.66): the block kernel's per-rotor loops now vectorise
-  (compiled._w_motors); the report of 2,000 perturbed vehicles is byte-identical.
-
-This script after issue 29's work on sim/ (load ~2.6, 5 repeats; ratio to the scaled
-target, median and spread): numpy single vehicle 142x, ratio 1.02 (0.62-1.54); numba
-batch 34.9 M vehicle-steps/s per thread's CPU second (30.6 M on the wall clock at that
-load), ratio 1.66 (1.44-3.82), 40x the numpy batch; the numba command 1.44 s CPU, ratio
-1.12 (0.84-1.86), +0.70 s over the numpy command's 0.75 s (before: ratio 0.80 for the
-batch, 1.10 for the command, in a run at load ~2).
+After issue 29 item 1 (sim/equations.py the one source; the float step and the numpy
+batch traced from it, numba compiling it), this script, 5 repeats each, at load ~2.6
+(and ~5 in a first run):
+- numpy single vehicle 198x real time, ratio 0.98 (0.97-1.00) to the scaled 320x (1.01,
+  0.84-2.24, at load ~5); in pairs against the hand-written generator of before, about
+  1.1x its CPU time (the trace computes the rolling moments and yaw reactions rotor by
+  rotor, where the generator had factored them by hand);
+- numba batch of 10,000 x 10 s: 40.1 M vehicle-steps per thread's CPU second (19.8 M on
+  the wall clock), ratio 1.59 (1.26-2.03) to the scaled 47 M (1.62 at load ~5); the
+  hand-laid block kernel it replaces read 38-39 M beside it in pairs;
+- numpy batch of 1,000 x 1.5 s: 1.19 M vehicle-steps/s;
+- the whole `hover-test --engine numba` command, one vehicle: 1.00 s CPU, ratio 1.01
+  (0.77-1.07) to the scaled 0.6 s (0.86 at load ~5), 0.36 s more than `--engine numpy`
+  (0.63 s): numba's import (~0.3 s) and cache load (~0.25 s) are most of it, so one
+  vehicle flies on numpy by default (sim.choose_engine). As whole processes in pairs
+  (median wall): one vehicle 2.10 s numba against 1.05 s numpy (load ~5); `--samples 2`
+  1.29 s numba against 4.77 s numpy (load ~1.6).
 """
 
 from __future__ import annotations
@@ -189,6 +189,9 @@ def main() -> None:
     parser.add_argument("--vehicles", type=int, default=10000)
     parser.add_argument("--duration", type=float, default=10.0)
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--numpy-vehicles", type=int, default=1000,
+                        help="vehicles of the numpy batch (its rate hardly depends on the "
+                             "count beyond a thousand, its run time does)")
     parser.add_argument("--numpy-batch-duration", type=float, default=1.0,
                         help="simulated seconds of the numpy batch (its rate hardly depends "
                              "on the duration, its run time does)")
@@ -224,11 +227,11 @@ def main() -> None:
         print(f"{label}, numba: {statistics.median(numba_x):10.3g} x real time; "
               f"numba / numpy {statistics.median(numba_x) / statistics.median(numpy_x):.1f}")
 
-    steps = args.vehicles * short.n_steps
-    times, _, _ = paired(1, lambda: robustness_batch(params, args.vehicles, short, Spreads(),
-                                                     seed=0, engine="numpy"))
+    steps = args.numpy_vehicles * short.n_steps
+    times, _, _ = paired(1, lambda: robustness_batch(params, args.numpy_vehicles, short,
+                                                     Spreads(), seed=0, engine="numpy"))
     numpy_rate = steps / times[0]
-    print(f"batch of {args.vehicles}, numpy ({short.duration_s:g} s): "
+    print(f"batch of {args.numpy_vehicles}, numpy ({short.duration_s:g} s): "
           f"{numpy_rate / 1e6:10.3g} M vehicle-steps/s")
     if compiled.available():
         steps = args.vehicles * config.n_steps

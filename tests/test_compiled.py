@@ -1,8 +1,10 @@
-"""The compiled engine (reedtool[fast]) against the numpy engines, the reference.
+"""The compiled engine (reedtool[fast]) against the numpy engines.
 
-Same inputs, same equations: results agree to test_sim.ENGINE_RTOL relative, derived there
-from what these flights make of a few-ulp change of their inputs (the engines differ by
-rounding only: other summation orders and kernels). Relative to a quantity's scale: a value that settles near 0 (a
+Both fly equations.py's functions (compiled.jitted is equations' code compiled; the numpy
+engines are traced from it), so the outcome is the same arithmetic; compilers may still
+contract or reorder a few operations (LLVM's fused multiply-adds, the block's lanes), so
+results are held to test_sim.ENGINE_RTOL relative, derived there from what these flights
+make of a few-ulp change of their inputs. Relative to a quantity's scale: a value that settles near 0 (a
 position error of 1e-5 m, the difference of two ~2 m coordinates; a crash depth of 2 cm
 after a 2 m fall) keeps only the digits the flight left it in either engine, so the
 absolute tolerance is ENGINE_RTOL times the largest magnitude of that quantity in the run or
@@ -166,43 +168,20 @@ def test_default_engine_is_numba_for_a_batch_numpy_for_one_vehicle(monkeypatch):
     assert choose_engine("auto", batch=True) == "numpy"
 
 
-def test_desaturation_is_one_function_in_every_per_vehicle_engine():
-    """compiled's desaturation and worst rotor are controller.prioritised_one and
-    most_out_of_range_one jitted, the generated step's the same functions run by Python:
-    bit-identical on saturating wrenches (the same IEEE operations in the same order;
-    exact by construction). The vectorised batch rule agrees to rounding (matmul may sum
-    in another order: a few ulps of ~10 N thrusts, 1e-12 relative is ~1e4 ulps), and
-    names the same worst rotor."""
-    from reedtool.sim.controller import ControllerGains, _prioritised, prioritised_one
-    from reedtool.sim.run import _prioritised as generated_step_desaturation
+def test_every_compiled_equation_is_equations_own_code():
+    """The compiled engine's equations are equations.py's functions compiled, not a
+    transcription: each jitted function runs the very code object of its namesake, and
+    every function of equations is compiled."""
+    import types
 
-    from reedtool.sim.controller import allocate, most_out_of_range_one
+    from reedtool.sim import equations
 
-    assert compiled._prioritised.py_func is prioritised_one
-    assert compiled._most_out_of_range.py_func is most_out_of_range_one
-    params = tilted_hex()
-    gains = ControllerGains.from_params(params)
-    pinv = np.ascontiguousarray(gains.allocation_pinv, dtype=float)
-    hi = gains.motor_constant * gains.omega_max_rad_s ** 2
-    rng = np.random.default_rng(3)
-    wrenches = rng.normal(size=(4, 200)) * np.array([[3 * params.weight_N], [2], [2], [1]])
-    rows = [tuple(float(x) for x in row) for row in pinv]
-    vectorised = _prioritised(pinv, wrenches, np.repeat(hi[:, None], 200, axis=1))
-    _, _, batch_worst = allocate(pinv, wrenches, hi)
-    saturating = 0
-    for j in range(200):
-        f, t0, t1, t2 = (float(x) for x in wrenches[:, j])
-        plain = pinv @ wrenches[:, j]
-        saturating += bool(np.any(plain < 0.0) or np.any(plain > hi))
-        jitted = np.empty(len(hi))
-        compiled._prioritised(pinv, hi, f, t0, t1, t2, jitted)
-        python = generated_step_desaturation(rows, [float(x) for x in hi], f, t0, t1, t2)
-        assert jitted.tolist() == python
-        worst = most_out_of_range_one(tuple(float(x) for x in plain), [float(x) for x in hi])
-        assert compiled._most_out_of_range(plain, hi) == worst == batch_worst[j]
-        np.testing.assert_allclose(python, vectorised[:, j], rtol=1e-12, atol=1e-12 * hi.max())
-        assert np.all(jitted >= 0.0) and np.all(jitted <= hi)
-    assert saturating > 150         # the wrenches exercise the desaturation, not the pinv
+    functions = {name for name, f in vars(equations).items()
+                 if isinstance(f, types.FunctionType) and f.__module__ == equations.__name__
+                 and name not in ("select", "guarded_by")}
+    assert set(compiled.jitted) == functions
+    for name, jitted in compiled.jitted.items():
+        assert jitted.py_func.__code__ is getattr(equations, name).__code__
 
 
 def test_numba_loads_without_importing_scipy_linalg():
@@ -228,18 +207,18 @@ def test_numba_loads_without_importing_scipy_linalg():
     assert out == ["False", "True", "5.0"]
 
 
-def test_kernel_cache_is_stamped_with_the_shared_functions_sources():
-    """numba keys a cached kernel to its own file; the kernels inline functions of
-    controller.py and motor.py, so their cache stamp carries those files' digests too
-    (an edit there recompiles them instead of flying old code)."""
+def test_kernel_cache_is_stamped_with_the_equations_source():
+    """numba keys a cached kernel to its own file; the kernels run equations.py's
+    functions, so their cache stamp carries that file's digest too (an edit there
+    recompiles them instead of flying old code)."""
     import hashlib
     import inspect
 
-    from reedtool.sim import controller, motor
+    from reedtool.sim import equations
 
     stamp = compiled._fly_block._cache._impl.locator.get_source_stamp()
-    digests = sorted(hashlib.sha256(open(inspect.getfile(m), "rb").read()).digest()
-                     for m in (controller, motor))
-    assert sorted(stamp[1:]) == digests
+    assert list(stamp[1:]) == [hashlib.sha256(open(inspect.getfile(equations), "rb")
+                                              .read()).digest()]
     # numba's own locators still serve functions of other files
-    assert not type(compiled._prioritised._cache._impl.locator).__name__.startswith("Shared")
+    assert not type(compiled.jitted["rotation"]._cache._impl.locator).__name__.startswith(
+        "Shared")

@@ -17,7 +17,8 @@ from reedtool.sim.batch import (
     sample_perturbations,
     simulate_batch,
 )
-from reedtool.sim.controller import ControllerGains, allocate
+from reedtool.sim import equations
+from reedtool.sim.controller import ControllerGains
 from reedtool.sim.dynamics import (
     Plant,
     State,
@@ -26,7 +27,7 @@ from reedtool.sim.dynamics import (
     rot_matrices,
     step_rigid_body,
 )
-from reedtool.sim.motor import drag_matrices, speed_command, speed_filter_factors
+from reedtool.sim.motor import speed_command, speed_filter_factors
 from reedtool.sim.params import VehicleParams, symmetric_multirotor
 from reedtool.sim.run import simulate_hover
 
@@ -108,22 +109,26 @@ def test_thrust_and_yaw_reaction_follow_rotors_conventions():
                                atol=1e-12)
 
 
-def test_rotor_drag_matrices_match_the_per_rotor_formula():
+def test_rotor_drag_matches_the_per_rotor_formula():
+    # equations.rotor_wrench's drag against RotorS' formula written here with numpy's
+    # cross products: force -w c_d u_perp at the rotor, its moment r x F, rolling moment
+    # -w c_r u_perp, u the rotor's airspeed v + w x r without its part along the axis.
     params = tilted_hex()
-    K = drag_matrices(params.rotor_position_m, params.rotor_axis,
-                      params.rotor_drag_coefficient, params.rolling_moment_coefficient)
     rng = np.random.default_rng(1)
     v, w = rng.normal(size=3), rng.normal(size=3)
+    speed = 500.0
     for i in range(params.n_rotors):
         r, a = params.rotor_position_m[i], params.rotor_axis[i]
         u = v + np.cross(w, r)
         u_perp = u - (u @ a) * a
-        force = -params.rotor_drag_coefficient[i] * u_perp
-        expected = np.concatenate([force, np.cross(r, force),
-                                   -params.rolling_moment_coefficient[i] * u_perp])
-        # Entries ~1e-4 (drag coefficients) times O(1) speeds: rounding ~1e-20; 1e-15 is
-        # far above it and far below the entries themselves.
-        np.testing.assert_allclose(K[:, :, i] @ np.concatenate([v, w]), expected, atol=1e-15)
+        force = -speed * params.rotor_drag_coefficient[i] * u_perp
+        expected = np.concatenate([force, np.cross(r, force)
+                                   - speed * params.rolling_moment_coefficient[i] * u_perp])
+        got = equations.rotor_wrench(*r, *a, 0.0, 0.0, 0.0, params.rotor_drag_coefficient[i],
+                                     params.rolling_moment_coefficient[i], 0.0, speed, *v, *w)
+        # Entries ~0.04 N (drag coefficients ~1e-4 times 500 rad/s, O(1) speeds):
+        # rounding ~1e-17; 1e-13 is far above it and far below the entries themselves.
+        np.testing.assert_allclose(got, expected, atol=1e-13)
 
 
 def test_motor_response_and_command_limits():
@@ -143,8 +148,12 @@ def test_allocation_desaturates_keeping_the_torque_direction():
     gains = ControllerGains.from_params(params)
     t_max = params.thrust_max_N
     wrench = np.array([[params.weight_N], [3.0], [1.5], [0.4]])   # far beyond authority
-    thrust, saturated, _ = allocate(gains.allocation_pinv, wrench, t_max)
-    assert saturated[0]
+    pinv = tuple(float(x) for x in gains.allocation_pinv.ravel())
+    thrust = [0.0] * 4
+    equations.pinv_thrusts(pinv, *wrench[:, 0], thrust)
+    saturated, _ = equations.desaturate(pinv, tuple(t_max), *wrench[:, 0], thrust)
+    thrust = np.array(thrust)[:, None]
+    assert saturated
     assert np.all(thrust >= -1e-12) and np.all(thrust <= t_max[:, None] + 1e-9)
     achieved = params.allocation() @ thrust[:, 0]
     assert achieved[0] == pytest.approx(params.weight_N)         # thrust kept

@@ -101,11 +101,12 @@ def choose_engine(requested: str, batch: bool) -> str:
     """The engine that flies a run: `requested` unless "auto".
 
     "auto" is numba for a run with a batch, when numba imports, and numpy otherwise.
-    Measured as whole `hover-test` processes (benchmarks/bench_hover.py, docs/hover-test.md):
-    one vehicle flies 10 s in ~30 ms on numpy, less than numba's own start-up (importing
-    numba and loading its cached kernels, ~0.5 s), so numpy finishes first; a batch, even of
-    2 vehicles, is ~2x faster as a whole on numba, the numpy batch paying its per-step
-    array overhead ~10,000 times.
+    Measured as whole `hover-test` processes (benchmarks/bench_hover.py, docs/hover-test.md,
+    "Speed"): one vehicle flies 10 s in ~50 ms on numpy, less than numba's own start-up
+    (importing numba and loading its cached kernel, ~0.55 s of CPU), so numpy finishes
+    first (1.05 s against 2.10 s wall); a batch, even of 2 vehicles, is faster as a whole
+    on numba (1.29 s against 4.77 s), the numpy batch paying its per-step array overhead
+    ~10,000 times.
     """
     if requested != "auto":
         return requested

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from reedtool.sim import ExitStatus, HoverConfig
-from reedtool.sim.batch import hover_speeds
+from reedtool.sim.layout import hover_speeds
 from reedtool.sim.controller import ControllerDesign, ControllerGains
 from reedtool.sim.params import VehicleParams
 from reedtool.sim.run import HoverRun, simulate_hover

@@ -2,10 +2,9 @@
 
 For a single vehicle numpy's per-call overhead (about half a microsecond per operation on
 tiny arrays) dominates, so the array engine in `batch` runs a 10 s flight in seconds.
-`scalar` generates the step for the vehicle at hand (same equations as the array engine:
-motor model, rigid body, controller); this module runs it and judges the flight every
-`config.sample_every` steps. tests/test_sim.py holds the two engines to the same
-trajectory, so the transcription cannot drift from the reference.
+`scalar` generates the step for the vehicle at hand, traced from the flight equations
+(`equations`) as the array engine's is; this module runs it (or the compiled engine) and
+makes the verdict of the judged flight.
 """
 
 from __future__ import annotations
@@ -17,9 +16,9 @@ import numpy as np
 
 from reedtool.io.json_values import finite_or_none
 from reedtool.sim import ExitStatus, HoverConfig
-from reedtool.sim.batch import describe, hover_speeds
-from reedtool.sim.controller import (ControllerDesign, ControllerGains,
-                                     most_out_of_range_one, prioritised_one)
+from reedtool.sim.batch import describe
+from reedtool.sim.layout import hover_speeds
+from reedtool.sim.controller import ControllerDesign, ControllerGains
 from reedtool.sim.dynamics import quat_from_rpy
 from reedtool.sim.params import VehicleParams
 from reedtool.sim.scalar import compile_vehicle
@@ -84,8 +83,8 @@ def simulate_hover(params: VehicleParams, config: HoverConfig = HoverConfig(),
                    initial_omega_rad_s: np.ndarray | None = None) -> HoverRun:
     """Fly `params` from the disturbed start for config.duration_s and judge the hover.
 
-    `engine`: "numpy" (the reference: the generated float step) or "numba" (the compiled
-    kernel of `compiled`, same equations and the same Flight). `gains` and
+    `engine`: "numpy" (the generated float step, no compiler needed) or "numba" (the
+    compiled kernel of `compiled`: the same equations, the same Flight). `gains` and
     `initial_omega_rad_s` override the designed controller and the trim speeds at the
     start (sim.failure: the flight after a rotor fails).
     """
@@ -100,8 +99,7 @@ def simulate_hover(params: VehicleParams, config: HoverConfig = HoverConfig(),
 
         fly = vehicle_flyer(params, gains, config, setpoint)
     else:
-        fly = compile_vehicle(params, gains, config, setpoint, most_out_of_range_one,
-                              _prioritised)
+        fly = compile_vehicle(params, gains, config, setpoint)
 
     # ---- the disturbed start: rotors at the trim speeds, at rest
     p0 = tuple(sp + off for sp, off in zip(setpoint, config.offset_m))
@@ -151,15 +149,6 @@ def simulate_hover(params: VehicleParams, config: HoverConfig = HoverConfig(),
 _EVENTS = {"non-finite": ExitStatus.DIVERGED, "flipped": ExitStatus.CRASHED,
            "ground": ExitStatus.CRASHED, "yaw-spin": ExitStatus.YAW_SPIN,
            "drifted": ExitStatus.DIVERGED, "rate": ExitStatus.DIVERGED}
-
-
-def _prioritised(rows: list[tuple], thrust_max: list[float], f: float, t0: float, t1: float,
-                 t2: float) -> list[float]:
-    """controller.prioritised_one (the one desaturation of the per-vehicle engines) as the
-    generated step calls it: the thrusts returned as a list."""
-    thrust = [0.0] * len(rows)
-    prioritised_one(rows, thrust_max, f, t0, t1, t2, thrust)
-    return thrust
 
 
 def sample_series(rec: list[tuple], rotor_names: tuple[str, ...]) -> dict[str, np.ndarray]:
