@@ -35,3 +35,19 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if item.module is not None and item.module.__name__.rpartition(".")[2] in NUMERIC_MODULES:
             item.add_marker(pytest.mark.numeric)
+
+
+def pytest_sessionstart(session):
+    """Compile the numba kernels once, in the process that hands out the work, before the
+    workers start (`pytest -n N`): on a cold cache (every CI run) each worker, and each
+    hover-test subprocess a test starts, would otherwise compile them itself (~30 s of CPU
+    each) until one of them had written numba's cache. A run in one process compiles them
+    on first use, as before."""
+    config = session.config
+    distributed = getattr(config.option, "numprocesses", None) not in (None, 0)
+    if hasattr(config, "workerinput") or not distributed:
+        return
+    from reedtool.sim import compiled
+
+    if compiled.available():
+        compiled.warm_up()

@@ -74,7 +74,7 @@ PROGRESS_AFTER_S = 2.0
               show_default=True, help=f"{SPREAD_HELP} of each motor constant (fraction).")
 @click.option("--engine", type=click.Choice(["auto", "numpy", "numba"]), default="auto",
               show_default=True,
-              help="Simulator engine: numpy (the reference) or numba (compiled, all cores; "
+              help="Simulator engine: numpy (no compiler needed) or numba (compiled, all cores; "
                    "needs numba: pip install numba); auto: numba for a --samples batch "
                    "when it is installed, numpy for one vehicle (faster as a whole).")
 @click.option("--min-pass-rate", type=FiniteFloatRange(0.0, 1.0), default=0.95,
