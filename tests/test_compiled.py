@@ -184,6 +184,26 @@ def test_every_compiled_equation_is_equations_own_code():
         assert jitted.py_func.__code__ is getattr(equations, name).__code__
 
 
+def test_compiled_judge_is_equations_own_code():
+    """The kernels judge a flight with equations' judge compiled: the functions _fly and
+    _fly_block call are judge_sample, verdict, settle_time and judge_start's own code
+    objects, and no kernel carries a judge of its own (no reason code is named in
+    compiled.py's source)."""
+    import inspect
+
+    from reedtool.sim import equations
+
+    for name in ("judge_start", "judge_sample", "verdict", "settle_time"):
+        assert getattr(compiled, "_" + name).py_func.__code__ is \
+            getattr(equations, name).__code__
+    source = inspect.getsource(compiled)
+    for code in ("NON_FINITE", "FLIPPED", "GROUND", "YAW_SPIN", "DRIFTED", "RATE"):
+        assert code not in source
+    for kernel in (compiled._fly, compiled._fly_block):
+        names = kernel.py_func.__code__.co_names
+        assert "_judge_sample" in names and "_verdict" in names
+
+
 def test_numba_loads_without_importing_scipy_linalg():
     """The compiled engine's start-up leaves scipy.linalg unimported (numba's BLAS probe
     would import it: ~0.3 s of a single-vehicle run) and numba's answer as it was."""

@@ -5,7 +5,8 @@ per vehicle): the step is the flight equations traced over arrays (`columns`), t
 trace as the single-vehicle float engine's (`scalar`), so the two fly the same arithmetic.
 The robustness batch perturbs the plant (mass, inertia, COM, per-motor constants) and
 flies every vehicle on the controller designed for the nominal model, as a real airframe
-is flown on the model it was tuned from. The judge of a flight lives here.
+is flown on the model it was tuned from. The judge of a flight is equations' too
+(`judge_sample`, `verdict`, `settle_time`), traced over the columns (`columns.build_judge`).
 """
 
 from __future__ import annotations

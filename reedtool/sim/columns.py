@@ -11,6 +11,8 @@ constant, is the float engine's step (`scalar`), so the two fly the same arithme
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from reedtool.sim import layout
@@ -105,6 +107,16 @@ def build(params, gains, config, plant, speed_command: bool = False) -> tuple:
 
 
 
+def _acos(x):
+    """math.acos over an array: numpy's arccos differs from it in the last bit (its own
+    approximation), and the judge's numbers are equations' to the bit; NaN outside
+    [-1, 1] as numpy's. Once a sample, over the batch's vehicles."""
+    flat = np.ravel(x)
+    out = np.fromiter((math.acos(v) if -1.0 <= v <= 1.0 else math.nan for v in flat.tolist()),
+                      float, flat.size)
+    return out.reshape(np.shape(x))
+
+
 def build_judge(omega_max, config) -> tuple:
     """(judge, verdict, settle): equations.judge_sample, verdict and settle_time traced
     over arrays of vehicles.
@@ -118,7 +130,7 @@ def build_judge(omega_max, config) -> tuple:
     jc = as_constants(judge_settings(config))
     namespace: dict = {"sqrt": np.sqrt, "where": np.where, "logical_or": np.logical_or,
                        "logical_and": np.logical_and, "isfinite": np.isfinite,
-                       "fabs": np.fabs, "acos": np.arccos, "degrees": np.degrees,
+                       "fabs": np.fabs, "acos": _acos, "degrees": np.degrees,
                        "nan": np.nan}
     J = [leaf(name) for name in JUDGE]
     trace = Trace()

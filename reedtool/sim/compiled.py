@@ -3,8 +3,9 @@
 Optional (numba): without it, `available()` is False and the numpy engines (`run`,
 `batch`) are all there is. The equations are `equations`' functions themselves, jitted
 (`jitted`): the same Python functions the generated engines are traced from, so the
-compiled engine flies them by construction. What is written here is the loop around
-them and the judge of `batch.simulate_batch`: `_fly` flies one vehicle; `_fly_batch`
+compiled engine flies them by construction, and judges a flight by them too
+(`equations.judge_sample`, `verdict`, `settle_time`). What is written here is the loop
+around them: `_fly` flies one vehicle; `_fly_batch`
 flies blocks of BLOCK vehicles on `_fly_block`, spread over the cores (`prange`), each
 stage of a block one loop over its vehicles that calls an equation inlined (SIMD lanes).
 

@@ -17,6 +17,10 @@ desaturation acts only when a rotor is out of range (`@guarded_by` that test): t
 engine calls `desaturate` itself under its guard, the batch traces its work into columns
 for the vehicles whose guard holds, the compiled engine runs it as written.
 
+The judge of a flight is here too, in the same style: `judge_sample` (each sample: the
+record J and the events that end a flight), `verdict` (at the end: settled, saturated or
+not settled) and `settle_time`; every engine judges by them, built the same ways.
+
 Frames and units (docs/hover-test.md, "The simulation"): world z up, gravity -z; body
 axes the base link's, origin at the COM; state p, v (world, m, m/s), q = (w, x, y, z)
 body -> world, w body rates (rad/s), rotor speeds omega (rad/s), and the integral of the

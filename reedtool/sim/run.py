@@ -3,8 +3,8 @@
 For a single vehicle numpy's per-call overhead (about half a microsecond per operation on
 tiny arrays) dominates, so the array engine in `batch` runs a 10 s flight in seconds.
 `scalar` generates the step for the vehicle at hand, traced from the flight equations
-(`equations`) as the array engine's is; this module runs it (or the compiled engine) and
-makes the verdict of the judged flight.
+(`equations`) as the array engine's is, its judge included; this module runs it (or the
+compiled engine) and turns the judged flight into a HoverRun.
 """
 
 from __future__ import annotations

@@ -8,11 +8,12 @@ dropped, the desaturation called as the function itself when its guard holds. So
 engine flies the same equations as the compiled one by construction.
 
 `compile_vehicle` returns `fly(state, rec)`, which flies the whole run from `state`
-(STATE order, then the rotor speeds) and judges it every `config.sample_every` steps,
-as `batch.simulate_batch` does; `rec`, if not None, is called with each sample
+(STATE order, then the rotor speeds) and judges it every `config.sample_every` steps by
+`equations.judge_sample`, traced the same way (`judge_lines`), and at the end by
+`equations.verdict`; `rec`, if not None, is called with each sample
 (t, x, y, z, R00, R10, R20, R21, R22, position error, cos(attitude error), *omega). It
-returns a Flight tuple: why it stopped early (None when it reached the end) and what the
-judge tracked; `run` turns that into a HoverRun.
+returns a Flight tuple: why it ended (equations' reason code) and what the judge tracked;
+`run` turns that into a HoverRun.
 """
 
 from __future__ import annotations
