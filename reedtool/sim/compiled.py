@@ -58,10 +58,13 @@ BLOCK = 64              # vehicles per block of the batch kernel (its state fits
 # Rows of the block kernel's working memory W (row r of vehicle j at W[r * BLOCK + j]);
 # rotor rows for up to MAX_BLOCK_ROTORS rotors (more fly on the per-vehicle kernel).
 MAX_BLOCK_ROTORS = 16
-_P, _V, _Q, _W, _I, _R, _E, _C, _F, _M, _XI, _AQ, _HH, _MASS, _S, _SH, _OUT = (
-    0, 3, 6, 10, 13, 16, 25, 28, 32, 35, 38, 41, 42, 43, 44, 47, 50)
-_OM = 51
-_T = _OM + MAX_BLOCK_ROTORS
+# Rows 0 to 16 + n are the state in equations' layout, so W[j::BLOCK] is vehicle j's x.
+_P, _V, _Q, _W, _I, _OM = 0, 3, 6, 10, 13, 16
+_R = _OM + MAX_BLOCK_ROTORS
+_E, _C, _F, _M, _XI, _AQ, _HH, _MASS, _S, _SH, _OUT = (
+    _R + 9, _R + 12, _R + 16, _R + 19, _R + 22, _R + 25, _R + 26, _R + 27, _R + 28, _R + 31,
+    _R + 34)
+_T = _OUT + 1
 _K = _T + MAX_BLOCK_ROTORS
 _NROWS = _K + MAX_BLOCK_ROTORS
 
@@ -445,10 +448,6 @@ if numba is not None:
         J = np.empty((BLOCK, JUDGE_SIZE))
         for j in range(BLOCK):
             _judge_start(J[j])
-        # one vehicle's state, rotation and error, gathered from W for the judge
-        xj = np.zeros(16 + n)
-        Rj = np.empty(9)
-        ej = np.empty(3)
         worst = np.zeros(BLOCK, dtype=np.int64)
         Tcol = np.empty(n)
         n_rec = 0
@@ -475,15 +474,10 @@ if numba is not None:
                         if n_rec < pos_rec.shape[1]:
                             pos_rec[j, n_rec] = np.nan
                         continue
-                    for a in range(16):
-                        xj[a] = W[(_P + a) * BLOCK + j]     # p v q w integral: rows 0-15
-                    for i in range(n):
-                        xj[16 + i] = W[(_OM + i) * BLOCK + j]
-                    for a in range(9):
-                        Rj[a] = W[(_R + a) * BLOCK + j]
-                    for a in range(3):
-                        ej[a] = W[(_E + a) * BLOCK + j]
-                    why, val = _judge_sample(jc, omega_max, t, xj, Rj, ej,
+                    # vehicle j's state, rotation and error: strided views of W
+                    why, val = _judge_sample(jc, omega_max, t, W[j::BLOCK],
+                                             W[_R * BLOCK + j::BLOCK],
+                                             W[_E * BLOCK + j::BLOCK],
                                              W[_OUT * BLOCK + j] > 0.0, worst[j], J[j])
                     if n_rec < pos_rec.shape[1]:
                         pos_rec[j, n_rec] = J[j, 3]
