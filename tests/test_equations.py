@@ -188,7 +188,7 @@ def test_traced_float_judge_is_the_equations_bit_for_bit():
     n = params.n_rotors
     namespace: dict = {"sqrt": math.sqrt, "acos": math.acos, "degrees": math.degrees,
                        "isfinite": math.isfinite, "fabs": math.fabs, "nan": math.nan}
-    lines = judge_lines(params.omega_max_rad_s, config, namespace)
+    lines = judge_lines(params.omega_max_rad_s, config)
     args = ["t", *state_names(n), *ROTATION, *ERROR, "saturated", "worst", *JUDGE]
     body = "\n".join("    " + line for line in
                      [*lines, f"return ({', '.join(JUDGE)},), reason, value"])

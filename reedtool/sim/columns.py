@@ -11,6 +11,7 @@ constant, is the float engine's step (`scalar`), so the two fly the same arithme
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -125,9 +126,15 @@ def build_judge(omega_max, config) -> tuple:
     x, the rotation R, the position error e and the record J (layout.JUDGE); verdict(*J)
     -> (reason, value); settle(reason, *J) -> the settle times.
     """
+    return _judge_functions(tuple(float(w) for w in omega_max),
+                            as_constants(judge_settings(config)))
+
+
+@functools.lru_cache(maxsize=8)
+def _judge_functions(omega_max: tuple, jc: tuple) -> tuple:
+    # Traced once per vehicle and settings (the functions keep no state).
     n = len(omega_max)
     names = state_names(n)
-    jc = as_constants(judge_settings(config))
     namespace: dict = {"sqrt": np.sqrt, "where": np.where, "logical_or": np.logical_or,
                        "logical_and": np.logical_and, "isfinite": np.isfinite,
                        "fabs": np.fabs, "acos": _acos, "degrees": np.degrees,
@@ -135,7 +142,7 @@ def build_judge(omega_max, config) -> tuple:
     J = [leaf(name) for name in JUDGE]
     trace = Trace()
     reason, value = trace.judge_sample(
-        jc, as_constants(np.asarray(omega_max, dtype=float)), leaf("t"),
+        jc, omega_max, leaf("t"),
         [leaf(name) for name in names], [leaf(name) for name in ROTATION],
         [leaf(name) for name in ERROR], leaf("saturated"), leaf("worst"), J)
     sources = [(

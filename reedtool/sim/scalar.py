@@ -20,10 +20,7 @@ from __future__ import annotations
 
 import functools
 import math
-
 from typing import Callable, NamedTuple
-
-import numpy as np
 
 from reedtool.sim import equations, layout
 from reedtool.sim.layout import (ERROR, JUDGE, ROTATION, STATE, as_constants, judge_settings,
@@ -99,23 +96,29 @@ def step_lines(params, gains, config, setpoint_m, namespace: dict) -> tuple[list
     return writer.lines(split=True)
 
 
-def judge_lines(omega_max, config, namespace: dict) -> list[str]:
+def judge_lines(omega_max, config) -> list[str]:
     """equations.judge_sample traced into statements: from the state (STATE, om<i>),
     ROTATION, ERROR, `t`, `saturated`, `worst` and the record J (layout.JUDGE), into J,
     `reason` and `value`. Its intermediate names start with `_j` (it runs between the
     step's two halves)."""
+    return list(_judge_lines(tuple(float(w) for w in omega_max),
+                             as_constants(judge_settings(config))))
+
+
+@functools.lru_cache(maxsize=8)
+def _judge_lines(omega_max: tuple, jc: tuple) -> tuple:
+    # Traced once per vehicle and settings (a run's set-up would trace it again).
     n = len(omega_max)
     trace = Trace()
     x = [leaf(name) for name in state_names(n)]
     J = [leaf(name) for name in JUDGE]
     reason, value = trace.judge_sample(
-        as_constants(judge_settings(config)), as_constants(np.asarray(omega_max)),
-        leaf("t"), x, [leaf(name) for name in ROTATION], [leaf(name) for name in ERROR],
-        leaf("saturated"), leaf("worst"), J)
-    writer = Writer(namespace, prefix="_j")
+        jc, omega_max, leaf("t"), x, [leaf(name) for name in ROTATION],
+        [leaf(name) for name in ERROR], leaf("saturated"), leaf("worst"), J)
+    writer = Writer({}, prefix="_j")
     for target, out in [*zip(JUDGE, J), ("reason", reason), ("value", value)]:
         writer.assign(target, out)
-    return writer.lines()
+    return tuple(writer.lines())
 
 
 def _source(params, gains, config, setpoint_m, namespace: dict) -> str:
@@ -131,7 +134,7 @@ def _source(params, gains, config, setpoint_m, namespace: dict) -> str:
     # verdict (equations.verdict, run as itself: once a flight).
     judge = [
         "t = step * dt",
-        *judge_lines(params.omega_max_rad_s, config, namespace),
+        *judge_lines(params.omega_max_rad_s, config),
         "if rec is not None:",
         f"    rec((t, px, py, pz, R00, R10, R20, R21, R22, pos, cos_att, {', '.join(om)}))",
         "if reason != 0 or step == n_steps:",
