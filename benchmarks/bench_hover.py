@@ -64,7 +64,10 @@ import time
 from pathlib import Path
 
 from reedtool.sim import HoverConfig, compiled
-from reedtool.sim.batch import Spreads, robustness_batch
+from reedtool.sim.batch import (FLOAT_ENGINE_MAX_VEHICLES, Spreads, perturbed_plant,
+                                robustness_batch, sample_perturbations, simulate_batch,
+                                simulate_one_by_one)
+from reedtool.sim.controller import ControllerDesign
 from reedtool.sim.params import symmetric_multirotor
 from reedtool.sim.run import simulate_hover
 
@@ -233,6 +236,24 @@ def main() -> None:
     numpy_rate = steps / times[0]
     print(f"batch of {args.numpy_vehicles}, numpy ({short.duration_s:g} s): "
           f"{numpy_rate / 1e6:10.3g} M vehicle-steps/s")
+    if args.numpy_vehicles <= 4 * FLOAT_ENGINE_MAX_VEHICLES:
+        # the two ways the numpy engine can fly a small batch (robustness_batch picks one
+        # by FLOAT_ENGINE_MAX_VEHICLES), interleaved, each on the same perturbed plant
+        plant = perturbed_plant(params, sample_perturbations(
+            args.numpy_vehicles, params.n_rotors, Spreads(), 0))
+        ways = {"columns": lambda: simulate_batch(params, short, plant),
+                "one by one": lambda: simulate_one_by_one(params, short, plant,
+                                                          ControllerDesign(), None, False)}
+        cpu = {name: [] for name in ways}
+        for _ in range(args.repeats):
+            for name, fly in ways.items():
+                cpu[name].append(paired(1, fly)[0][0])
+        print(f"  columns / one by one: " + ", ".join(
+            f"{name} {steps / statistics.median(t) / 1e6:.3g} M vehicle-steps/s "
+            f"({steps / max(t) / 1e6:.3g}-{steps / min(t) / 1e6:.3g})"
+            for name, t in cpu.items())
+            + f"; ratio {statistics.median(a / b for a, b in zip(cpu['columns'], cpu['one by one'])):.2f}"
+            f" (picked: {'one by one' if args.numpy_vehicles <= FLOAT_ENGINE_MAX_VEHICLES else 'columns'})")
     if compiled.available():
         steps = args.vehicles * config.n_steps
         threads = numba.get_num_threads()

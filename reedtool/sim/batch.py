@@ -274,6 +274,62 @@ SpeedCommand = Callable[[State, np.ndarray, np.ndarray, np.ndarray],
                         Callable[[int, bool], tuple]]
 
 
+def simulate_one_by_one(params: VehicleParams, config: HoverConfig, plant: Plant,
+                         design: ControllerDesign, progress: Callable[[int], None] | None,
+                         record: bool) -> Outcome:
+    """simulate_batch's Outcome, each vehicle flown on its own traced float step
+    (`scalar`, the same equations and judge): for a few vehicles, faster than columns
+    that pay numpy's per-call overhead at every step (FLOAT_ENGINE_MAX_VEHICLES)."""
+    from reedtool.sim.scalar import compile_vehicle
+
+    gains = ControllerGains.from_params(params, design)
+    N, n = plant.n_vehicles, params.n_rotors
+    state, setpoint = initial_state(params, gains, config, N)
+    start = (*state.p[:, 0], *state.v[:, 0], *state.q[:, 0], *state.w[:, 0], 0.0, 0.0, 0.0,
+             tuple(state.omega[:, 0]))
+    start = tuple(float(v) for v in start[:-1]) + (tuple(float(w) for w in start[-1]),)
+    park = (*setpoint, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, *start[-1])
+    flights, recorded = [], []
+    done = 0
+    for j in range(N):
+        fly = compile_vehicle(params, gains, config, tuple(float(v) for v in setpoint), plant,
+                              j, gains.omega_max_rad_s)
+        rec: list[tuple] = []
+        flight = fly(start, rec.append if record else None)
+        flights.append(flight)
+        recorded.append([row[9] for row in rec])
+        if progress is not None:
+            progress(config.n_steps * (j + 1) // N - done)
+            done = config.n_steps * (j + 1) // N
+    reason = np.array([f.reason for f in flights], dtype=np.int64)
+    reached_end = np.isin(reason, [equations.SETTLED, equations.NOT_SETTLED,
+                                   equations.SATURATED])
+    final = np.array([f.state if reached_end[j] else park for j, f in enumerate(flights)]).T
+    final_state = State(p=final[0:3], v=final[3:6], q=final[6:10], w=final[10:13],
+                        omega=final[13:13 + n])
+
+    def column(field):
+        return np.array([getattr(f, field) for f in flights], dtype=float)
+
+    position_error = None
+    if record:
+        position_error = _samples([], config, N)
+        for j, rows in enumerate(recorded):
+            position_error[:len(rows), j] = rows
+    return Outcome(
+        status_code=_STATUS_CODE[reason], reason=reason, reason_value=column("value"),
+        end_time_s=np.where(reached_end, config.duration_s, column("end_time_s")),
+        settle_time_s=column("settle_time_s"),
+        max_position_error_m=column("max_position_error_m"),
+        max_attitude_error_deg=np.degrees(np.arccos(column("min_cos_attitude"))),
+        final_position_error_m=column("position_error_m"),
+        final_attitude_error_deg=np.degrees(np.arccos(column("cos_attitude"))),
+        max_throttle=column("max_throttle"),
+        longest_saturation_s=column("longest_saturation_s"),
+        final_omega_rad_s=final_state.omega.copy(), final_state=final_state, config=config,
+        position_error_m=position_error)
+
+
 def _samples(recorded: list[np.ndarray], config: HoverConfig, N: int) -> np.ndarray:
     """(samples, N): the recorded rows, NaN-padded to every sample of the full run."""
     rows = config.n_steps // config.sample_every + (config.n_steps % config.sample_every != 0) + 1
@@ -352,6 +408,13 @@ def perturbed_plant(params: VehicleParams, perturbation: Perturbation) -> Plant:
     return plant
 
 
+# Up to this many vehicles the numpy engine flies a robustness batch one vehicle at a
+# time on the traced float step (same equations, same judge, same Outcome): numpy's
+# columns pay a fixed per-call overhead at every step, which a few vehicles do not fill.
+# Measured (benchmarks/bench_hover.py --numpy-vehicles, docs/hover-test.md "Speed").
+FLOAT_ENGINE_MAX_VEHICLES = 32
+
+
 @dataclass
 class BatchReport:
     n_vehicles: int
@@ -389,8 +452,11 @@ def robustness_batch(params: VehicleParams, n_vehicles: int, config: HoverConfig
     `engine`: "numpy" (this module) or "numba" (`compiled`, all cores).
     """
     perturbation = sample_perturbations(n_vehicles, params.n_rotors, spreads, seed)
-    outcome = simulate_batch(params, config, perturbed_plant(params, perturbation), design,
-                             progress, engine, record)
+    plant = perturbed_plant(params, perturbation)
+    if engine == "numpy" and n_vehicles <= FLOAT_ENGINE_MAX_VEHICLES:
+        outcome = simulate_one_by_one(params, config, plant, design, progress, record)
+    else:
+        outcome = simulate_batch(params, config, plant, design, progress, engine, record)
     passed = outcome.status_code == STATUS_CODES[ExitStatus.PASSED]
     counts: dict[str, int] = {}
     for code in outcome.status_code:

@@ -682,6 +682,7 @@ def vehicle_flyer(params, gains: ControllerGains, config: HoverConfig, setpoint_
                       col["settle_time_s"], col["max_position_error_m"],
                       col["min_cos_attitude"], col["max_throttle"],
                       col["longest_saturation_s"], col["final_position_error_m"],
-                      col["final_cos_attitude"], tuple(float(x) for x in final[13:]))
+                      col["final_cos_attitude"], tuple(float(x) for x in final[13:]),
+                      tuple(float(x) for x in final))
 
     return fly

@@ -42,12 +42,17 @@ class Flight(NamedTuple):
     position_error_m: float     # at the last sample
     cos_attitude: float
     omega_rad_s: tuple
+    state: tuple                # p, v, q, w and the rotor speeds at the end
 
 
-def compile_vehicle(params, gains, config, setpoint_m: tuple[float, float, float]) -> Callable:
-    """`fly` for `params` flown by `gains` as `config` says, towards `setpoint_m`."""
+def compile_vehicle(params, gains, config, setpoint_m: tuple[float, float, float],
+                    plant=None, vehicle: int = 0, judge_omega_max=None) -> Callable:
+    """`fly` for `params` flown by `gains` as `config` says, towards `setpoint_m`; the
+    plant is vehicle `vehicle` of `plant` (default: the nominal one). The judge reads the
+    throttle against `judge_omega_max` (default: params')."""
     namespace: dict = {}
-    source = _source(params, gains, config, setpoint_m, namespace)
+    source = _source(params, gains, config, setpoint_m, namespace, plant, vehicle,
+                     params.omega_max_rad_s if judge_omega_max is None else judge_omega_max)
     namespace.update({"sqrt": math.sqrt, "tan": math.tan, "acos": math.acos,
                       "degrees": math.degrees, "isfinite": math.isfinite, "fabs": math.fabs,
                       "nan": math.nan, "Flight": Flight, "verdict": equations.verdict,
@@ -63,13 +68,15 @@ def _compiled(source: str, n_rotors: int):
     return compile(source, f"<reedtool.sim.scalar step, {n_rotors} rotors>", "exec")
 
 
-def step_lines(params, gains, config, setpoint_m, namespace: dict) -> tuple[list, list]:
+def step_lines(params, gains, config, setpoint_m, namespace: dict, plant=None,
+               vehicle: int = 0) -> tuple[list, list]:
     """(before, after): one step traced into statements, from the state named by STATE
     and om<i>. `before` runs equations.control_state (into ROTATION, ERROR, T<i>,
     `saturated`, `worst`) and computes equations.advance_state; `after` sets the new
     state. Traced together, so what both compute (w x J w) is computed once. Constants
-    that are not numbers go into `namespace`."""
-    the = layout.inputs(params, gains, config, setpoint_m=setpoint_m)
+    that are not numbers go into `namespace`. The plant: vehicle `vehicle` of `plant`
+    (default: the nominal one)."""
+    the = layout.inputs(params, gains, config, plant, setpoint_m=setpoint_m)
     n = params.n_rotors
     names = state_names(n)
     ctl, pinv, thrust_max, sp = (as_constants(v) for v in (the.ctl, the.pinv, the.thrust_max,
@@ -90,7 +97,7 @@ def step_lines(params, gains, config, setpoint_m, namespace: dict) -> tuple[list
         if isinstance(value, Sym) and value.op not in ("leaf", "out"):
             writer.name(value, target)
         writer.assign(target, value, early=True)
-    trace.advance_state(as_constants(the.vehicle(0)), x, T, R, e)
+    trace.advance_state(as_constants(the.vehicle(vehicle)), x, T, R, e)
     for target, value in zip(names, x):
         writer.assign(target, value)
     return writer.lines(split=True)
@@ -121,10 +128,11 @@ def _judge_lines(omega_max: tuple, jc: tuple) -> tuple:
     return tuple(writer.lines())
 
 
-def _source(params, gains, config, setpoint_m, namespace: dict) -> str:
+def _source(params, gains, config, setpoint_m, namespace: dict, plant, vehicle,
+            judge_omega_max) -> str:
     n = params.n_rotors
     om = [f"om{i}" for i in range(n)]
-    before, after = step_lines(params, gains, config, setpoint_m, namespace)
+    before, after = step_lines(params, gains, config, setpoint_m, namespace, plant, vehicle)
     L = literal
     start = [0.0] * equations.JUDGE_SIZE
     equations.judge_start(start)
@@ -134,7 +142,7 @@ def _source(params, gains, config, setpoint_m, namespace: dict) -> str:
     # verdict (equations.verdict, run as itself: once a flight).
     judge = [
         "t = step * dt",
-        *judge_lines(params.omega_max_rad_s, config),
+        *judge_lines(judge_omega_max, config),
         "if rec is not None:",
         f"    rec((t, px, py, pz, R00, R10, R20, R21, R22, pos, cos_att, {', '.join(om)}))",
         "if reason != 0 or step == n_steps:",
@@ -142,7 +150,8 @@ def _source(params, gains, config, setpoint_m, namespace: dict) -> str:
         "    if reason == 0:",
         "        reason, value = verdict(jc, J)",
         "    return Flight(reason, value, t, settle_time(jc, reason, J), max_pos, min_cos,",
-        f"                  max_throttle, sat_longest, pos, cos_att, ({', '.join(om)},))",
+        f"                  max_throttle, sat_longest, pos, cos_att, ({', '.join(om)},),",
+        f"                  ({', '.join(STATE[:13])}, {', '.join(om)}))",
     ]
 
     def indent(lines, depth):
