@@ -209,13 +209,15 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
                 # ---- judge every running vehicle on the state at time t
                 # (equations.judge_sample over the columns; the ended keep their record)
                 running = reason == 0
+                all_running = running.all()
                 *judged, why, value = judge(
                     t, *rows, *R9, *(X[0:3] - setpoint[:, None]),
                     False if saturated is None else saturated,
                     0 if worst_rotor is None else worst_rotor, *J)
                 if record:
                     recorded.append(np.where(running, judged[3], np.nan))
-                J = [np.where(running, new, old) for new, old in zip(judged, J)]
+                J = judged if all_running else [np.where(running, new, old)
+                                                for new, old in zip(judged, J)]
                 ended = running & (why != 0)
                 if ended.any():
                     reason[ended] = why[ended]
@@ -249,6 +251,7 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
     # Time each vehicle entered the band for good; NaN when it ended early or outside it.
     with np.errstate(invalid="ignore"):
         settle = np.broadcast_to(settle_time(reason, *J)[0], (N,)).astype(float)
+    J = [np.array(np.broadcast_to(row, (N,)), dtype=float) for row in J]
     max_pos, min_cos_att, max_throttle, final_pos, final_cos = J[0], J[1], J[2], J[3], J[4]
     sat_longest = J[9]
     status = _STATUS_CODE[reason]

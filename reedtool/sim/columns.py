@@ -111,11 +111,14 @@ def build(params, gains, config, plant, speed_command: bool = False) -> tuple:
 def _acos(x):
     """math.acos over an array: numpy's arccos differs from it in the last bit (its own
     approximation), and the judge's numbers are equations' to the bit; NaN outside
-    [-1, 1] as numpy's. Once a sample, over the batch's vehicles."""
-    flat = np.ravel(x)
-    out = np.fromiter((math.acos(v) if -1.0 <= v <= 1.0 else math.nan for v in flat.tolist()),
-                      float, flat.size)
-    return out.reshape(np.shape(x))
+    [-1, 1] as numpy's. The judge asks it acos(0) for every vehicle that is not flipped
+    (equations.tilt_deg): those are one value, the rest one call each."""
+    x = np.asarray(x, dtype=float)
+    out = np.full(x.shape, math.acos(0.0))
+    other = np.flatnonzero(x != 0.0)
+    out.flat[other] = [math.acos(v) if -1.0 <= v <= 1.0 else math.nan
+                       for v in x.flat[other].tolist()]
+    return out
 
 
 def build_judge(omega_max, config) -> tuple:

@@ -585,8 +585,9 @@ def all_finite(px, py, pz, qw, qx, qy, qz, wx, wy, wz):
 
 @select
 def tilt_deg(R22):
-    """How far a flipped vehicle's body z is from up [deg] (0 when it is not flipped)."""
-    return math.degrees(math.acos(larger(R22, -1.0))) if R22 < 0.0 else 0.0
+    """How far a flipped vehicle's body z is from up [deg] (0 when it is not flipped).
+    acos reads 0 for a vehicle that is not flipped (a batch computes both sides)."""
+    return math.degrees(math.acos(clamp(R22, -1.0, 0.0))) if R22 < 0.0 else 0.0
 
 
 @select
