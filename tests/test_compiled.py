@@ -164,6 +164,11 @@ def test_default_engine_is_numba_for_a_batch_numpy_for_one_vehicle(monkeypatch):
     # an explicit choice is kept; without numba a batch falls back to the reference
     assert choose_engine("numpy", batch=True) == "numpy"
     assert choose_engine("numba", batch=False) == "numba"
+    # told the batch's size, auto keeps numpy for a few vehicles (they fly one by one
+    # faster than numba starts: sim.AUTO_NUMPY_MAX_VEHICLES's measurements)
+    assert choose_engine("auto", batch=True, vehicles=2) == "numpy"
+    assert choose_engine("auto", batch=True, vehicles=16) == "numba"
+    assert choose_engine("numba", batch=True, vehicles=2) == "numba"
     monkeypatch.setattr(compiled, "available", lambda: False)
     assert choose_engine("auto", batch=True) == "numpy"
 
