@@ -257,12 +257,14 @@ def main() -> None:
         for _ in range(args.repeats):
             for name, fly in ways.items():
                 cpu[name].append(paired(1, fly)[0][0])
-        print(f"  columns / one by one: " + ", ".join(
+        ratio = statistics.median(a / b for a, b in zip(cpu["columns"], cpu["one by one"]))
+        picked = ("one by one" if args.numpy_vehicles <= FLOAT_ENGINE_MAX_VEHICLES
+                  else "columns")
+        print("  columns / one by one: " + ", ".join(
             f"{name} {steps / statistics.median(t) / 1e6:.3g} M vehicle-steps/s "
             f"({steps / max(t) / 1e6:.3g}-{steps / min(t) / 1e6:.3g})"
             for name, t in cpu.items())
-            + f"; ratio {statistics.median(a / b for a, b in zip(cpu['columns'], cpu['one by one'])):.2f}"
-            f" (picked: {'one by one' if args.numpy_vehicles <= FLOAT_ENGINE_MAX_VEHICLES else 'columns'})")
+            + f"; CPU ratio {ratio:.2f} (robustness_batch picks: {picked})")
     if compiled.available():
         steps = args.vehicles * config.n_steps
         threads = numba.get_num_threads()
