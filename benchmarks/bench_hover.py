@@ -56,7 +56,7 @@ After the judge became one source too (equations.judge_sample, verdict, settle_t
 thread's CPU second); whole numba command 1.12 / 1.22. `--numpy-vehicles N` (N up to
 4 x batch.FLOAT_ENGINE_MAX_VEHICLES) also flies that batch both ways the numpy engine
 can, columns and one by one on the float step, and prints the median CPU ratio: 8
-vehicles 5.4, 24 1.76, 32 1.45, 40 0.93, 48 0.82, 64 0.52 (robustness_batch flies up to
+vehicles 5.4, 16 2.2, 24 1.76, 32 1.45, 40 0.93, 48 0.82, 64 0.52 (robustness_batch flies up to
 32 one by one).
 """
 

@@ -288,10 +288,12 @@ def simulate_one_by_one(params: VehicleParams, config: HoverConfig, plant: Plant
     gains = ControllerGains.from_params(params, design)
     N, n = plant.n_vehicles, params.n_rotors
     state, setpoint = initial_state(params, gains, config, N)
-    start = (*state.p[:, 0], *state.v[:, 0], *state.q[:, 0], *state.w[:, 0], 0.0, 0.0, 0.0,
-             tuple(state.omega[:, 0]))
-    start = tuple(float(v) for v in start[:-1]) + (tuple(float(w) for w in start[-1]),)
-    park = (*setpoint, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, *start[-1])
+    omega0 = tuple(float(w) for w in state.omega[:, 0])
+    start = (*(float(v) for v in (*state.p[:, 0], *state.v[:, 0], *state.q[:, 0],
+                                  *state.w[:, 0])), 0.0, 0.0, 0.0, omega0)
+    # an ended vehicle's final state is the level hover it is parked at (as the columns'
+    # and numba's batches park them)
+    park = (*setpoint, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, *omega0)
     flights, recorded = [], []
     done = 0
     for j in range(N):
