@@ -52,8 +52,9 @@ batch traced from it, numba compiling it), this script, 5 repeats each, at load 
 
 After the judge became one source too (equations.judge_sample, verdict, settle_time),
 5 repeats at load ~0.3-0.6, before / after, yardstick-scaled ratios: numpy single vehicle
-0.83 / 0.82; numba batch of 4,000 x 5 s 1.71 / 1.50 (30.0 / 34.1 M vehicle-steps per
-thread's CPU second); whole numba command 1.12 / 1.22. `--numpy-vehicles N` (N up to
+0.83 / 0.84; numba batch of 4,000 x 5 s 1.71 / 1.60 (30.0 / 28.5 M vehicle-steps per
+thread's CPU second); whole numba command 1.12 / 1.10; in pairs (CPU new / old, median
+of 5) the numba batch 1.02, the numpy batch of 1,000 1.00. `--numpy-vehicles N` (N up to
 4 x batch.FLOAT_ENGINE_MAX_VEHICLES) also flies that batch both ways the numpy engine
 can, columns and one by one on the float step, and prints the median CPU ratio: 8
 vehicles 5.4, 16 2.2, 24 1.76, 32 1.45, 40 0.93, 48 0.82, 64 0.52 (robustness_batch flies up to
