@@ -126,7 +126,7 @@ def judged_samples(n_rotors: int, config: HoverConfig, count: int, seed: int):
     states = random_states(n_rotors, count, seed)
     samples = []
     for i, x in enumerate(states):
-        kind = i % 9
+        kind = i % 10
         if kind == 1:       # non-finite: NaN or an infinity in p, q or w
             x[rng.choice([0, 1, 2, 6, 7, 8, 9, 10, 11, 12])] = rng.choice(
                 [np.nan, np.inf, -np.inf])
@@ -147,6 +147,9 @@ def judged_samples(n_rotors: int, config: HoverConfig, count: int, seed: int):
             x[10] = 2.0 * config.diverged_rate_rad_s
         elif kind == 8:     # inside the band: the record's `within` and last-out paths
             x[0:3] = [0.0, 0.0, config.hover_altitude_m] + rng.normal(scale=0.01, size=3)
+            x[6:10] = [1.0, 0.0, 0.0, 0.0]
+        elif kind == 9:     # level, exactly on the band's edge: sqrt(tol^2) is tol
+            x[0:3] = [config.position_tol_m, 0.0, config.hover_altitude_m]
             x[6:10] = [1.0, 0.0, 0.0, 0.0]
         t = 0.01 * rng.integers(1, 1000)
         J = [rng.uniform(0.0, 2.0), rng.uniform(0.5, 1.0), rng.uniform(0.5, 1.0),
@@ -203,6 +206,9 @@ def test_traced_float_judge_is_the_equations_bit_for_bit():
         assert same(got_value, want_value), (want_reason, got_value, want_value)
         assert all(same(a, b) for a, b in zip(got_J, want_J)), (got_J, want_J)
         reasons.add(want_reason)
+    # the band's edge is inside it (the record says so)
+    edge = [state for _, state, *_ in judged_samples(n, config, 450, seed=3)][9]
+    assert edge[0] == config.position_tol_m
     # every ending, and flying on
     assert reasons == {0, equations.NON_FINITE, equations.FLIPPED, equations.GROUND,
                        equations.YAW_SPIN, equations.DRIFTED, equations.RATE}
