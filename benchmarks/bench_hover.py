@@ -49,6 +49,16 @@ batch traced from it, numba compiling it), this script, 5 repeats each, at load 
   vehicle flies on numpy by default (sim.choose_engine). As whole processes in pairs
   (median wall): one vehicle 2.10 s numba against 1.05 s numpy (load ~5); `--samples 2`
   1.29 s numba against 4.77 s numpy (load ~1.6).
+
+After the judge became one source too (equations.judge_sample, verdict, settle_time),
+5 repeats at load ~0.3-0.6, before / after, yardstick-scaled ratios: numpy single vehicle
+0.83 / 0.84; numba batch of 4,000 x 5 s 1.71 / 1.60 (30.0 / 28.5 M vehicle-steps per
+thread's CPU second); whole numba command 1.12 / 1.10; in pairs (CPU new / old, median
+of 5) the numba batch 1.02, the numpy batch of 1,000 1.00. `--numpy-vehicles N` (N up to
+4 x batch.FLOAT_ENGINE_MAX_VEHICLES) also flies that batch both ways the numpy engine
+can, columns and one by one on the float step, and prints the median CPU ratio: 8
+vehicles 5.4, 16 2.2, 24 1.76, 32 1.45, 40 0.93, 48 0.82, 64 0.52 (robustness_batch flies up to
+32 one by one).
 """
 
 from __future__ import annotations
@@ -64,7 +74,10 @@ import time
 from pathlib import Path
 
 from reedtool.sim import HoverConfig, compiled
-from reedtool.sim.batch import Spreads, robustness_batch
+from reedtool.sim.batch import (FLOAT_ENGINE_MAX_VEHICLES, Spreads, perturbed_plant,
+                                robustness_batch, sample_perturbations, simulate_batch,
+                                simulate_one_by_one)
+from reedtool.sim.controller import ControllerDesign
 from reedtool.sim.params import symmetric_multirotor
 from reedtool.sim.run import simulate_hover
 
@@ -233,6 +246,26 @@ def main() -> None:
     numpy_rate = steps / times[0]
     print(f"batch of {args.numpy_vehicles}, numpy ({short.duration_s:g} s): "
           f"{numpy_rate / 1e6:10.3g} M vehicle-steps/s")
+    if args.numpy_vehicles <= 4 * FLOAT_ENGINE_MAX_VEHICLES:
+        # the two ways the numpy engine can fly a small batch (robustness_batch picks one
+        # by FLOAT_ENGINE_MAX_VEHICLES), interleaved, each on the same perturbed plant
+        plant = perturbed_plant(params, sample_perturbations(
+            args.numpy_vehicles, params.n_rotors, Spreads(), 0))
+        ways = {"columns": lambda: simulate_batch(params, short, plant),
+                "one by one": lambda: simulate_one_by_one(params, short, plant,
+                                                          ControllerDesign(), None, False)}
+        cpu = {name: [] for name in ways}
+        for _ in range(args.repeats):
+            for name, fly in ways.items():
+                cpu[name].append(paired(1, fly)[0][0])
+        ratio = statistics.median(a / b for a, b in zip(cpu["columns"], cpu["one by one"]))
+        picked = ("one by one" if args.numpy_vehicles <= FLOAT_ENGINE_MAX_VEHICLES
+                  else "columns")
+        print("  columns / one by one: " + ", ".join(
+            f"{name} {steps / statistics.median(t) / 1e6:.3g} M vehicle-steps/s "
+            f"({steps / max(t) / 1e6:.3g}-{steps / min(t) / 1e6:.3g})"
+            for name, t in cpu.items())
+            + f"; CPU ratio {ratio:.2f} (robustness_batch picks: {picked})")
     if compiled.available():
         steps = args.vehicles * config.n_steps
         threads = numba.get_num_threads()

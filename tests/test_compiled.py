@@ -164,6 +164,11 @@ def test_default_engine_is_numba_for_a_batch_numpy_for_one_vehicle(monkeypatch):
     # an explicit choice is kept; without numba a batch falls back to the reference
     assert choose_engine("numpy", batch=True) == "numpy"
     assert choose_engine("numba", batch=False) == "numba"
+    # told the batch's size, auto keeps numpy for a few vehicles (they fly one by one
+    # faster than numba starts: sim.AUTO_NUMPY_MAX_VEHICLES's measurements)
+    assert choose_engine("auto", batch=True, vehicles=2) == "numpy"
+    assert choose_engine("auto", batch=True, vehicles=16) == "numba"
+    assert choose_engine("numba", batch=True, vehicles=2) == "numba"
     monkeypatch.setattr(compiled, "available", lambda: False)
     assert choose_engine("auto", batch=True) == "numpy"
 
@@ -182,6 +187,27 @@ def test_every_compiled_equation_is_equations_own_code():
     assert set(compiled.jitted) == functions
     for name, jitted in compiled.jitted.items():
         assert jitted.py_func.__code__ is getattr(equations, name).__code__
+
+
+def test_compiled_judge_is_equations_own_code():
+    """The kernels judge a flight with equations' judge compiled: the functions _fly and
+    _fly_block call are judge_sample, verdict, settle_time and judge_start's own code
+    objects, and no kernel carries a judge of its own (no reason code is named in
+    compiled.py's source)."""
+    import inspect
+    import re
+
+    from reedtool.sim import equations
+
+    for name in ("judge_start", "judge_sample", "verdict", "settle_time"):
+        assert getattr(compiled, "_" + name).py_func.__code__ is \
+            getattr(equations, name).__code__
+    source = inspect.getsource(compiled)
+    for code in ("NON_FINITE", "FLIPPED", "GROUND", "YAW_SPIN", "DRIFTED", "RATE"):
+        assert not re.search(rf"\b_?{code}\b", source), code
+    for kernel in (compiled._fly, compiled._fly_block):
+        names = kernel.py_func.__code__.co_names
+        assert "_judge_sample" in names and "_verdict" in names
 
 
 def test_numba_loads_without_importing_scipy_linalg():

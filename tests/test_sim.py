@@ -445,3 +445,35 @@ def test_initial_attitude_is_the_urdf_rpy_convention():
     R = rot_matrices(q.reshape(4, 1))[:, :, 0]
     # Quaternion products vs Euler products of unit entries: a few ulps (~1e-15).
     np.testing.assert_allclose(R, rpy_to_matrix((0.3, -0.2, 1.1)), atol=1e-12)
+
+
+def test_one_by_one_is_the_column_batch_exactly():
+    """A small numpy batch flown one vehicle at a time on the traced float step
+    (batch.simulate_one_by_one, what robustness_batch picks for a few vehicles) is the
+    column batch: both steps and judges equal equations.py run by the interpreter, bit for
+    bit (test_equations), so whole flights are equal, endings, parked states and the
+    recorded position errors included."""
+    from reedtool.sim.batch import simulate_one_by_one
+    from reedtool.sim.controller import ControllerDesign
+
+    params = symmetric_multirotor(4)   # thrust-to-weight 1.63: the heavy ones fail
+    config = HoverConfig(duration_s=4.0)
+    plant = perturbed_plant(params, sample_perturbations(
+        12, 4, Spreads(mass_rel=0.6, com_m=0.02, inertia_rel=0.2, motor_constant_rel=0.1),
+        seed=2))
+    columns = simulate_batch(params, config, plant, record=True)
+    single = simulate_one_by_one(params, config, plant, ControllerDesign(), None, True)
+    statuses = {columns.status(i) for i in range(12)}
+    assert ExitStatus.PASSED in statuses and len(statuses) > 1
+    for name in ("status_code", "reason", "reason_value", "end_time_s", "settle_time_s",
+                 "max_position_error_m", "max_attitude_error_deg", "final_position_error_m",
+                 "final_attitude_error_deg", "max_throttle", "longest_saturation_s",
+                 "position_error_m"):
+        np.testing.assert_array_equal(getattr(single, name), getattr(columns, name), name)
+    # The final state of the vehicles that flew to the end (an ended vehicle's is its
+    # parked state, which the columns fly on to the end: meaningless either way).
+    flew = columns.end_time_s == config.duration_s
+    assert 0 < flew.sum() < 12
+    for name in ("p", "v", "q", "w", "omega"):
+        np.testing.assert_array_equal(getattr(single.final_state, name)[:, flew],
+                                      getattr(columns.final_state, name)[:, flew], name)

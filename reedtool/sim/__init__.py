@@ -97,20 +97,32 @@ class HoverConfig:
 ENGINES = ("auto", "numpy", "numba")
 
 
-def choose_engine(requested: str, batch: bool) -> str:
+# Up to this many batch vehicles "auto" keeps numpy, when told the batch's size: they fly
+# one by one on the float step (batch.FLOAT_ENGINE_MAX_VEHICLES), faster than numba's
+# start-up. Whole `hover-test examples/reed_quad_x --samples N` processes, wall, numpy /
+# numba, load ~0.5: N=2 0.58-0.67 / 0.91-1.02 s; N=4 0.69-0.89 / 0.86-0.87; N=8
+# 1.06-1.18 / 0.99-1.29; N=16 1.54-1.88 / 0.88-0.96.
+AUTO_NUMPY_MAX_VEHICLES = 3
+
+
+def choose_engine(requested: str, batch: bool, vehicles: int | None = None) -> str:
     """The engine that flies a run: `requested` unless "auto".
+
+    `vehicles`, when given, is the batch's size: up to AUTO_NUMPY_MAX_VEHICLES of them,
+    auto keeps numpy (they fly one by one on the float step, in less time than numba
+    takes to start).
 
     "auto" is numba for a run with a batch, when numba imports, and numpy otherwise.
     Measured as whole `hover-test` processes (benchmarks/bench_hover.py, docs/hover-test.md,
     "Speed"): one vehicle flies 10 s in ~50 ms on numpy, less than numba's own start-up
     (importing numba and loading its cached kernel, ~0.55 s of CPU), so numpy finishes
-    first (1.05 s against 2.10 s wall); a batch, even of 2 vehicles, is faster as a whole
-    on numba (1.29 s against 4.77 s), the numpy batch paying its per-step array overhead
-    ~10,000 times.
+    first (1.05 s against 2.10 s wall); a batch in numpy columns pays its per-step array
+    overhead ~10,000 times (`--samples 2`: 4.77 s against numba's 1.29 s), and since
+    small batches fly one by one instead, numba wins from about 8 vehicles (above).
     """
     if requested != "auto":
         return requested
-    if not batch:
+    if not batch or (vehicles is not None and vehicles <= AUTO_NUMPY_MAX_VEHICLES):
         return "numpy"
     from reedtool.sim.compiled import available
 

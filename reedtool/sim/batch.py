@@ -5,7 +5,8 @@ per vehicle): the step is the flight equations traced over arrays (`columns`), t
 trace as the single-vehicle float engine's (`scalar`), so the two fly the same arithmetic.
 The robustness batch perturbs the plant (mass, inertia, COM, per-motor constants) and
 flies every vehicle on the controller designed for the nominal model, as a real airframe
-is flown on the model it was tuned from. The judge of a flight lives here.
+is flown on the model it was tuned from. The judge of a flight is equations' too
+(`judge_sample`, `verdict`, `settle_time`), traced over the columns (`columns.build_judge`).
 """
 
 from __future__ import annotations
@@ -25,10 +26,18 @@ from reedtool.sim.dynamics import Plant, State, quat_from_rpy
 from reedtool.sim.layout import hover_speeds
 from reedtool.sim.params import VehicleParams
 
-# Why a run ended, beyond its ExitStatus (index into REASONS).
-REASONS = ("", "settled", "not-settled", "non-finite", "drifted", "rate", "ground", "flipped",
-           "saturated", "yaw-spin")
-_R = {name: i for i, name in enumerate(REASONS)}
+# Why a run ended, beyond its ExitStatus: REASONS[code] (equations' judge).
+REASONS = equations.REASONS
+
+STATUS_OF_REASON = {
+    "settled": ExitStatus.PASSED, "not-settled": ExitStatus.NOT_SETTLED,
+    "saturated": ExitStatus.SATURATED, "non-finite": ExitStatus.DIVERGED,
+    "drifted": ExitStatus.DIVERGED, "rate": ExitStatus.DIVERGED,
+    "ground": ExitStatus.CRASHED, "flipped": ExitStatus.CRASHED,
+    "yaw-spin": ExitStatus.YAW_SPIN}
+# status code by reason code (0: still flying)
+_STATUS_CODE = np.array([0, *(STATUS_CODES[STATUS_OF_REASON[r]] for r in REASONS[1:])],
+                        dtype=np.int64)
 
 
 @dataclass
@@ -157,37 +166,25 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
     control, advance = columns.build(
         params, gains if gains is not None else ControllerGains.from_params(params, design),
         config, plant, speed_command=command is not None)
-    omega_max = np.repeat(np.asarray(params.omega_max_rad_s if command is not None
-                                     else gains.omega_max_rad_s, dtype=float)[:, None], N,
-                          axis=1)
     R9 = np.empty((9, N))
-    R = R9.reshape(3, 3, N)
     if command is not None:
         omega_cmd = np.empty((n, N))
         speed_command_step = command(state, R9, setpoint, omega_cmd)
 
-    status = np.zeros(N, dtype=np.int64)
+    judge, verdict, settle_time = columns.build_judge(
+        params.omega_max_rad_s if command is not None else gains.omega_max_rad_s, config)
     reason = np.zeros(N, dtype=np.int64)
     reason_value = np.zeros(N)
     end_time = np.full(N, config.duration_s)
-    last_out = np.zeros(N)                  # last sample time outside the tolerance band
-    sat_since = np.full(N, np.nan)          # start of the current saturated streak
-    sat_rotor = np.zeros(N, dtype=np.int64)
-    sat_longest = np.zeros(N)               # longest streak so far [s] and its rotor
-    sat_longest_rotor = np.zeros(N, dtype=np.int64)
-    max_pos = np.zeros(N)
-    min_cos_att = np.ones(N)
-    max_throttle = np.zeros(N)
-    final_pos = np.zeros(N)
-    final_cos = np.ones(N)
-    cos_tol = config.cos_attitude_tol
-    every = config.sample_every
-    sample_dt = every * dt
+    # the judge's record J (equations' layout), one row per field
+    start = [0.0] * equations.JUDGE_SIZE
+    equations.judge_start(start)
+    J = [np.full(N, v) for v in start]
     n_steps = config.n_steps
+    every = config.sample_every
     report_every = max(1, n_steps // 100)
     recorded: list[np.ndarray] = []
     reported = 0
-    p_col = np.repeat(setpoint[:, None], N, axis=1)
 
     # where() computes both sides of a select: the unused one may warn (sqrt of a
     # negative thrust command, a tumbling vehicle's tangent); the judge ends what is
@@ -210,50 +207,27 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
                 u = list(omega_cmd)
             if sample:
                 # ---- judge every running vehicle on the state at time t
-                p_err = state.p - p_col
-                running = status == 0
-                pos = np.sqrt((p_err * p_err).sum(axis=0))
+                # (equations.judge_sample over the columns; the ended keep their record)
+                running = reason == 0
+                all_running = running.all()
+                *judged, why, value = judge(
+                    t, *rows, *R9, *(X[0:3] - setpoint[:, None]),
+                    False if saturated is None else saturated,
+                    0 if worst_rotor is None else worst_rotor, *J)
                 if record:
-                    recorded.append(np.where(running, pos, np.nan))
-                R22 = R[2, 2]
-                # Attitude error: the angle from the level hover attitude at the setpoint
-                # heading (what the trim assumes), i.e. the rotation angle of R itself.
-                trace = R[0, 0] + R[1, 1] + R22
-                cos_att = np.minimum(np.maximum(0.5 * (trace - 1.0), -1.0), 1.0)
-                throttle = (state.omega / omega_max).max(axis=0)
-                # Only running vehicles update their record.
-                np.fmax(max_pos, pos, out=max_pos, where=running)
-                np.fmin(min_cos_att, cos_att, out=min_cos_att, where=running)
-                np.fmax(max_throttle, throttle, out=max_throttle, where=running)
-                np.copyto(final_pos, pos, where=running)
-                np.copyto(final_cos, cos_att, where=running)
-                within = (pos <= config.position_tol_m) & (cos_att >= cos_tol)
-                np.copyto(last_out, t, where=running & ~within)
-                # Saturated streaks: start, rotor furthest out at the start, longest so far.
-                if saturated is None:           # no rotor of any vehicle out of range
-                    sat_since.fill(np.nan)
-                else:
-                    np.copyto(sat_since, t, where=saturated & np.isnan(sat_since))
-                    np.copyto(sat_since, np.nan, where=~saturated)
-                    np.copyto(sat_rotor, worst_rotor, where=saturated & (sat_since == t))
-                    longer = running & saturated & (t - sat_since > sat_longest)
-                    np.copyto(sat_longest, t - sat_since, where=longer)
-                    np.copyto(sat_longest_rotor, sat_rotor, where=longer)
-                ended = _judge_events(config, status, reason, reason_value, end_time,
-                                      running, t, state, R, pos)
+                    recorded.append(np.where(running, judged[3], np.nan))
+                J = judged if all_running else [np.where(running, new, old)
+                                                for new, old in zip(judged, J)]
+                ended = running & (why != 0)
+                if ended.any():
+                    reason[ended] = why[ended]
+                    reason_value[ended] = value[ended]
+                    end_time[ended] = t
                 if last:
-                    settled = (status == 0) & within & (
-                        last_out + sample_dt <= config.duration_s - config.hold_s + 1e-9)
-                    status[settled] = STATUS_CODES[ExitStatus.PASSED]
-                    reason[settled] = _R["settled"]
-                    # Not settled with the rotors long at their limits: say so, it is the cause.
-                    starved = (status == 0) & (sat_longest >= config.saturation_limit_s - 1e-9)
-                    status[starved] = STATUS_CODES[ExitStatus.SATURATED]
-                    reason[starved] = _R["saturated"]
-                    reason_value[starved] = sat_longest_rotor[starved]
-                    rest = status == 0
-                    status[rest] = STATUS_CODES[ExitStatus.NOT_SETTLED]
-                    reason[rest] = _R["not-settled"]
+                    rest = reason == 0
+                    why, value = verdict(*J)
+                    reason[rest] = np.broadcast_to(why, (N,))[rest]
+                    reason_value[rest] = np.broadcast_to(value, (N,))[rest]
                     break
                 if ended.any():
                     # Park finished vehicles at a level hover so they stay finite and cheap.
@@ -262,7 +236,7 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
                     X[6:10, ended] = q_park[:, None]
                     X[10:16, ended] = 0.0
                     X[16:, ended] = omega_park[:, None]
-                    if (status != 0).all():
+                    if (reason != 0).all():
                         break
             # ---- advance all vehicles one step (equations.advance_state, or
             # advance_plant under a speed command)
@@ -275,10 +249,12 @@ def simulate_batch(params: VehicleParams, config: HoverConfig = HoverConfig(),
         progress(n_steps - reported)
 
     # Time each vehicle entered the band for good; NaN when it ended early or outside it.
-    reached_end = np.isin(status, [STATUS_CODES[ExitStatus.PASSED],
-                                   STATUS_CODES[ExitStatus.NOT_SETTLED],
-                                   STATUS_CODES[ExitStatus.SATURATED]])
-    settle = np.where(reached_end & within, last_out + sample_dt, np.nan)
+    with np.errstate(invalid="ignore"):
+        settle = np.broadcast_to(settle_time(reason, *J)[0], (N,)).astype(float)
+    J = [np.array(np.broadcast_to(row, (N,)), dtype=float) for row in J]
+    max_pos, min_cos_att, max_throttle, final_pos, final_cos = J[0], J[1], J[2], J[3], J[4]
+    sat_longest = J[9]
+    status = _STATUS_CODE[reason]
     # A vehicle parked early has its parked speeds in state.omega; its own final speeds
     # are meaningless anyway, so report the state as is.
     return Outcome(
@@ -301,6 +277,64 @@ SpeedCommand = Callable[[State, np.ndarray, np.ndarray, np.ndarray],
                         Callable[[int, bool], tuple]]
 
 
+def simulate_one_by_one(params: VehicleParams, config: HoverConfig, plant: Plant,
+                         design: ControllerDesign, progress: Callable[[int], None] | None,
+                         record: bool) -> Outcome:
+    """simulate_batch's Outcome, each vehicle flown on its own traced float step
+    (`scalar`, the same equations and judge): for a few vehicles, faster than columns
+    that pay numpy's per-call overhead at every step (FLOAT_ENGINE_MAX_VEHICLES)."""
+    from reedtool.sim.scalar import compile_vehicle
+
+    gains = ControllerGains.from_params(params, design)
+    N, n = plant.n_vehicles, params.n_rotors
+    state, setpoint = initial_state(params, gains, config, N)
+    omega0 = tuple(float(w) for w in state.omega[:, 0])
+    start = (*(float(v) for v in (*state.p[:, 0], *state.v[:, 0], *state.q[:, 0],
+                                  *state.w[:, 0])), 0.0, 0.0, 0.0, omega0)
+    # an ended vehicle's final state is the level hover it is parked at (as the columns'
+    # and numba's batches park them)
+    park = (*setpoint, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, *omega0)
+    flights, recorded = [], []
+    done = 0
+    for j in range(N):
+        fly = compile_vehicle(params, gains, config, tuple(float(v) for v in setpoint), plant,
+                              j, gains.omega_max_rad_s)
+        rec: list[tuple] = []
+        flight = fly(start, rec.append if record else None)
+        flights.append(flight)
+        recorded.append([row[9] for row in rec])
+        if progress is not None:
+            progress(config.n_steps * (j + 1) // N - done)
+            done = config.n_steps * (j + 1) // N
+    reason = np.array([f.reason for f in flights], dtype=np.int64)
+    reached_end = np.isin(reason, [equations.SETTLED, equations.NOT_SETTLED,
+                                   equations.SATURATED])
+    final = np.array([f.state if reached_end[j] else park for j, f in enumerate(flights)]).T
+    final_state = State(p=final[0:3], v=final[3:6], q=final[6:10], w=final[10:13],
+                        omega=final[13:13 + n])
+
+    def column(field):
+        return np.array([getattr(f, field) for f in flights], dtype=float)
+
+    position_error = None
+    if record:
+        position_error = _samples([], config, N)
+        for j, rows in enumerate(recorded):
+            position_error[:len(rows), j] = rows
+    return Outcome(
+        status_code=_STATUS_CODE[reason], reason=reason, reason_value=column("value"),
+        end_time_s=np.where(reached_end, config.duration_s, column("end_time_s")),
+        settle_time_s=column("settle_time_s"),
+        max_position_error_m=column("max_position_error_m"),
+        max_attitude_error_deg=np.degrees(np.arccos(column("min_cos_attitude"))),
+        final_position_error_m=column("position_error_m"),
+        final_attitude_error_deg=np.degrees(np.arccos(column("cos_attitude"))),
+        max_throttle=column("max_throttle"),
+        longest_saturation_s=column("longest_saturation_s"),
+        final_omega_rad_s=final_state.omega.copy(), final_state=final_state, config=config,
+        position_error_m=position_error)
+
+
 def _samples(recorded: list[np.ndarray], config: HoverConfig, N: int) -> np.ndarray:
     """(samples, N): the recorded rows, NaN-padded to every sample of the full run."""
     rows = config.n_steps // config.sample_every + (config.n_steps % config.sample_every != 0) + 1
@@ -317,8 +351,7 @@ def _simulate_compiled(params: VehicleParams, config: HoverConfig, plant: Plant,
 
     out = fly_batch(params, config, plant, design, record)
     reason = out["reason"]
-    status = np.array([STATUS_CODES[_STATUS_OF_REASON[REASONS[r]]] for r in reason],
-                      dtype=np.int64)
+    status = _STATUS_CODE[reason]
     F = out["final"].T
     state = State(p=F[0:3].copy(), v=F[3:6].copy(), q=F[6:10].copy(), w=F[10:13].copy(),
                   omega=F[13:].copy())
@@ -332,51 +365,6 @@ def _simulate_compiled(params: VehicleParams, config: HoverConfig, plant: Plant,
         max_throttle=out["max_throttle"], longest_saturation_s=out["longest_saturation_s"],
         final_omega_rad_s=state.omega.copy(), final_state=state, config=config,
         position_error_m=out.get("position_error_m"))
-
-
-_STATUS_OF_REASON = {
-    "settled": ExitStatus.PASSED, "not-settled": ExitStatus.NOT_SETTLED,
-    "saturated": ExitStatus.SATURATED, "non-finite": ExitStatus.DIVERGED,
-    "drifted": ExitStatus.DIVERGED, "rate": ExitStatus.DIVERGED,
-    "ground": ExitStatus.CRASHED, "flipped": ExitStatus.CRASHED,
-    "yaw-spin": ExitStatus.YAW_SPIN}
-
-
-def _judge_events(config: HoverConfig, status: np.ndarray, reason: np.ndarray,
-                  reason_value: np.ndarray, end_time: np.ndarray, running: np.ndarray,
-                  t: float, state: State, R: np.ndarray, pos: np.ndarray) -> np.ndarray:
-    """End the running vehicles that hit an event at time t (the first event in this
-    order wins); returns which vehicles ended."""
-    N = len(status)
-    with np.errstate(invalid="ignore"):
-        w = state.w
-        R22 = R[2, 2]
-        rate_xy = np.sqrt(w[0] * w[0] + w[1] * w[1])
-        finite = (np.isfinite(state.p).all(axis=0) & np.isfinite(w).all(axis=0)
-                  & np.isfinite(state.q).all(axis=0))
-        # (hit, status, reason, the value that ended it: computed when needed)
-        events = [
-            (~finite, ExitStatus.DIVERGED, "non-finite", lambda: np.zeros(N)),
-            (R22 < 0.0, ExitStatus.CRASHED, "flipped",
-             lambda: np.degrees(np.arccos(np.clip(R22, -1.0, 1.0)))),
-            (state.p[2] < 0.0, ExitStatus.CRASHED, "ground", lambda: state.p[2]),
-            (np.abs(w[2]) > config.yaw_spin_rad_s, ExitStatus.YAW_SPIN,
-             "yaw-spin", lambda: np.abs(w[2])),
-            (pos > config.divergence_distance_m, ExitStatus.DIVERGED, "drifted",
-             lambda: pos),
-            (rate_xy > config.diverged_rate_rad_s, ExitStatus.DIVERGED, "rate",
-             lambda: rate_xy),
-        ]
-    ended = np.zeros(N, dtype=bool)
-    for hit, code, why, value in events:
-        new = running & hit & ~ended
-        if new.any():
-            status[new] = STATUS_CODES[code]
-            reason[new] = _R[why]
-            reason_value[new] = value()[new]
-            end_time[new] = t
-            ended |= new
-    return ended
 
 
 # ------------------------------------------------------------ robustness batch
@@ -425,6 +413,13 @@ def perturbed_plant(params: VehicleParams, perturbation: Perturbation) -> Plant:
     return plant
 
 
+# Up to this many vehicles the numpy engine flies a robustness batch one vehicle at a
+# time on the traced float step (same equations, same judge, same Outcome): numpy's
+# columns pay a fixed per-call overhead at every step, which a few vehicles do not fill.
+# Measured (benchmarks/bench_hover.py --numpy-vehicles, docs/hover-test.md "Speed").
+FLOAT_ENGINE_MAX_VEHICLES = 32
+
+
 @dataclass
 class BatchReport:
     n_vehicles: int
@@ -462,8 +457,11 @@ def robustness_batch(params: VehicleParams, n_vehicles: int, config: HoverConfig
     `engine`: "numpy" (this module) or "numba" (`compiled`, all cores).
     """
     perturbation = sample_perturbations(n_vehicles, params.n_rotors, spreads, seed)
-    outcome = simulate_batch(params, config, perturbed_plant(params, perturbation), design,
-                             progress, engine, record)
+    plant = perturbed_plant(params, perturbation)
+    if engine == "numpy" and n_vehicles <= FLOAT_ENGINE_MAX_VEHICLES:
+        outcome = simulate_one_by_one(params, config, plant, design, progress, record)
+    else:
+        outcome = simulate_batch(params, config, plant, design, progress, engine, record)
     passed = outcome.status_code == STATUS_CODES[ExitStatus.PASSED]
     counts: dict[str, int] = {}
     for code in outcome.status_code:

@@ -11,10 +11,14 @@ constant, is the float engine's step (`scalar`), so the two fly the same arithme
 
 from __future__ import annotations
 
+import functools
+import math
+
 import numpy as np
 
 from reedtool.sim import layout
-from reedtool.sim.layout import ERROR, ROTATION, as_constants, state_names
+from reedtool.sim.layout import (ERROR, JUDGE, ROTATION, as_constants, judge_settings,
+                                 state_names)
 from reedtool.sim.trace import Trace, Writer, leaf
 
 def _function(name: str, args: list[str], lines: list[str], returns: list[str]) -> str:
@@ -102,3 +106,63 @@ def build(params, gains, config, plant, speed_command: bool = False) -> tuple:
     exec(compile(source, "<reedtool.sim.columns advance>", "exec"), namespace)
     return control, namespace["advance"]
 
+
+
+def _acos(x):
+    """math.acos over an array: numpy's arccos differs from it in the last bit (its own
+    approximation), and the judge's numbers are equations' to the bit; NaN outside
+    [-1, 1] as numpy's. The judge asks it acos(0) for every vehicle that is not flipped
+    (equations.tilt_deg): those are one value, the rest one call each."""
+    x = np.asarray(x, dtype=float)
+    out = np.full(x.shape, math.acos(0.0))
+    other = np.flatnonzero(x != 0.0)
+    out.flat[other] = [math.acos(v) if -1.0 <= v <= 1.0 else math.nan
+                       for v in x.flat[other].tolist()]
+    return out
+
+
+def build_judge(omega_max, config) -> tuple:
+    """(judge, verdict, settle): equations.judge_sample, verdict and settle_time traced
+    over arrays of vehicles.
+
+    judge(t, *x, *R, *e, saturated, worst, *J) -> (*J, reason, value) for the state rows
+    x, the rotation R, the position error e and the record J (layout.JUDGE); verdict(*J)
+    -> (reason, value); settle(reason, *J) -> the settle times.
+    """
+    return _judge_functions(tuple(float(w) for w in omega_max),
+                            as_constants(judge_settings(config)))
+
+
+@functools.lru_cache(maxsize=8)
+def _judge_functions(omega_max: tuple, jc: tuple) -> tuple:
+    # Traced once per vehicle and settings (the functions keep no state).
+    n = len(omega_max)
+    names = state_names(n)
+    namespace: dict = {"sqrt": np.sqrt, "where": np.where, "logical_or": np.logical_or,
+                       "logical_and": np.logical_and, "isfinite": np.isfinite,
+                       "fabs": np.fabs, "acos": _acos, "degrees": np.degrees,
+                       "nan": np.nan}
+    J = [leaf(name) for name in JUDGE]
+    trace = Trace()
+    reason, value = trace.judge_sample(
+        jc, omega_max, leaf("t"),
+        [leaf(name) for name in names], [leaf(name) for name in ROTATION],
+        [leaf(name) for name in ERROR], leaf("saturated"), leaf("worst"), J)
+    sources = [(
+        "judge", ["t", *names, *ROTATION, *ERROR, "saturated", "worst", *JUDGE],
+        [*zip(JUDGE, J), ("reason", reason), ("value", value)])]
+    trace = Trace()
+    J = [leaf(name) for name in JUDGE]
+    sources.append(("verdict", list(JUDGE), list(zip(("reason", "value"),
+                                                     trace.verdict(jc, J)))))
+    trace = Trace()
+    J = [leaf(name) for name in JUDGE]
+    sources.append(("settle", ["reason", *JUDGE],
+                    [("settle", trace.settle_time(jc, leaf("reason"), J))]))
+    for name, args, outputs in sources:
+        writer = Writer(namespace, columns=True)
+        for target, out in outputs:
+            writer.assign(target, out)
+        source = _function(name, args, writer.lines(), [t for t, _ in outputs])
+        exec(compile(source, f"<reedtool.sim.columns {name}>", "exec"), namespace)
+    return namespace["judge"], namespace["verdict"], namespace["settle"]

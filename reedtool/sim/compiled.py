@@ -3,8 +3,9 @@
 Optional (numba): without it, `available()` is False and the numpy engines (`run`,
 `batch`) are all there is. The equations are `equations`' functions themselves, jitted
 (`jitted`): the same Python functions the generated engines are traced from, so the
-compiled engine flies them by construction. What is written here is the loop around
-them and the judge of `batch.simulate_batch`: `_fly` flies one vehicle; `_fly_batch`
+compiled engine flies them by construction, and judges a flight by them too
+(`equations.judge_sample`, `verdict`, `settle_time`). What is written here is the loop
+around them: `_fly` flies one vehicle; `_fly_batch`
 flies blocks of BLOCK vehicles on `_fly_block`, spread over the cores (`prange`), each
 stage of a block one loop over its vehicles that calls an equation inlined (SIMD lanes).
 
@@ -45,26 +46,25 @@ def unavailable_reason() -> str:
     return ("the compiled engine needs numba: pip install numba (reedtool's `fast` extra)")
 
 
-# Reason codes: batch.REASONS indices (kept literal here: numba needs constants).
-_SETTLED, _NOT_SETTLED, _NON_FINITE, _DRIFTED, _RATE, _GROUND, _FLIPPED, _SATURATED, \
-    _YAW_SPIN = 1, 2, 3, 4, 5, 6, 7, 8, 9
-
 # Layout of the float outputs per vehicle.
 OUT_FIELDS = ("reason_value", "end_time_s", "settle_time_s", "max_position_error_m",
               "min_cos_attitude", "final_position_error_m", "final_cos_attitude",
               "max_throttle", "longest_saturation_s", "last_out_s", "within")
-# Layout of the judge's settings vector.
-CFG_FIELDS = ("dt", "sp_x", "sp_y", "sp_z", "pos_tol", "cos_tol", "yaw_spin", "div_dist",
-              "div_rate", "duration", "hold", "sat_limit", "n_steps", "every")
+# Layout of the run's settings vector (the judge's are equations' jc).
+CFG_FIELDS = ("dt", "sp_x", "sp_y", "sp_z", "duration", "n_steps", "every")
+JUDGE_SIZE = equations.JUDGE_SIZE
 REC_FIXED = 11          # t, x, y, z, R00, R10, R20, R21, R22, pos, cos_att; then omega
 BLOCK = 64              # vehicles per block of the batch kernel (its state fits in L1)
 # Rows of the block kernel's working memory W (row r of vehicle j at W[r * BLOCK + j]);
 # rotor rows for up to MAX_BLOCK_ROTORS rotors (more fly on the per-vehicle kernel).
 MAX_BLOCK_ROTORS = 16
-_P, _V, _Q, _W, _I, _R, _E, _C, _F, _M, _XI, _AQ, _HH, _MASS, _S, _SH, _OUT = (
-    0, 3, 6, 10, 13, 16, 25, 28, 32, 35, 38, 41, 42, 43, 44, 47, 50)
-_OM = 51
-_T = _OM + MAX_BLOCK_ROTORS
+# Rows 0 to 16 + n are the state in equations' layout, so W[j::BLOCK] is vehicle j's x.
+_P, _V, _Q, _W, _I, _OM = 0, 3, 6, 10, 13, 16
+_R = _OM + MAX_BLOCK_ROTORS
+_E, _C, _F, _M, _XI, _AQ, _HH, _MASS, _S, _SH, _OUT = (
+    _R + 9, _R + 12, _R + 16, _R + 19, _R + 22, _R + 25, _R + 26, _R + 27, _R + 28, _R + 31,
+    _R + 34)
+_T = _OUT + 1
 _K = _T + MAX_BLOCK_ROTORS
 _NROWS = _K + MAX_BLOCK_ROTORS
 
@@ -141,18 +141,22 @@ if numba is not None:
         jitted["cot_series"], jitted["cot_ratio"], jitted["attitude_step"], jitted["integral"])
     _control_state = jitted["control_state"]
     _advance_state = jitted["advance_state"]
+    _judge_start, _judge_sample, _verdict, _settle_time = (
+        jitted["judge_start"], jitted["judge_sample"], jitted["verdict"],
+        jitted["settle_time"])
 
     @njit(cache=True, error_model="numpy")
-    def _fly(cfg, ctl, pinv, thrust_max, veh, state0, out_f, out_i, final, rec, pos_rec):
-        """Fly one vehicle from state0 (equations' state layout) as batch.simulate_batch
-        judges it.
+    def _fly(cfg, jc, ctl, pinv, thrust_max, veh, state0, out_f, out_i, final, rec,
+             pos_rec):
+        """Fly one vehicle from state0 (equations' state layout), judged by equations'
+        judge (jc its settings).
 
         Fills out_f (OUT_FIELDS), out_i (reason, longest-saturation rotor), final (p, v,
         q, w, omega when it ended), rec (one row per sample) and pos_rec (the position
         error per sample) when they have rows; returns the samples judged.
         """
         dt = cfg[0]
-        n_steps, every = int(cfg[12]), int(cfg[13])
+        n_steps, every = int(cfg[5]), int(cfg[6])
         omega_max = veh[20]
         n = len(thrust_max)
         x = state0.copy()
@@ -160,56 +164,20 @@ if numba is not None:
         e = np.zeros(3)
         R = np.empty(9)
         T = np.empty(n)
-        sample_dt = every * dt
+        J = np.empty(JUDGE_SIZE)
+        _judge_start(J)
         reason = 0
         value = 0.0
-        end_time = cfg[9]
-        max_pos = 0.0
-        min_cos = 1.0
-        max_throttle = 0.0
-        final_pos = 0.0
-        final_cos = 1.0
-        last_out = 0.0
-        within = False
-        sat_since = np.nan
-        sat_rotor = 0
-        sat_longest = 0.0
-        sat_longest_rotor = 0
+        end_time = cfg[4]
         n_rec = 0
         for step in range(n_steps + 1):
             t = step * dt
             last = step == n_steps
             saturated, worst = _control_state(ctl, pinv, thrust_max, sp, x, R, e, T)
             if step % every == 0 or last:
-                pos = math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
-                cos_att = min(max(0.5 * ((R[0] + R[4] + R[8]) - 1.0), -1.0), 1.0)
-                throttle = x[16] / omega_max[0]
-                for i in range(1, n):
-                    ratio = x[16 + i] / omega_max[i]
-                    if ratio > throttle:
-                        throttle = ratio
-                if pos > max_pos:
-                    max_pos = pos
-                if cos_att < min_cos:
-                    min_cos = cos_att
-                if throttle > max_throttle:
-                    max_throttle = throttle
-                final_pos = pos
-                final_cos = cos_att
-                within = pos <= cfg[4] and cos_att >= cfg[5]
-                if not within:
-                    last_out = t
-                if saturated:
-                    if math.isnan(sat_since):
-                        sat_since = t
-                        sat_rotor = worst
-                    if t - sat_since > sat_longest:
-                        sat_longest = t - sat_since
-                        sat_longest_rotor = sat_rotor
-                else:
-                    sat_since = np.nan
+                reason, value = _judge_sample(jc, omega_max, t, x, R, e, saturated, worst, J)
                 if n_rec < pos_rec.shape[0]:
-                    pos_rec[n_rec] = pos
+                    pos_rec[n_rec] = J[3]
                 if n_rec < rec.shape[0]:
                     rec[n_rec, 0] = t
                     rec[n_rec, 1] = x[0]
@@ -220,61 +188,41 @@ if numba is not None:
                     rec[n_rec, 6] = R[6]
                     rec[n_rec, 7] = R[7]
                     rec[n_rec, 8] = R[8]
-                    rec[n_rec, 9] = pos
-                    rec[n_rec, 10] = cos_att
+                    rec[n_rec, 9] = J[3]
+                    rec[n_rec, 10] = J[4]
                     for i in range(n):
                         rec[n_rec, REC_FIXED + i] = x[16 + i]
                 n_rec += 1
-                rate_xy = math.sqrt(x[10] * x[10] + x[11] * x[11])
-                finite = True
-                for a in range(13):
-                    if (a < 3 or a >= 6) and not math.isfinite(x[a]):
-                        finite = False
-                if not finite:
-                    reason, value = _NON_FINITE, 0.0
-                elif R[8] < 0.0:
-                    reason = _FLIPPED
-                    value = math.degrees(math.acos(max(R[8], -1.0)))
-                elif x[2] < 0.0:
-                    reason, value = _GROUND, x[2]
-                elif abs(x[12]) > cfg[6]:
-                    reason, value = _YAW_SPIN, abs(x[12])
-                elif pos > cfg[7]:
-                    reason, value = _DRIFTED, pos
-                elif rate_xy > cfg[8]:
-                    reason, value = _RATE, rate_xy
                 if reason != 0:
                     end_time = t
                     break
                 if last:
-                    if within and last_out + sample_dt <= cfg[9] - cfg[10] + 1e-9:
-                        reason = _SETTLED
-                    elif sat_longest >= cfg[11] - 1e-9:
-                        reason = _SATURATED
-                        value = float(sat_longest_rotor)
-                    else:
-                        reason = _NOT_SETTLED
+                    reason, value = _verdict(jc, J)
                     break
             _advance_state(veh, x, T, R, e)
-        out_i[0] = reason
-        out_i[1] = sat_longest_rotor
-        out_f[0] = value
-        out_f[1] = end_time
-        reached_end = reason == _SETTLED or reason == _NOT_SETTLED or reason == _SATURATED
-        out_f[2] = last_out + sample_dt if reached_end and within else np.nan
-        out_f[3] = max_pos
-        out_f[4] = min_cos
-        out_f[5] = final_pos
-        out_f[6] = final_cos
-        out_f[7] = max_throttle
-        out_f[8] = sat_longest
-        out_f[9] = last_out
-        out_f[10] = 1.0 if within else 0.0
+        _report(jc, reason, value, end_time, J, out_f, out_i)
         for a in range(13):
             final[a] = x[a]
         for i in range(n):
             final[13 + i] = x[16 + i]
         return n_rec
+
+    @njit(cache=True, error_model="numpy")
+    def _report(jc, reason, value, end_time, J, out_f, out_i):
+        """A judged flight into out_f (OUT_FIELDS) and out_i (reason, saturation rotor)."""
+        out_i[0] = reason
+        out_i[1] = int(J[10])
+        out_f[0] = value
+        out_f[1] = end_time
+        out_f[2] = _settle_time(jc, reason, J)
+        out_f[3] = J[0]
+        out_f[4] = J[1]
+        out_f[5] = J[3]
+        out_f[6] = J[4]
+        out_f[7] = J[2]
+        out_f[8] = J[9]
+        out_f[9] = J[5]
+        out_f[10] = J[6]
 
     # ---- the batch: blocks of BLOCK vehicles, each stage one loop over the block's
     # vehicles that calls an equation (inlined) on rows of one flat working array W, at
@@ -460,7 +408,7 @@ if numba is not None:
             out[13 + i] = W[(_OM + i) * BLOCK + j]
 
     @njit(cache=True, error_model="numpy")
-    def _fly_block(cfg, ctl, pinv, thrust_max, nominal, mass, S, shift, k, state0, out_f,
+    def _fly_block(cfg, jc, ctl, pinv, thrust_max, nominal, mass, S, shift, k, state0, out_f,
                    out_i, final, pos_rec):
         """_fly for a block of up to BLOCK vehicles at once, stage by stage (the _w_*
         functions), each stage the equations inlined in a loop over the vehicles. The
@@ -471,8 +419,7 @@ if numba is not None:
             lead_down, omega_max = nominal
         J0, dt_J0inv = _nine(J0a), _nine(dt_J0inva)
         ctl = (*_nine(ctl[0:9]), *_nine(ctl[9:18]))
-        n_steps, every = int(cfg[12]), int(cfg[13])
-        sample_dt = every * dt
+        n_steps, every = int(cfg[5]), int(cfg[6])
         half_dt = 0.5 * dt
         sp = cfg[1:4]
         n, B = k.shape[1], mass.shape[0]
@@ -497,18 +444,10 @@ if numba is not None:
         n_running = B
         reason = np.zeros(BLOCK, dtype=np.int64)
         value = np.zeros(BLOCK)
-        end_time = np.full(BLOCK, cfg[9])
-        max_pos = np.zeros(BLOCK)
-        min_cos = np.ones(BLOCK)
-        max_thr = np.zeros(BLOCK)
-        final_pos = np.zeros(BLOCK)
-        final_cos = np.ones(BLOCK)
-        last_out = np.zeros(BLOCK)
-        within = np.zeros(BLOCK, dtype=np.bool_)
-        sat_since = np.full(BLOCK, np.nan)
-        sat_rotor = np.zeros(BLOCK, dtype=np.int64)
-        sat_longest = np.zeros(BLOCK)
-        sat_longest_rotor = np.zeros(BLOCK, dtype=np.int64)
+        end_time = np.full(BLOCK, cfg[4])
+        J = np.empty((BLOCK, JUDGE_SIZE))
+        for j in range(BLOCK):
+            _judge_start(J[j])
         worst = np.zeros(BLOCK, dtype=np.int64)
         Tcol = np.empty(n)
         n_rec = 0
@@ -535,61 +474,13 @@ if numba is not None:
                         if n_rec < pos_rec.shape[1]:
                             pos_rec[j, n_rec] = np.nan
                         continue
-                    e0, e1, e2 = (W[(_E + 0) * BLOCK + j], W[(_E + 1) * BLOCK + j],
-                                  W[(_E + 2) * BLOCK + j])
-                    pos_err = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-                    R22 = W[(_R + 8) * BLOCK + j]
-                    cos_att = min(max(0.5 * ((W[(_R + 0) * BLOCK + j] + W[(_R + 4) * BLOCK + j]
-                                              + R22) - 1.0), -1.0), 1.0)
-                    throttle = W[_OM * BLOCK + j] / omega_max[0]
-                    for i in range(1, n):
-                        ratio = W[(_OM + i) * BLOCK + j] / omega_max[i]
-                        if ratio > throttle:
-                            throttle = ratio
-                    if pos_err > max_pos[j]:
-                        max_pos[j] = pos_err
-                    if cos_att < min_cos[j]:
-                        min_cos[j] = cos_att
-                    if throttle > max_thr[j]:
-                        max_thr[j] = throttle
-                    final_pos[j] = pos_err
-                    final_cos[j] = cos_att
-                    within[j] = pos_err <= cfg[4] and cos_att >= cfg[5]
-                    if not within[j]:
-                        last_out[j] = t
-                    if W[_OUT * BLOCK + j] > 0.0:
-                        if math.isnan(sat_since[j]):
-                            sat_since[j] = t
-                            sat_rotor[j] = worst[j]
-                        if t - sat_since[j] > sat_longest[j]:
-                            sat_longest[j] = t - sat_since[j]
-                            sat_longest_rotor[j] = sat_rotor[j]
-                    else:
-                        sat_since[j] = np.nan
+                    # vehicle j's state, rotation and error: strided views of W
+                    why, val = _judge_sample(jc, omega_max, t, W[j::BLOCK],
+                                             W[_R * BLOCK + j::BLOCK],
+                                             W[_E * BLOCK + j::BLOCK],
+                                             W[_OUT * BLOCK + j] > 0.0, worst[j], J[j])
                     if n_rec < pos_rec.shape[1]:
-                        pos_rec[j, n_rec] = pos_err
-                    wx, wy, wz = (W[(_W + 0) * BLOCK + j], W[(_W + 1) * BLOCK + j],
-                                  W[(_W + 2) * BLOCK + j])
-                    rate_xy = math.sqrt(wx * wx + wy * wy)
-                    finite = True
-                    for r in (_P, _P + 1, _P + 2, _Q, _Q + 1, _Q + 2, _Q + 3, _W, _W + 1, _W + 2):
-                        if not math.isfinite(W[r * BLOCK + j]):
-                            finite = False
-                    why = 0
-                    val = 0.0
-                    if not finite:
-                        why = _NON_FINITE
-                    elif R22 < 0.0:
-                        why = _FLIPPED
-                        val = math.degrees(math.acos(max(R22, -1.0)))
-                    elif W[(_P + 2) * BLOCK + j] < 0.0:
-                        why, val = _GROUND, W[(_P + 2) * BLOCK + j]
-                    elif abs(wz) > cfg[6]:
-                        why, val = _YAW_SPIN, abs(wz)
-                    elif pos_err > cfg[7]:
-                        why, val = _DRIFTED, pos_err
-                    elif rate_xy > cfg[8]:
-                        why, val = _RATE, rate_xy
+                        pos_rec[j, n_rec] = J[j, 3]
                     if why != 0:
                         reason[j] = why
                         value[j] = val
@@ -607,13 +498,7 @@ if numba is not None:
                         for i in range(n):
                             W[(_OM + i) * BLOCK + j] = state0[16 + i]
                     elif last:
-                        if within[j] and last_out[j] + sample_dt <= cfg[9] - cfg[10] + 1e-9:
-                            reason[j] = _SETTLED
-                        elif sat_longest[j] >= cfg[11] - 1e-9:
-                            reason[j] = _SATURATED
-                            value[j] = float(sat_longest_rotor[j])
-                        else:
-                            reason[j] = _NOT_SETTLED
+                        reason[j], value[j] = _verdict(jc, J[j])
                 n_rec += 1
                 if last or n_running == 0:
                     break
@@ -630,26 +515,14 @@ if numba is not None:
                                                         half_dt)
             _w_attitude(W)
         for j in range(B):
-            out_i[j, 0] = reason[j]
-            out_i[j, 1] = sat_longest_rotor[j]
+            _report(jc, reason[j], value[j], end_time[j], J[j], out_f[j], out_i[j])
             reached = running[j]
-            out_f[j, 0] = value[j]
-            out_f[j, 1] = end_time[j]
-            out_f[j, 2] = last_out[j] + sample_dt if reached and within[j] else np.nan
-            out_f[j, 3] = max_pos[j]
-            out_f[j, 4] = min_cos[j]
-            out_f[j, 5] = final_pos[j]
-            out_f[j, 6] = final_cos[j]
-            out_f[j, 7] = max_thr[j]
-            out_f[j, 8] = sat_longest[j]
-            out_f[j, 9] = last_out[j]
-            out_f[j, 10] = 1.0 if within[j] else 0.0
             if reached:
                 _w_save(W, j, n, final[j])
 
     @njit(cache=True, parallel=True, error_model="numpy")
-    def _fly_batch(cfg, ctl, pinv, thrust_max, nominal, mass, S, shift, k, state0, out_f,
-                   out_i, final, pos_rec):
+    def _fly_batch(cfg, jc, ctl, pinv, thrust_max, nominal, mass, S, shift, k, state0,
+                   out_f, out_i, final, pos_rec):
         """Blocks of BLOCK vehicles on _fly_block, spread over the cores; vehicles with
         more than MAX_BLOCK_ROTORS rotors one by one on _fly."""
         N = mass.shape[0]
@@ -660,13 +533,13 @@ if numba is not None:
             for j in prange(N):
                 veh = (dt, g, mass[j], lead, i_max, pos, axis, tmap, cd, cr, k[j], shift[j],
                        S[j], J0, dt_J0inv, inv_k, up, down, lead_up, lead_down, omega_max)
-                _fly(cfg, ctl, pinv, thrust_max, veh, state0, out_f[j], out_i[j], final[j],
-                     rec, pos_rec[j])
+                _fly(cfg, jc, ctl, pinv, thrust_max, veh, state0, out_f[j], out_i[j],
+                     final[j], rec, pos_rec[j])
             return
         for b in prange((N + BLOCK - 1) // BLOCK):
             lo = b * BLOCK
             hi = min(lo + BLOCK, N)
-            _fly_block(cfg, ctl, pinv, thrust_max, nominal, mass[lo:hi], S[lo:hi],
+            _fly_block(cfg, jc, ctl, pinv, thrust_max, nominal, mass[lo:hi], S[lo:hi],
                        shift[lo:hi], k[lo:hi], state0, out_f[lo:hi], out_i[lo:hi],
                        final[lo:hi], pos_rec[lo:hi])
 
@@ -697,11 +570,8 @@ def _load_numba_typing() -> None:
 def _settings(config: HoverConfig, setpoint) -> np.ndarray:
     values = {
         "dt": config.dt_s, "sp_x": setpoint[0], "sp_y": setpoint[1], "sp_z": setpoint[2],
-        "pos_tol": config.position_tol_m, "cos_tol": config.cos_attitude_tol,
-        "yaw_spin": config.yaw_spin_rad_s, "div_dist": config.divergence_distance_m,
-        "div_rate": config.diverged_rate_rad_s, "duration": config.duration_s,
-        "hold": config.hold_s, "sat_limit": config.saturation_limit_s,
-        "n_steps": config.n_steps, "every": config.sample_every}
+        "duration": config.duration_s, "n_steps": config.n_steps,
+        "every": config.sample_every}
     return np.array([float(values[name]) for name in CFG_FIELDS])
 
 
@@ -748,7 +618,7 @@ def fly_batch(params, config: HoverConfig, plant,
     if numba is None:
         raise RuntimeError(unavailable_reason())
     config.validate()
-    from reedtool.sim.layout import inputs
+    from reedtool.sim.layout import inputs, judge_settings
 
     gains = ControllerGains.from_params(params, design)
     state0, park = _start(params, gains, config)
@@ -761,14 +631,15 @@ def fly_batch(params, config: HoverConfig, plant,
     rows = config.n_steps // config.sample_every + (config.n_steps % config.sample_every != 0) + 1
     pos_rec = np.full((N, rows if record else 0), np.nan)
     _load_numba_typing()
+    jc = judge_settings(config)
     if N == 1:
-        _fly(cfg, the.ctl, the.pinv, the.thrust_max, the.vehicle(0), state0, out_f[0],
+        _fly(cfg, jc, the.ctl, the.pinv, the.thrust_max, the.vehicle(0), state0, out_f[0],
              out_i[0], final[0], np.empty((0, 0)), pos_rec[0])
     else:
-        _fly_batch(cfg, the.ctl, the.pinv, the.thrust_max, the.nominal, the.mass, the.S,
+        _fly_batch(cfg, jc, the.ctl, the.pinv, the.thrust_max, the.nominal, the.mass, the.S,
                    the.shift, the.k, state0, out_f, out_i, final, pos_rec)
     reason = out_i[:, 0].copy()
-    ended = ~np.isin(reason, [_SETTLED, _NOT_SETTLED, _SATURATED])
+    ended = ~np.isin(reason, [equations.SETTLED, equations.NOT_SETTLED, equations.SATURATED])
     final[ended] = park
     result = {name: out_f[:, i].copy() for i, name in enumerate(OUT_FIELDS)}
     result.update(reason=reason, saturation_rotor=out_i[:, 1].copy(), final=final)
@@ -780,7 +651,7 @@ def fly_batch(params, config: HoverConfig, plant,
 def vehicle_flyer(params, gains: ControllerGains, config: HoverConfig, setpoint_m):
     """`fly(state, rec)` with scalar.compile_vehicle's contract, on the compiled kernel:
     run.simulate_hover flies it unchanged."""
-    from reedtool.sim.layout import inputs
+    from reedtool.sim.layout import inputs, judge_settings
     from reedtool.sim.scalar import Flight
 
     if numba is None:
@@ -790,8 +661,7 @@ def vehicle_flyer(params, gains: ControllerGains, config: HoverConfig, setpoint_
     cfg = _settings(config, the.setpoint)
     veh = the.vehicle(0)
     n = params.n_rotors
-    reasons = {_NON_FINITE: "non-finite", _FLIPPED: "flipped", _GROUND: "ground",
-               _YAW_SPIN: "yaw-spin", _DRIFTED: "drifted", _RATE: "rate"}
+    jc = judge_settings(config)
 
     def fly(state, rec):
         *head, omega = state
@@ -801,22 +671,18 @@ def vehicle_flyer(params, gains: ControllerGains, config: HoverConfig, setpoint_
         final = np.zeros(13 + n)
         rows = config.n_steps // config.sample_every + 2 if rec is not None else 0
         buffer = np.empty((rows, REC_FIXED + n))
-        n_rec = _fly(cfg, the.ctl, the.pinv, the.thrust_max, veh, state0, out_f, out_i,
+        n_rec = _fly(cfg, jc, the.ctl, the.pinv, the.thrust_max, veh, state0, out_f, out_i,
                      final, buffer, np.empty(0))
         n_rec = min(n_rec, rows)
         if rec is not None:
             for row in buffer[:n_rec]:
                 rec(tuple(float(x) for x in row))
         col = dict(zip(OUT_FIELDS, (float(x) for x in out_f)))
-        reason = int(out_i[0])
-        # The judge's verdict at the end is run.simulate_hover's to make (as for the
-        # generated engine): hand back only the early endings.
-        early = reasons.get(reason)
-        omega_end = tuple(float(x) for x in final[13:])
-        return Flight(early, col["reason_value"] if early else 0.0, col["end_time_s"],
-                      col["max_position_error_m"], col["min_cos_attitude"],
-                      col["max_throttle"], col["last_out_s"], bool(col["within"]),
-                      col["longest_saturation_s"], int(out_i[1]),
-                      col["final_position_error_m"], col["final_cos_attitude"], omega_end)
+        return Flight(int(out_i[0]), col["reason_value"], col["end_time_s"],
+                      col["settle_time_s"], col["max_position_error_m"],
+                      col["min_cos_attitude"], col["max_throttle"],
+                      col["longest_saturation_s"], col["final_position_error_m"],
+                      col["final_cos_attitude"], tuple(float(x) for x in final[13:]),
+                      tuple(float(x) for x in final))
 
     return fly

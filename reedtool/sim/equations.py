@@ -17,6 +17,10 @@ desaturation acts only when a rotor is out of range (`@guarded_by` that test): t
 engine calls `desaturate` itself under its guard, the batch traces its work into columns
 for the vehicles whose guard holds, the compiled engine runs it as written.
 
+The judge of a flight is here too, in the same style: `judge_sample` (each sample: the
+record J and the events that end a flight), `verdict` (at the end: settled, saturated or
+not settled) and `settle_time`; every engine judges by them, built the same ways.
+
 Frames and units (docs/hover-test.md, "The simulation"): world z up, gravity -z; body
 axes the base link's, origin at the COM; state p, v (world, m, m/s), q = (w, x, y, z)
 body -> world, w body rates (rad/s), rotor speeds omega (rad/s), and the integral of the
@@ -494,3 +498,187 @@ def advance_state(veh, x, T, R, e):
                              omega_max[i])
     advance_plant(veh, x, T, R)
     x[13], x[14], x[15] = integral(i_max, dt, x[13], x[14], x[15], e[0], e[1], e[2])
+
+
+# ------------------------------------------------------------------ the judge
+
+# Why a flight ended: batch.REASONS[code]; 0 while it flies on.
+SETTLED, NOT_SETTLED, NON_FINITE, DRIFTED, RATE, GROUND, FLIPPED, SATURATED, YAW_SPIN = (
+    1, 2, 3, 4, 5, 6, 7, 8, 9)
+REASONS = ("", "settled", "not-settled", "non-finite", "drifted", "rate", "ground", "flipped",
+           "saturated", "yaw-spin")
+
+# The judge's settings jc (layout.judge_settings): pos_tol cos_tol yaw_spin div_dist div_rate
+#   duration hold sat_limit sample_dt (m, cos, rad/s, m, rad/s, s, s, s, s).
+# What it tracks over the samples, J (floats; judge_start sets them):
+#   0 max position error, 1 min cos(attitude error), 2 max throttle, 3 position error and
+#   4 cos(attitude error) at the last sample, 5 last sample time outside the band,
+#   6 inside the band at the last sample (1.0 / 0.0), 7 start of the current saturated
+#   streak (NaN: none), 8 its rotor furthest out at its start, 9 longest streak [s],
+#   10 that streak's rotor.
+JUDGE_SIZE = 11
+
+
+@select
+def smaller(a, b):
+    """min(a, b), b when either is NaN."""
+    return a if a < b else b
+
+
+@select
+def either(cond, a, b):
+    """`a` where cond holds, else `b`."""
+    return a if cond else b
+
+
+@select
+def flag(cond):
+    """1.0 for True, 0.0 for False (J holds floats)."""
+    return 1.0 if cond else 0.0
+
+
+@select
+def over(x, limit):
+    """x above limit (False for NaN)."""
+    return x > limit
+
+
+@select
+def under(x, limit):
+    """x below limit (False for NaN)."""
+    return x < limit
+
+
+@select
+def at_least(x, limit):
+    """x at or above limit (False for NaN)."""
+    return x >= limit
+
+
+@select
+def inside_band(pos, pos_tol, cos_att, cos_tol):
+    """Position and attitude errors both within the tolerance band."""
+    return pos <= pos_tol and cos_att >= cos_tol
+
+
+@select
+def streak_begins(saturated, since):
+    """A saturated sample with no streak running: one begins."""
+    return saturated and since != since
+
+
+@select
+def streak_start(saturated, since, t):
+    """When the current saturated streak began: t if it begins now, NaN when the demand
+    is back in range."""
+    return (t if since != since else since) if saturated else math.nan
+
+
+@select
+def all_finite(px, py, pz, qw, qx, qy, qz, wx, wy, wz):
+    """Position, attitude and rates all finite."""
+    return (math.isfinite(px) and math.isfinite(py) and math.isfinite(pz)
+            and math.isfinite(qw) and math.isfinite(qx) and math.isfinite(qy)
+            and math.isfinite(qz) and math.isfinite(wx) and math.isfinite(wy)
+            and math.isfinite(wz))
+
+
+@select
+def tilt_deg(R22):
+    """How far a flipped vehicle's body z is from up [deg] (0 when it is not flipped).
+    acos reads 0 for a vehicle that is not flipped (a batch computes both sides)."""
+    return math.degrees(math.acos(clamp(R22, -1.0, 0.0))) if R22 < 0.0 else 0.0
+
+
+@select
+def settles(within, last_out, sample_dt, duration, hold):
+    """Inside the band at the end, and for the hold time before it."""
+    return within != 0.0 and last_out + sample_dt <= duration - hold + 1e-9
+
+
+@select
+def ran_to_end(reason):
+    """An ending at the end of the run, not an event on the way."""
+    return reason == SETTLED or reason == NOT_SETTLED or reason == SATURATED
+
+
+@select
+def settled_at(reached_end, within, last_out, sample_dt):
+    """The time the vehicle entered the band for good; NaN when it ended early or
+    outside the band."""
+    return last_out + sample_dt if reached_end and within != 0.0 else math.nan
+
+
+def judge_start(J):
+    """J before the first sample."""
+    J[0], J[1], J[2], J[3], J[4], J[5] = 0.0, 1.0, 0.0, 0.0, 1.0, 0.0
+    J[6], J[7], J[8], J[9], J[10] = 0.0, math.nan, 0.0, 0.0, 0.0
+
+
+def judge_sample(jc, omega_max, t, x, R, e, saturated, worst, J):
+    """One sample of the flight at time t: state x, its rotation R and position error e,
+    and whether the controller's demand there is out of the rotors' range (`saturated`,
+    `worst` the rotor furthest out). Updates J; returns (reason, value): the event that
+    ends the flight here (the first in this order: non-finite, flipped, ground, yaw spin,
+    drifted, roll/pitch rate) and the number that ended it, or (0, 0.0)."""
+    pos = math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
+    # the attitude error: the rotation angle of R from the level hover at heading 0
+    cos_att = clamp(0.5 * ((R[0] + R[4] + R[8]) - 1.0), -1.0, 1.0)
+    throttle = x[16] / omega_max[0]
+    for i in range(1, len(omega_max)):
+        throttle = larger(x[16 + i] / omega_max[i], throttle)
+    J[0] = larger(pos, J[0])
+    J[1] = smaller(cos_att, J[1])
+    J[2] = larger(throttle, J[2])
+    J[3] = pos
+    J[4] = cos_att
+    within = inside_band(pos, jc[0], cos_att, jc[1])
+    J[5] = either(within, J[5], t)
+    J[6] = flag(within)
+    # saturated streaks: start, rotor furthest out at the start, longest so far
+    since = J[7]
+    rotor = either(streak_begins(saturated, since), worst, J[8])
+    since = streak_start(saturated, since, t)
+    longer = over(t - since, J[9])
+    J[9] = either(longer, t - since, J[9])
+    J[10] = either(longer, rotor, J[10])
+    J[7] = since
+    J[8] = rotor
+    # events, the last in the order first so that the first one that holds wins
+    rate_xy = math.sqrt(x[10] * x[10] + x[11] * x[11])
+    hit = over(rate_xy, jc[4])
+    reason = either(hit, RATE, 0)
+    value = either(hit, rate_xy, 0.0)
+    hit = over(pos, jc[3])
+    reason = either(hit, DRIFTED, reason)
+    value = either(hit, pos, value)
+    yaw_rate = math.fabs(x[12])
+    hit = over(yaw_rate, jc[2])
+    reason = either(hit, YAW_SPIN, reason)
+    value = either(hit, yaw_rate, value)
+    hit = under(x[2], 0.0)
+    reason = either(hit, GROUND, reason)
+    value = either(hit, x[2], value)
+    hit = under(R[8], 0.0)
+    reason = either(hit, FLIPPED, reason)
+    value = either(hit, tilt_deg(R[8]), value)
+    finite = all_finite(x[0], x[1], x[2], x[6], x[7], x[8], x[9], x[10], x[11], x[12])
+    reason = either(finite, reason, NON_FINITE)
+    value = either(finite, value, 0.0)
+    return reason, value
+
+
+def verdict(jc, J):
+    """(reason, value) of a flight that flew to the end: settled (in the band for the
+    hold time), else saturated when the rotors were at their limits for sat_limit in a
+    row (value: the rotor furthest out), else not settled."""
+    settled = settles(J[6], J[5], jc[8], jc[5], jc[6])
+    starved = at_least(J[9], jc[7] - 1e-9)
+    reason = either(settled, SETTLED, either(starved, SATURATED, NOT_SETTLED))
+    value = either(settled, 0.0, either(starved, J[10], 0.0))
+    return reason, value
+
+
+def settle_time(jc, reason, J):
+    """When the flight entered the band for good (NaN: never, or it ended early)."""
+    return settled_at(ran_to_end(reason), J[6], J[5], jc[8])

@@ -108,3 +108,16 @@ def inputs(params, gains: ControllerGains, config: HoverConfig, plant=None,
                   S=_c(np.asarray(plant.inertia_scale_sqrt).T),
                   shift=_c(np.asarray(plant.com_shift_m).T),
                   k=_c(np.asarray(plant.motor_constant).T))
+
+
+# Names of the judge's record J in the traced code (equations' J layout).
+JUDGE = ("max_pos", "min_cos", "max_throttle", "pos", "cos_att", "last_out", "within",
+         "sat_since", "sat_rotor", "sat_longest", "sat_rotor_longest")
+
+
+def judge_settings(config: HoverConfig) -> np.ndarray:
+    """equations' jc for `config`: what the judge holds a flight to."""
+    return _c([config.position_tol_m, config.cos_attitude_tol, config.yaw_spin_rad_s,
+               config.divergence_distance_m, config.diverged_rate_rad_s, config.duration_s,
+               config.hold_s, config.saturation_limit_s,
+               config.sample_every * config.dt_s])

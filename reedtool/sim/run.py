@@ -3,8 +3,8 @@
 For a single vehicle numpy's per-call overhead (about half a microsecond per operation on
 tiny arrays) dominates, so the array engine in `batch` runs a 10 s flight in seconds.
 `scalar` generates the step for the vehicle at hand, traced from the flight equations
-(`equations`) as the array engine's is; this module runs it (or the compiled engine) and
-makes the verdict of the judged flight.
+(`equations`) as the array engine's is, its judge included; this module runs it (or the
+compiled engine) and turns the judged flight into a HoverRun.
 """
 
 from __future__ import annotations
@@ -16,7 +16,8 @@ import numpy as np
 
 from reedtool.io.json_values import finite_or_none
 from reedtool.sim import ExitStatus, HoverConfig
-from reedtool.sim.batch import describe
+from reedtool.sim.batch import STATUS_OF_REASON, describe
+from reedtool.sim.equations import REASONS
 from reedtool.sim.layout import hover_speeds
 from reedtool.sim.controller import ControllerDesign, ControllerGains
 from reedtool.sim.dynamics import quat_from_rpy
@@ -91,7 +92,6 @@ def simulate_hover(params: VehicleParams, config: HoverConfig = HoverConfig(),
     config.validate()
     if gains is None:
         gains = ControllerGains.from_params(params, design)
-    sample_dt = config.sample_every * config.dt_s
     acos, degrees = math.acos, math.degrees
     setpoint = (0.0, 0.0, float(config.hover_altitude_m))
     if engine == "numba":
@@ -111,26 +111,15 @@ def simulate_hover(params: VehicleParams, config: HoverConfig = HoverConfig(),
     flight = fly((*p0, 0.0, 0.0, 0.0, *q0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
                   tuple(float(w) for w in omega0)), rec.append if record else None)
 
-    end_time, value = flight.end_time_s, flight.value
-    within, last_out = flight.within, flight.last_out_s
+    # the judge's ending (equations.judge_sample, verdict, settle_time), as the engine ran it
+    reason = REASONS[flight.reason]
+    status = STATUS_OF_REASON[reason]
+    end_time, value, settle = flight.end_time_s, flight.value, flight.settle_time_s
     sat_longest = flight.longest_saturation_s
     pos, cos_att = flight.position_error_m, flight.cos_attitude
     max_pos, min_cos, max_throttle = (flight.max_position_error_m, flight.min_cos_attitude,
                                       flight.max_throttle)
     omega = flight.omega_rad_s
-    if flight.reason is not None:
-        status, reason = _EVENTS[flight.reason], flight.reason
-    elif within and last_out + sample_dt <= config.duration_s - config.hold_s + 1e-9:
-        status, reason = ExitStatus.PASSED, "settled"
-    elif sat_longest >= config.saturation_limit_s - 1e-9:
-        status, reason, value = (ExitStatus.SATURATED, "saturated",
-                                 float(flight.longest_saturation_rotor))
-    else:
-        status, reason = ExitStatus.NOT_SETTLED, "not-settled"
-
-    # Time it entered the band for good; NaN when it ended early or outside the band.
-    reached_end = status in (ExitStatus.PASSED, ExitStatus.NOT_SETTLED, ExitStatus.SATURATED)
-    settle = last_out + sample_dt if reached_end and within else math.nan
     final_att_deg = degrees(acos(cos_att)) if cos_att == cos_att else math.nan
     message = describe(status, reason, value, end_time, settle, pos, final_att_deg, config,
                        params.rotor_names, sat_longest)
@@ -143,12 +132,6 @@ def simulate_hover(params: VehicleParams, config: HoverConfig = HoverConfig(),
         final_omega_rad_s=np.array(omega), initial_omega_rad_s=omega0, gains=gains,
         config=config, rotor_names=params.rotor_names,
         series=sample_series(rec, params.rotor_names) if record else {}, engine=engine)
-
-
-# How the generated engine's early endings map to statuses.
-_EVENTS = {"non-finite": ExitStatus.DIVERGED, "flipped": ExitStatus.CRASHED,
-           "ground": ExitStatus.CRASHED, "yaw-spin": ExitStatus.YAW_SPIN,
-           "drifted": ExitStatus.DIVERGED, "rate": ExitStatus.DIVERGED}
 
 
 def sample_series(rec: list[tuple], rotor_names: tuple[str, ...]) -> dict[str, np.ndarray]:

@@ -177,6 +177,7 @@ class _TracedMath:
     """`math` for traced code: sqrt and tan of a Sym become nodes."""
 
     inf = math.inf
+    nan = math.nan
 
     def __getattr__(self, name):
         real = getattr(math, name)
@@ -346,9 +347,12 @@ class Writer:
     `lines()`. Constants that are not numbers (a pseudo-inverse's rows) go into
     `namespace` under generated names."""
 
-    def __init__(self, namespace: dict, columns: bool = False):
+    def __init__(self, namespace: dict, columns: bool = False, prefix: str = "_"):
         """`columns`: the values are arrays over vehicles (selects as `where`, guarded
-        steps vehicle by vehicle: guarded_columns)."""
+        steps vehicle by vehicle: guarded_columns). `prefix` starts the names of
+        intermediate values (code run between another writer's split halves needs its
+        own)."""
+        self.prefix = prefix
         self.namespace = namespace
         self.columns = columns
         self.outputs: list[tuple[str, object]] = []
@@ -435,7 +439,7 @@ class Writer:
             expr = self._expression(node, ref)
             name = self.fixed.get(node.serial)
             if name is None and uses.get(node.serial, 0) > 1:
-                name = f"_{next(self._names)}"
+                name = f"{self.prefix}{next(self._names)}"
             if name is not None:
                 out.append(f"{name} = {expr}")
                 named[node.serial] = name
@@ -457,7 +461,7 @@ class Writer:
                 direct.append(f"{target} = {r}")
                 assigned.add(target)
             else:
-                tmp = f"_{next(self._names)}"
+                tmp = f"{self.prefix}{next(self._names)}"
                 out.append(f"{tmp} = {r}")
                 renames.append(f"{target} = {tmp}")
         return (out, direct + renames) if split else out + direct + renames
@@ -513,7 +517,7 @@ class Writer:
         test = " or ".join(select_text(guard, [t, literal(limits[i])])
                            for i, t in enumerate(names))
         changed, result = self.fixed_results.get(node.serial) or (
-            f"_{next(self._names)}", f"_{next(self._names)}")
+            f"{self.prefix}{next(self._names)}", f"{self.prefix}{next(self._names)}")
         self._t_names[node.serial] = names
         self._result_names[node.serial] = {"changed": changed, "result": result}
         self.namespace[name] = step
