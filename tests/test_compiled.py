@@ -161,6 +161,10 @@ def test_default_engine_is_numba_for_a_batch_numpy_for_one_vehicle(monkeypatch):
     assert report["sim"]["engine"] == "numba" and report["batch"]["engine"] == "numba"
     _, out = run_cli("hover-test", SEED_MODEL, *ARGV, "--duration", "3", "--format", "json")
     assert json.loads(out)["sim"]["engine"] == "numpy"
+    # the command tells choose_engine the batch's size: 3 vehicles stay on numpy
+    _, out = run_cli("hover-test", SEED_MODEL, *ARGV, "--duration", "3", "--format", "json",
+                     "--samples", "3")
+    assert json.loads(out)["batch"]["engine"] == "numpy"
     # an explicit choice is kept; without numba a batch falls back to the reference
     assert choose_engine("numpy", batch=True) == "numpy"
     assert choose_engine("numba", batch=False) == "numba"

@@ -155,7 +155,8 @@ def plan_hover_test(options: HoverTestOptions) -> HoverPlan:
     if options.controller_files:
         _check_controller(options)
     engine = choose_engine(options.engine,
-                           batch=options.samples is not None and not options.controller_files)
+                           batch=options.samples is not None and not options.controller_files,
+                           vehicles=options.samples)
     if engine == "numba":
         from reedtool.sim.compiled import available, unavailable_reason
 
