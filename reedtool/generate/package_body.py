@@ -70,7 +70,8 @@ def plan_body_edit(model_file: Path, package: str, mesh_name: str, props,
     mesh's frame) the body of `model_file`."""
     from reedtool.io.fileio import read_xml_file
     from reedtool.io.xacro_edit import property_value_span, set_block_inertia, set_properties
-    from reedtool.physics.inertia import fmt_number, inertia_element
+    from reedtool.io.xml_numbers import short_text
+    from reedtool.physics.inertia import inertia_element
     from reedtool.generate.package_spec import com_text
 
     text, encoding = read_xml_file(model_file, what="xacro file")
@@ -92,7 +93,7 @@ def plan_body_edit(model_file: Path, package: str, mesh_name: str, props,
                  "writes the body with its COM, or pass --recenter com to move the mesh")
     mass_kg = float(props.mass_kg)
     if set_mass:
-        values["mass"] = fmt_number(mass_kg)
+        values["mass"] = short_text(mass_kg)
     new_text, missing = set_properties(text, values)
     missing = [name for name in missing if name != "use_mesh_file"]
     new_text, inertia_span = set_block_inertia(new_text, "body_inertia",

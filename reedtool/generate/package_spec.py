@@ -20,6 +20,8 @@ from pathlib import Path
 from typing import Callable, Mapping
 
 from reedtool.errors import PLAUSIBLE, ReedtoolError, check_plausible
+from reedtool.io.xml_numbers import short_text
+from reedtool.model import inertia_values
 from reedtool.physics.propulsion import FIREFLY
 from reedtool.generate.airframes import Airframe, GroundLayout, get_frame
 
@@ -579,20 +581,16 @@ def _as_xacro(expr: str) -> str:
 
 def _centred(centre_m: float, expr: str) -> str:
     """`expr` moved by a rotor-centre coordinate, e.g. `0.0152 + arm_length`."""
-    from reedtool.physics.inertia import fmt_number
-
     if centre_m == 0.0:
         return expr
     if expr == "0":
-        return fmt_number(centre_m)
-    return f"{fmt_number(centre_m)} + {expr}"
+        return short_text(centre_m)
+    return f"{short_text(centre_m)} + {expr}"
 
 
 def com_text(com_m) -> str:
     """A COM as an xyz attribute; below a nanometre is the mesh integral's round-off: 0."""
-    from reedtool.physics.inertia import fmt_number
-
-    return " ".join(fmt_number(0.0 if abs(v) < 1e-9 else float(v)) for v in com_m)
+    return " ".join(short_text(0.0 if abs(v) < 1e-9 else float(v)) for v in com_m)
 
 
 def _body_depth_m(spec: PackageSpec) -> float:
@@ -603,11 +601,7 @@ def _body_depth_m(spec: PackageSpec) -> float:
 
 
 def _inertia_attrs(I) -> dict[str, str]:
-    from reedtool.physics.inertia import fmt_number
-
-    return {key: fmt_number(I[i][j]) for key, (i, j) in {
-        "ixx": (0, 0), "ixy": (0, 1), "ixz": (0, 2),
-        "iyy": (1, 1), "iyz": (1, 2), "izz": (2, 2)}.items()}
+    return {key: short_text(value) for key, value in inertia_values(I).items()}
 
 
 def template_context(spec: PackageSpec, body_props=None) -> dict:
@@ -617,14 +611,12 @@ def template_context(spec: PackageSpec, body_props=None) -> dict:
     tensor about it) replaces the body box when a mesh was imported; its COM is written
     into the body's <inertial><origin>.
     """
-    from reedtool.physics.inertia import fmt_number
-
     ctx: dict = {
         "name": spec.name, "ros": spec.ros, "kind": spec.kind, "sim": spec.sim,
         "frame": {"name": spec.frame.name, "title": spec.frame.title},
         "description": spec.description, "version": spec.version, "license": spec.license,
         "maintainer": spec.maintainer, "maintainer_email": spec.maintainer_email,
-        "p": {key: fmt_number(value) for key, value in spec.values.items()},
+        "p": {key: short_text(value) for key, value in spec.values.items()},
         "mesh_file": "body.stl" if spec.mesh is not None else None,
         "command_line": "",
     }
@@ -639,14 +631,12 @@ def scaled_lee_gains(mass_kg: float, inertia_kg_m2) -> dict[str, list[str]]:
     """RotorS' firefly Lee gains scaled by this vehicle's mass (position, velocity) and
     principal inertia diagonal (attitude, angular rate), 4 significant digits: the gains
     the generated controllers (Lee YAML, gz MulticopterVelocityControl) carry."""
-    from reedtool.physics.inertia import fmt_number
-
     mass_ratio = mass_kg / _FIREFLY_MASS_KG
     inertia_ratio = [inertia_kg_m2[i][i] / _FIREFLY_INERTIA_KG_M2[i] for i in range(3)]
     gains = {}
     for key, values in _FIREFLY_LEE_GAINS.items():
         ratio = [mass_ratio] * 3 if key in ("position_gain", "velocity_gain") else inertia_ratio
-        gains[key] = [fmt_number(float(f"{v * r:.4g}")) for v, r in zip(values, ratio)]
+        gains[key] = [short_text(float(f"{v * r:.4g}")) for v, r in zip(values, ratio)]
     return gains
 
 
@@ -657,7 +647,6 @@ def _multirotor_context(spec: PackageSpec, body_props) -> dict:
         MassProperties,
         box_inertia,
         combine,
-        fmt_number,
         sphere_inertia,
     )
 
@@ -666,10 +655,10 @@ def _multirotor_context(spec: PackageSpec, body_props) -> dict:
     if body_props is None:
         size = (spec["body_width"], spec["body_width"], spec["body_height"])
         body_props = MassProperties(mass_kg, np.zeros(3), box_inertia(mass_kg, size))
-        body_source = (f"a solid box {fmt_number(size[0])} x {fmt_number(size[1])} x "
-                       f"{fmt_number(size[2])} m of {fmt_number(mass_kg)} kg")
+        body_source = (f"a solid box {short_text(size[0])} x {short_text(size[1])} x "
+                       f"{short_text(size[2])} m of {short_text(mass_kg)} kg")
     else:
-        body_source = f"the body mesh (meshes/body.stl) filled uniformly, {fmt_number(mass_kg)} kg"
+        body_source = f"the body mesh (meshes/body.stl) filled uniformly, {short_text(mass_kg)} kg"
     blade = (spec["radius_rotor"], ROTOR_BLADE_WIDTH_M, ROTOR_BLADE_THICKNESS_M)
     rotor_I = box_inertia(spec["mass_rotor"] * spec["rotor_velocity_slowdown_sim"], blade)
 
@@ -685,7 +674,7 @@ def _multirotor_context(spec: PackageSpec, body_props) -> dict:
         ux, uy = frame.unit_xy(slot)
         if on_mounts:
             # On the CAD body's motor mounts: where the mesh has them, not a pattern.
-            xyz_expr = [fmt_number(float(v)) for v in position]
+            xyz_expr = [short_text(float(v)) for v in position]
         else:
             xyz_expr = [_centred(c, expr) for c, expr in zip(centre, (
                 _py_coeff(ux, "arm_length"), _py_coeff(uy, "arm_length"),
@@ -696,7 +685,7 @@ def _multirotor_context(spec: PackageSpec, body_props) -> dict:
             "color": "Red" if position[0] < -1e-9 else "Blue",
             "xyz": " ".join(_as_xacro(expr) for expr in xyz_expr),
             "xyz_expr": xyz_expr,
-            "position_m": [fmt_number(v) for v in position],
+            "position_m": [short_text(v) for v in position],
         })
         parts.append(MassProperties(spec["mass_rotor"], np.asarray(position),
                                     box_inertia(spec["mass_rotor"], blade)))
@@ -708,8 +697,8 @@ def _multirotor_context(spec: PackageSpec, body_props) -> dict:
     # about its COM (checks/controller_rules.py, C405/C406).
     for rotor, position in zip(rotors, positions):
         dx, dy = position[0] - total.com_m[0], position[1] - total.com_m[1]
-        rotor["angle_rad"] = fmt_number(float(np.arctan2(dy, dx)))
-        rotor["radial_m"] = fmt_number(float(np.hypot(dx, dy)))
+        rotor["angle_rad"] = short_text(float(np.arctan2(dy, dx)))
+        rotor["radial_m"] = short_text(float(np.hypot(dx, dy)))
     gains = scaled_lee_gains(total.mass_kg, I_total)
     return {
         "rotor_count": frame.rotor_count,
@@ -719,13 +708,13 @@ def _multirotor_context(spec: PackageSpec, body_props) -> dict:
         "body_inertia_source": body_source,
         "body_com_xyz": com_text(body_com),
         "rotor_inertia": _inertia_attrs(rotor_I),
-        "total_mass_kg": fmt_number(total.mass_kg),
+        "total_mass_kg": short_text(total.mass_kg),
         "total_inertia": _inertia_attrs(I_total),
         "lee_gains": gains,
         "thrust_to_weight": f"{thrust_to_weight(spec):.2f}",
-        "rotor_disc_thickness_m": fmt_number(ROTOR_DISC_THICKNESS_M),
+        "rotor_disc_thickness_m": short_text(ROTOR_DISC_THICKNESS_M),
         # Spawn 5 cm above the ground: below the body (box or mesh) or the lower rotor discs.
-        "spawn_z_m": fmt_number(round(0.05 + max(_body_depth_m(spec), max(
+        "spawn_z_m": short_text(round(0.05 + max(_body_depth_m(spec), max(
             -p[2] for p in positions) + ROTOR_DISC_THICKNESS_M / 2.0), 3)),
     }
 
@@ -737,7 +726,6 @@ def _ground_context(spec: PackageSpec, body_props) -> dict:
         MassProperties,
         box_inertia,
         cylinder_inertia,
-        fmt_number,
         sphere_inertia,
     )
 
@@ -746,17 +734,17 @@ def _ground_context(spec: PackageSpec, body_props) -> dict:
     size = (spec["body_length"], spec["body_width"], spec["body_height"])
     if body_props is None:
         body_props = MassProperties(mass_kg, np.zeros(3), box_inertia(mass_kg, size))
-        body_source = (f"a solid box {' x '.join(fmt_number(s) for s in size)} m of "
-                       f"{fmt_number(mass_kg)} kg")
+        body_source = (f"a solid box {' x '.join(short_text(s) for s in size)} m of "
+                       f"{short_text(mass_kg)} kg")
     else:
-        body_source = f"the body mesh (meshes/body.stl) filled uniformly, {fmt_number(mass_kg)} kg"
+        body_source = f"the body mesh (meshes/body.stl) filled uniformly, {short_text(mass_kg)} kg"
     r, h = spec["wheel_radius"], spec["body_height"]
     base_height_m = spec["ground_clearance"] + h / 2.0      # base_link above the ground
     wheel_z_m = r - base_height_m
     wheels = [{
         "name": w.name,
-        "x": fmt_number(w.x_per_wheelbase * spec["wheelbase"]) if layout.name == "car-4w" else "0",
-        "y": fmt_number(w.side * spec["track_width"] / 2.0),
+        "x": short_text(w.x_per_wheelbase * spec["wheelbase"]) if layout.name == "car-4w" else "0",
+        "y": short_text(w.side * spec["track_width"] / 2.0),
         "side": "left" if w.side > 0 else "right",
     } for w in layout.wheels]
     caster_radius_m = spec["ground_clearance"] / 2.0
@@ -768,15 +756,15 @@ def _ground_context(spec: PackageSpec, body_props) -> dict:
         "body_com_xyz": com_text(body_props.com_m),
         "wheel_inertia": _inertia_attrs(cylinder_inertia(spec["wheel_mass"], r,
                                                          spec["wheel_width"], axis="y")),
-        "base_height": fmt_number(base_height_m),
-        "wheel_z": fmt_number(wheel_z_m),
-        "wheel_diameter": fmt_number(2 * r),
+        "base_height": short_text(base_height_m),
+        "wheel_z": short_text(wheel_z_m),
+        "wheel_diameter": short_text(2 * r),
         "caster": layout.caster,
-        "caster_radius": fmt_number(caster_radius_m),
-        "caster_x": fmt_number(-(spec["body_length"] / 2.0 - caster_radius_m)),
-        "caster_z": fmt_number(caster_radius_m - base_height_m),
+        "caster_radius": short_text(caster_radius_m),
+        "caster_x": short_text(-(spec["body_length"] / 2.0 - caster_radius_m)),
+        "caster_z": short_text(caster_radius_m - base_height_m),
         "caster_inertia": _inertia_attrs(sphere_inertia(spec["caster_mass"], caster_radius_m)),
-        "total_mass_kg": fmt_number(total_mass_estimate_kg(spec)),
+        "total_mass_kg": short_text(total_mass_estimate_kg(spec)),
     }
     return ctx
 

@@ -16,7 +16,6 @@ from typing import Iterable, Iterator
 import numpy as np
 
 from reedtool.errors import ReedtoolError
-from reedtool.io.xml_numbers import clean_tensor, short_text as fmt_number  # noqa: F401 - re-exported
 from reedtool.model import Box, Cylinder, Link, Mesh, Robot, Sphere
 
 # ------------------------------------------------------------ the value object

@@ -44,7 +44,7 @@ def _vector(v) -> str:
 
 
 def report_lines(outcome) -> list[str]:
-    from reedtool.physics.inertia import clean_tensor
+    from reedtool.io.xml_numbers import clean_tensor
 
     imp = outcome.imported
     topo, props = imp.topology, imp.mass

@@ -18,7 +18,7 @@ def _vec(v, fmt: str = ".6g") -> str:
 
 
 def _tensor_line(I) -> str:
-    from reedtool.physics.inertia import clean_tensor
+    from reedtool.io.xml_numbers import clean_tensor
 
     I = clean_tensor(I)
     return (f"ixx {I[0, 0]:.4g}  iyy {I[1, 1]:.4g}  izz {I[2, 2]:.4g}  "
@@ -41,7 +41,7 @@ def render_text(report) -> str:
     """`report`: a workflows.inertia_check.InertiaReport of a model that was computed."""
     model, robot, comparisons = report.model, report.robot, report.comparisons
     whole, own, findings = report.whole, report.own, report.findings
-    from reedtool.physics.inertia import clean_tensor
+    from reedtool.io.xml_numbers import clean_tensor
     from reedtool.report import display_path
 
     lines = [f"{display_path(str(model))}: {len(robot.links)} links, base frame "
